@@ -1,0 +1,81 @@
+// Clamped knot vectors of B-splines of order k (degree k - 1).
+//
+// A knot vector t_0 <= ... <= t_{n+k-1} defines n B-splines of order k. Clamped: the first k
+// knots equal the start of the domain and the last k its end, so the spline interpolates its
+// first and last control points. Interior knots have multiplicity at most k - 1 (the spline
+// stays at least C^0). Notation follows Piegl & Tiller, The NURBS Book (2nd ed., 1997), with
+// order k = p + 1.
+#ifndef SPLINEGRID_CORE_BSPLINE_KNOT_VECTOR_H_
+#define SPLINEGRID_CORE_BSPLINE_KNOT_VECTOR_H_
+
+#include <span>
+#include <vector>
+
+#include "absl/status/statusor.h"
+
+namespace splinegrid {
+
+// Highest supported order (degree 9). Basis evaluation keeps k x k tables on the stack.
+inline constexpr int kMaxOrder = 10;
+
+// Knot placement for a least-squares fit.
+enum class KnotPlacement {
+  kUniform,   // equally spaced interior knots
+  kAveraged,  // from the data parameters, Piegl & Tiller eq. 9.8 / 9.68-9.69
+};
+
+class KnotVector {
+ public:
+  // The single constant B-spline on [0, 1] (order 1, knots {0, 1}): the basis of an unused
+  // direction of a tensor-product spline.
+  KnotVector() : order_(1), knots_{0.0, 1.0} {}
+
+  // Validates and wraps `knots`: order in [1, kMaxOrder], at least 2k knots, all finite and
+  // non-decreasing, clamped at both ends, non-empty domain, interior multiplicity <= k - 1.
+  static absl::StatusOr<KnotVector> Create(int order, std::vector<double> knots);
+
+  // Clamped knots on [0, 1] with equally spaced interior knots.
+  // Precondition: 1 <= order <= kMaxOrder, num_controls >= order.
+  static KnotVector Uniform(int order, int num_controls);
+
+  // Clamped knots on [0, 1] placed from strictly increasing data parameters u_0 = 0 < ... <
+  // u_{m-1} = 1 so that every knot span holds data (Schoenberg-Whitney), which keeps the
+  // least-squares problem well posed:
+  //  - num_controls == m: knot averaging, P&T eq. 9.8, t_{j+k-1} = mean(u_j .. u_{j+k-2});
+  //  - num_controls < m: P&T eq. 9.68-9.69, d = m / (n - k + 1), i = floor(j d),
+  //    a = j d - i, t_{k-1+j} = (1 - a) u_{i-1} + a u_i, j = 1 .. n - k.
+  // Errors: INVALID_ARGUMENT if the parameters are not strictly increasing on [0, 1] or
+  // num_controls is outside [order, m].
+  static absl::StatusOr<KnotVector> Averaged(int order, int num_controls,
+                                             std::span<const double> params);
+
+  int order() const { return order_; }
+  int degree() const { return order_ - 1; }
+  int num_controls() const { return static_cast<int>(knots_.size()) - order_; }
+  std::span<const double> knots() const { return knots_; }
+  double knot(int i) const { return knots_[i]; }
+  double domain_begin() const { return knots_[order_ - 1]; }
+  double domain_end() const { return knots_[knots_.size() - order_]; }
+
+  // The knot span mu with t_mu <= u < t_{mu+1}, in [k - 1, n - 1]; u at or beyond the end of
+  // the domain gives the last non-empty span, u before it the first (P&T A2.1, binary search).
+  int FindSpan(double u) const;
+
+  // Number of knots equal to u.
+  int Multiplicity(double u) const;
+
+  // The distinct interior knots (excluding the domain ends), ascending.
+  std::vector<double> InteriorBreaks() const;
+
+  friend bool operator==(const KnotVector& a, const KnotVector& b) = default;
+
+ private:
+  KnotVector(int order, std::vector<double> knots) : order_(order), knots_(std::move(knots)) {}
+
+  int order_;
+  std::vector<double> knots_;
+};
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_CORE_BSPLINE_KNOT_VECTOR_H_

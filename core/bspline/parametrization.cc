@@ -1,0 +1,189 @@
+#include "core/bspline/parametrization.h"
+
+#include <cmath>
+
+#include "core/util/check.h"
+
+namespace splinegrid {
+
+std::string_view ParametrizationName(Parametrization p) {
+  switch (p) {
+    case Parametrization::kUniform:
+      return "uniform";
+    case Parametrization::kChordLength:
+      return "chord_length";
+    case Parametrization::kCentripetal:
+      return "centripetal";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// The increment of one segment for a squared chord length d2.
+template <Parametrization P>
+inline double Increment(double d2) {
+  if constexpr (P == Parametrization::kCentripetal) {
+    return std::sqrt(std::sqrt(d2));
+  } else {
+    return std::sqrt(d2);
+  }
+}
+
+// A plane of points with each coordinate in its own contiguous array (structure of arrays),
+// so that distances between neighbours vectorise without shuffling interleaved coordinates.
+template <int S>
+struct PlaneSoA {
+  std::array<std::vector<double>, S> x;
+  void Load(const double* points, int64_t count) {
+    for (int c = 0; c < S; ++c) {
+      x[c].resize(count);
+      double* out = x[c].data();
+      for (int64_t i = 0; i < count; ++i) out[i] = points[S * i + c];
+    }
+  }
+};
+
+// out[i] = Increment(|q_i - p_i|^2) for i < count, where p_i = (a[0][i], a[1][i], ...) and
+// q_i the same in b.
+template <int S, Parametrization P>
+void SegmentIncrements(const PlaneSoA<S>& a, int64_t a_offset, const PlaneSoA<S>& b,
+                       int64_t b_offset, int64_t count, double* __restrict out) {
+  const double* pa[S];
+  const double* pb[S];
+  for (int c = 0; c < S; ++c) {
+    pa[c] = a.x[c].data() + a_offset;
+    pb[c] = b.x[c].data() + b_offset;
+  }
+  for (int64_t i = 0; i < count; ++i) {
+    double d2 = 0.0;
+    for (int c = 0; c < S; ++c) d2 += (pb[c][i] - pa[c][i]) * (pb[c][i] - pa[c][i]);
+    out[i] = Increment<P>(d2);
+  }
+}
+
+// sum_x a[x] * b[x] (b == nullptr: sum_x a[x]) with eight independent partial sums, so that
+// the loop vectorises instead of waiting on one chain of dependent additions.
+double Dot(const double* a, const double* b, int64_t n) {
+  double partial[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int64_t x = 0;
+  for (; x + 8 <= n; x += 8) {
+    for (int t = 0; t < 8; ++t) partial[t] += b ? a[x + t] * b[x + t] : a[x + t];
+  }
+  double sum = 0.0;
+  for (; x < n; ++x) sum += b ? a[x] * b[x] : a[x];
+  for (double p : partial) sum += p;
+  return sum;
+}
+
+// Sum over lines of normalised increments, and the number of lines that took part.
+struct LineAverage {
+  std::vector<double> sum;
+  int64_t lines = 0;
+};
+
+// 1 / length, or 0 for a collapsed (or non-finite) line, which then takes no part.
+inline double InverseLength(double length) {
+  return length > 0.0 && std::isfinite(length) ? 1.0 / length : 0.0;
+}
+
+// One sweep over the points, a k-plane at a time, computes the increments of all three
+// directions:
+//  - i: each grid row is a whole line, normalised at once;
+//  - j: a k-plane holds whole j-lines, normalised after the plane;
+//  - k: lines span the block; their increments are kept until all lengths are known.
+// Memory beyond the input: two planes and the k-increments (a third of a 3D volume's input).
+template <int S, Parametrization P>
+std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
+  const Extents& n = block.extents();
+  const int64_t ni = n[0], nj = n[1], nk = n[2], plane = ni * nj;
+  std::array<LineAverage, 3> avg;
+  for (int d = 0; d < 3; ++d) avg[d].sum.assign(n[d] - 1, 0.0);
+  std::vector<double> row(ni), plane_j(plane), length_j(ni), length_k(plane, 0.0);
+  std::vector<double> inc_k((nk - 1) * plane);
+  PlaneSoA<S> current, previous;
+  for (int64_t k = 0; k < nk; ++k) {
+    current.Load(block.coords().data() + S * plane * k, plane);
+    for (int64_t j = 0; j < nj && ni > 1; ++j) {
+      SegmentIncrements<S, P>(current, ni * j, current, ni * j + 1, ni - 1, row.data());
+      if (const double inv = InverseLength(Dot(row.data(), nullptr, ni - 1)); inv > 0.0) {
+        for (int64_t i = 0; i + 1 < ni; ++i) avg[0].sum[i] += row[i] * inv;
+        ++avg[0].lines;
+      }
+    }
+    if (nj > 1) {
+      SegmentIncrements<S, P>(current, 0, current, ni, plane - ni, plane_j.data());
+      std::fill(length_j.begin(), length_j.end(), 0.0);
+      for (int64_t j = 0; j + 1 < nj; ++j) {
+        for (int64_t i = 0; i < ni; ++i) length_j[i] += plane_j[ni * j + i];
+      }
+      for (double& len : length_j) {
+        len = InverseLength(len);
+        avg[1].lines += len > 0.0 ? 1 : 0;
+      }
+      for (int64_t j = 0; j + 1 < nj; ++j) {
+        avg[1].sum[j] += Dot(plane_j.data() + ni * j, length_j.data(), ni);
+      }
+    }
+    if (k > 0) {
+      double* inc = inc_k.data() + plane * (k - 1);
+      SegmentIncrements<S, P>(previous, 0, current, 0, plane, inc);
+      for (int64_t x = 0; x < plane; ++x) length_k[x] += inc[x];
+    }
+    std::swap(current, previous);
+  }
+  if (nk > 1) {
+    for (double& len : length_k) {
+      len = InverseLength(len);
+      avg[2].lines += len > 0.0 ? 1 : 0;
+    }
+    for (int64_t k = 0; k + 1 < nk; ++k) {
+      avg[2].sum[k] = Dot(inc_k.data() + plane * k, length_k.data(), plane);
+    }
+  }
+  return avg;
+}
+
+// Parameters from summed normalised increments (uniform when no line took part).
+std::vector<double> ParametersFromIncrements(const LineAverage& avg) {
+  const int m = static_cast<int>(avg.sum.size()) + 1;
+  std::vector<double> params(m, 0.0);
+  if (m == 1) return params;
+  std::vector<double> increments = avg.sum;
+  for (double& inc : increments) inc = avg.lines == 0 ? 1.0 / (m - 1) : inc / avg.lines;
+  // Repeated points on every line leave an increment of exactly zero; give such intervals a
+  // millionth of a uniform step so that parameters stay strictly increasing.
+  double total = 0.0;
+  for (double& inc : increments) {
+    if (!(inc > 0.0)) inc = 1e-6 / (m - 1);
+    total += inc;
+  }
+  for (int i = 1; i < m; ++i) params[i] = params[i - 1] + increments[i - 1] / total;
+  params[m - 1] = 1.0;
+  return params;
+}
+
+}  // namespace
+
+std::array<std::vector<double>, 3> ParametrizeBlock(const StructuredBlock& block,
+                                                    Parametrization parametrization) {
+  std::array<LineAverage, 3> avg;
+  const bool planar = block.spatial_dim() == 2;
+  switch (parametrization) {
+    case Parametrization::kUniform:
+      for (int d = 0; d < 3; ++d) avg[d].sum.assign(block.extent(d) - 1, 0.0);
+      break;
+    case Parametrization::kChordLength:
+      avg = planar ? SweepIncrements<2, Parametrization::kChordLength>(block)
+                   : SweepIncrements<3, Parametrization::kChordLength>(block);
+      break;
+    case Parametrization::kCentripetal:
+      avg = planar ? SweepIncrements<2, Parametrization::kCentripetal>(block)
+                   : SweepIncrements<3, Parametrization::kCentripetal>(block);
+      break;
+  }
+  return {ParametersFromIncrements(avg[0]), ParametersFromIncrements(avg[1]),
+          ParametersFromIncrements(avg[2])};
+}
+
+}  // namespace splinegrid

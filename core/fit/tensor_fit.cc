@@ -1,0 +1,212 @@
+#include "core/fit/tensor_fit.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+constexpr char kDirectionNames[] = "ijk";
+
+// Control count and order of direction d for `points` data points.
+struct DirectionShape {
+  int controls;
+  int order;
+};
+
+DirectionShape ShapeOf(const FitOptions& options, const Extents& points, int d) {
+  if (points[d] == 1) return {1, 1};
+  const int controls = options.control_counts[d] == 0 ? points[d] : options.control_counts[d];
+  return {controls, std::min(options.order, controls)};
+}
+
+// out[p] = |a_p - b_p|^2 for points of S interleaved coordinates.
+template <int S>
+void SquaredDistances(const double* __restrict a, const double* __restrict b, int64_t count,
+                      double* __restrict out) {
+  for (int64_t p = 0; p < count; ++p) {
+    double sq = 0.0;
+    for (int c = 0; c < S; ++c) sq += (a[S * p + c] - b[S * p + c]) * (a[S * p + c] - b[S * p + c]);
+    out[p] = sq;
+  }
+}
+
+}  // namespace
+
+absl::Status FitOptions::Validate(const Extents& points) const {
+  if (order < 2 || order > kMaxOrder) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
+  }
+  for (int d = 0; d < 3; ++d) {
+    const int n = control_counts[d];
+    if (points[d] == 1) {
+      if (n > 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("control_counts[", d, "] = ", n, " but direction ",
+                         std::string(1, kDirectionNames[d]), " has a single point; use 0 or 1"));
+      }
+      continue;
+    }
+    if (n == 0) continue;
+    if (n < 2 || n > points[d]) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "control_counts[", d, "] = ", n, " is outside [2, ", points[d], "] (the ", points[d],
+          " points of direction ", std::string(1, kDirectionNames[d]), ")"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
+                                       const std::array<std::vector<double>, 3>& params,
+                                       const std::array<KnotVector, 3>& knots, EndCondition ends,
+                                       const CancelCheck& cancel) {
+  const Extents& m = block.extents();
+  std::vector<DirectionFit> fits;
+  fits.reserve(3);
+  for (int d = 0; d < 3; ++d) {
+    if (static_cast<int>(params[d].size()) != m[d]) {
+      return absl::InvalidArgumentError(absl::StrCat("direction ", d, ": ", params[d].size(),
+                                                     " parameters for ", m[d], " points"));
+    }
+    absl::StatusOr<DirectionFit> fit = DirectionFit::Create(knots[d], params[d], ends);
+    if (!fit.ok()) {
+      return absl::Status(fit.status().code(),
+                          absl::StrCat("direction ", std::string(1, kDirectionNames[d]), ": ",
+                                       fit.status().message()));
+    }
+    fits.push_back(*std::move(fit));
+  }
+  // Pass d fits direction d of a tensor whose already fitted directions hold control values:
+  // shape (s * cur_0 .. cur_{d-1}, m_d, cur_{d+1} .. cur_2) -> n_d. The slowest direction goes
+  // first: its lines are whole contiguous rows of the data, and it shrinks the data the most
+  // before the strided passes.
+  const int s = block.spatial_dim();
+  Extents cur = m;
+  std::unique_ptr<double[]> current;  // output of the previous pass (fully overwritten)
+  std::vector<double> control;        // output of the last pass
+  const double* in = block.coords().data();
+  for (int d = 2; d >= 0; --d) {
+    int64_t a = s, b = 1;
+    for (int e = 0; e < d; ++e) a *= cur[e];
+    for (int e = d + 1; e < 3; ++e) b *= cur[e];
+    cur[d] = knots[d].num_controls();
+    const int64_t size = a * cur[d] * b;
+    double* out;
+    std::unique_ptr<double[]> next;
+    if (d > 0) {
+      next.reset(new double[size]);
+      out = next.get();
+    } else {
+      control.resize(size);
+      out = control.data();
+    }
+    SG_RETURN_IF_ERROR(fits[d].Apply(in, a, b, out, cancel));
+    current = std::move(next);
+    in = out;
+  }
+  std::array<KnotVector, 3> all = knots;
+  return TensorSpline::Create(std::move(all), s, std::move(control));
+}
+
+absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
+                                           const std::array<std::vector<double>, 3>& params,
+                                           const StructuredBlock& block,
+                                           const CancelCheck& cancel) {
+  GridEvaluator evaluator(spline, params, /*first_derivatives=*/false);
+  if (evaluator.extents() != block.extents() || spline.spatial_dim() != block.spatial_dim()) {
+    return absl::InvalidArgumentError("spline parameters and data block differ in shape");
+  }
+  const int s = block.spatial_dim();
+  const int ni = block.extent(0), nj = block.extent(1);
+  // Lines are evaluated in batches (about 32k points) and compared with the data; the squared
+  // distances of a batch go to a buffer so that the sums vectorise.
+  const int64_t batch = std::max<int64_t>(1, 32768 / ni);
+  std::vector<double> fitted(batch * evaluator.line_size()), d2(batch * ni);
+  Deviation dev;
+  dev.num_points = block.num_points();
+  double sum_squares = 0.0, max_squared = -1.0;
+  for (int64_t l0 = 0; l0 < evaluator.num_lines(); l0 += batch) {
+    SG_RETURN_IF_ERROR(PollCancel(cancel));
+    const int64_t l1 = std::min(l0 + batch, evaluator.num_lines());
+    const int64_t count = (l1 - l0) * ni;
+    evaluator.EvaluateLines(l0, l1, fitted.data());
+    const double* data = block.coords().data() + l0 * evaluator.line_size();
+    if (s == 2) {
+      SquaredDistances<2>(fitted.data(), data, count, d2.data());
+    } else {
+      SquaredDistances<3>(fitted.data(), data, count, d2.data());
+    }
+    // Eight independent partial sums and maxima: the reductions vectorise.
+    double partial_sum[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    double partial_max[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    int64_t p = 0;
+    for (; p + 8 <= count; p += 8) {
+      for (int t = 0; t < 8; ++t) {
+        partial_sum[t] += d2[p + t];
+        partial_max[t] = partial_max[t] > d2[p + t] ? partial_max[t] : d2[p + t];
+      }
+    }
+    for (; p < count; ++p) {
+      partial_sum[0] += d2[p];
+      partial_max[0] = std::max(partial_max[0], d2[p]);
+    }
+    double batch_max = 0.0;
+    for (int t = 0; t < 8; ++t) {
+      sum_squares += partial_sum[t];
+      batch_max = std::max(batch_max, partial_max[t]);
+    }
+    if (batch_max > max_squared) {
+      max_squared = batch_max;
+      const int64_t at = std::find(d2.begin(), d2.begin() + count, batch_max) - d2.begin();
+      const int64_t line = l0 + at / ni;
+      dev.max_at = {static_cast<int>(at % ni), static_cast<int>(line % nj),
+                    static_cast<int>(line / nj)};
+    }
+  }
+  dev.max = std::sqrt(std::max(max_squared, 0.0));
+  dev.rms = std::sqrt(sum_squares / static_cast<double>(dev.num_points));
+  return dev;
+}
+
+absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const Extents& m = block.extents();
+  SG_RETURN_IF_ERROR(options.Validate(m));
+  SG_RETURN_IF_ERROR(ValidateFinite(block, "points"));
+  const std::array<std::vector<double>, 3> params =
+      ParametrizeBlock(block, options.parametrization);
+  std::array<KnotVector, 3> knots;
+  for (int d = 0; d < 3; ++d) {
+    const DirectionShape shape = ShapeOf(options, m, d);
+    if (m[d] == 1) continue;  // default KnotVector: the constant basis
+    if (options.knot_placement == KnotPlacement::kUniform) {
+      knots[d] = KnotVector::Uniform(shape.order, shape.controls);
+    } else {
+      SG_ASSIGN_OR_RETURN(knots[d], KnotVector::Averaged(shape.order, shape.controls, params[d]));
+    }
+  }
+  const EndCondition ends =
+      options.interpolate_ends ? EndCondition::kInterpolate : EndCondition::kFree;
+  SG_ASSIGN_OR_RETURN(TensorSpline spline, FitTensor(block, params, knots, ends, options.cancel));
+  SG_ASSIGN_OR_RETURN(Deviation deviation, MeasureDeviation(spline, params, block, options.cancel));
+  SG_ASSIGN_OR_RETURN(PointDistribution distribution, PointDistribution::Create(params));
+
+  FittedBlock fitted{std::move(spline), std::move(distribution), {}};
+  FitSummary& summary = fitted.summary;
+  summary.deviation = deviation;
+  summary.num_points = block.num_points();
+  summary.num_control_points = fitted.spline.num_control_points();
+  summary.compression_ratio = static_cast<double>(summary.num_points) / summary.num_control_points;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return fitted;
+}
+
+}  // namespace splinegrid
