@@ -65,8 +65,31 @@ void ScatterRow(const double* buffer, int64_t a, int64_t rows, int64_t r, int64_
 
 }  // namespace
 
+bool SchoenbergWhitneyHolds(const KnotVector& knots, std::span<const double> params,
+                            std::span<const int> pinned_controls) {
+  const int n = knots.num_controls(), k = knots.order(), m = static_cast<int>(params.size());
+  std::vector<bool> pinned(n, false);
+  for (int c : pinned_controls) {
+    if (c >= 0 && c < n) pinned[c] = true;
+  }
+  const std::span<const double> t = knots.knots();
+  int r = 0;  // next unused data point
+  for (int j = 0; j < n; ++j) {
+    if (pinned[j]) continue;
+    // Support of N_j: (t_j, t_{j+k}), closed at a clamped end where N_j is 1.
+    const double lo = t[j], hi = t[j + k];
+    const bool closed_lo = j == 0, closed_hi = j == n - 1;
+    while (r < m && (params[r] < lo || (params[r] == lo && !closed_lo))) ++r;
+    if (r == m || params[r] > hi || (params[r] == hi && !closed_hi)) return false;
+    ++r;
+  }
+  return true;
+}
+
 absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
-                                                  std::span<const double> params, EndCondition ends,
+                                                  std::span<const double> params,
+                                                  EndCondition ends,
+                                                  std::span<const Pin> interior_pins,
                                                   std::span<const PenaltyRow> penalties) {
   const int m = static_cast<int>(params.size());
   const int n = knots.num_controls();
@@ -79,12 +102,41 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   }
   for (int i = 1; i < m; ++i) {
     if (!(params[i] > params[i - 1])) {
-      return absl::InvalidArgumentError(absl::StrCat("parameters are not strictly increasing at ",
-                                                     i, ": ", params[i - 1], ", ", params[i]));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "parameters are not strictly increasing at ", i, ": ", params[i - 1], ", ", params[i]));
     }
   }
-  const SampledBasis basis = SampleBasis(knots, params, 0);
+  DirectionFit fit;
+  fit.num_points_ = m;
+  fit.num_controls_ = n;
+  fit.zero_pins_ = ends == EndCondition::kZero;
+  std::vector<int> pin_of(n, -1);  // control -> pin index
+  auto add_pin = [&](Pin pin) -> absl::Status {
+    if (pin.control < 0 || pin.control >= n || pin.data_row < 0 || pin.data_row >= m ||
+        pin_of[pin.control] >= 0) {
+      return absl::InvalidArgumentError(absl::StrCat("pin of control ", pin.control,
+                                                     " to data row ", pin.data_row,
+                                                     " is out of range or repeated"));
+    }
+    pin_of[pin.control] = static_cast<int>(fit.pins_.size());
+    fit.pins_.push_back(pin);
+    return absl::OkStatus();
+  };
+  if (ends != EndCondition::kFree) {
+    SG_RETURN_IF_ERROR(add_pin({0, 0}));
+    SG_RETURN_IF_ERROR(add_pin({n - 1, m - 1}));
+  }
+  for (const Pin& pin : interior_pins) SG_RETURN_IF_ERROR(add_pin(pin));
+  std::vector<int> free_index(n, -1);
+  for (int col = 0; col < n; ++col) {
+    if (pin_of[col] < 0) {
+      free_index[col] = static_cast<int>(fit.free_columns_.size());
+      fit.free_columns_.push_back(col);
+    }
+  }
+  const int n_free = static_cast<int>(fit.free_columns_.size());
 
+  const SampledBasis basis = SampleBasis(knots, params, 0);
   // Data rows come with non-decreasing first columns (sorted parameters); penalty rows are
   // merged in by their first column.
   int bandwidth = k;
@@ -93,8 +145,9 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   for (const PenaltyRow& p : penalties) {
     const int size = static_cast<int>(p.values.size());
     if (p.first < 0 || size < 1 || p.first + size > n) {
-      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first, " with ",
-                                                     size, " entries exceeds ", n, " controls"));
+      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first,
+                                                     " with ", size, " entries exceeds ", n,
+                                                     " controls"));
     }
     sorted_penalties.push_back(&p);
     bandwidth = std::max(bandwidth, size);
@@ -114,37 +167,40 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
     }
   }
 
-  const int off = ends == EndCondition::kFree ? 0 : 1;
-  const int n_free = n - 2 * off;
-  BandedQR qr(n_free, bandwidth, static_cast<int>(full.size()));
-  std::vector<RowSource> rows;
-  rows.reserve(full.size());
+  // Split every row into its free part (contiguous in free-index space, because pinned
+  // columns are simply left out) and its pinned terms.
+  fit.qr_ = BandedQR(n_free, bandwidth, static_cast<int>(full.size()));
+  fit.rows_.reserve(full.size());
   std::vector<double> free_values(bandwidth);
   for (const FullRow& row : full) {
-    RowSource source{row.data_row};
-    const int last = row.first + row.size - 1;
-    if (off == 1) {
-      if (row.first == 0) source.first_coef = row.values[0];
-      if (last == n - 1) source.last_coef = row.values[row.size - 1];
-    }
-    const int lo = std::max(row.first, off), hi = std::min(last, n - 1 - off);
-    if (lo > hi) continue;
+    RowSource source{row.data_row, static_cast<int>(fit.pinned_terms_.size()), 0};
+    int first_free = -1, count = 0;
     bool any = false;
-    for (int col = lo; col <= hi; ++col) {
-      free_values[col - lo] = row.values[col - row.first];
-      any |= free_values[col - lo] != 0.0;
+    for (int t = 0; t < row.size; ++t) {
+      const int col = row.first + t;
+      if (pin_of[col] >= 0) {
+        if (row.values[t] != 0.0) fit.pinned_terms_.push_back({pin_of[col], row.values[t]});
+        continue;
+      }
+      if (first_free < 0) first_free = free_index[col];
+      free_values[count++] = row.values[t];
+      any |= row.values[t] != 0.0;
     }
-    if (!any) continue;
-    qr.AddRow(lo - off, std::span<const double>(free_values.data(), hi - lo + 1));
-    rows.push_back(source);
+    source.pinned_end = static_cast<int>(fit.pinned_terms_.size());
+    if (!any) {
+      fit.pinned_terms_.resize(source.pinned_begin);  // the row constrains nothing free
+      continue;
+    }
+    fit.qr_.AddRow(first_free, std::span<const double>(free_values.data(), count));
+    fit.rows_.push_back(source);
   }
   if (n_free > 0) {
-    if (absl::Status rank = qr.CheckRank(); !rank.ok()) {
-      return absl::FailedPreconditionError(
-          absl::StrCat(rank.message(), " (", n, " controls of order ", k, " for ", m, " points)"));
+    if (absl::Status rank = fit.qr_.CheckRank(); !rank.ok()) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          rank.message(), " (", n, " controls of order ", k, " for ", m, " points)"));
     }
   }
-  return DirectionFit(m, n, ends, std::move(qr), std::move(rows));
+  return fit;
 }
 
 absl::Status DirectionFit::Apply(const double* in, int64_t a, int64_t b, double* out,
@@ -156,8 +212,10 @@ absl::Status DirectionFit::Apply(const double* in, int64_t a, int64_t b, double*
   }
   // Keep the accumulator (free controls x width) around 128 KiB so it stays in L2.
   const int64_t n_free = std::max(qr_.num_cols(), 1);
-  const int64_t width = std::min(std::clamp<int64_t>((16384 / n_free) / 8 * 8, 8, 1024), columns);
-  std::vector<double> scratch((n_free + 3) * width);  // v, ends, accumulator
+  const int64_t width =
+      std::min(std::clamp<int64_t>((16384 / n_free) / 8 * 8, 8, 1024), columns);
+  // v, one row per pin, accumulator.
+  std::vector<double> scratch((n_free + 1 + pins_.size()) * width);
   if (a >= width) {
     // Blocks inside one slab: rows are contiguous runs (see ApplyBlock).
     for (int64_t e = 0; e < b; ++e) {
@@ -182,31 +240,33 @@ void DirectionFit::ApplyBlock(const double* in, int64_t a, int64_t q0, int64_t q
   const int64_t width = q1 - q0;
   const int m = num_points_, n = num_controls_;
   const int n_free = qr_.num_cols();
-  const int off = ends_ == EndCondition::kFree ? 0 : 1;
-  // When the block lies inside one slab e (a long contiguous run), data rows are read in place
-  // and the accumulator is the output itself (rows off .. off + n_free - 1): nothing is copied.
-  const bool in_place = q0 / a == (q1 - 1) / a && width >= 16;
+  const int num_pins = static_cast<int>(pins_.size());
+  // When the block lies inside one slab e (a long contiguous run) and the free controls are
+  // consecutive (no interior pins), data rows are read in place and the accumulator is the
+  // output itself: nothing is copied.
+  const int off = n_free > 0 ? free_columns_.front() : 0;
+  const bool consecutive = n_free == 0 || free_columns_.back() - off == n_free - 1;
+  const bool in_place = q0 / a == (q1 - 1) / a && width >= 16 && consecutive;
   const int64_t e = q0 / a, c = q0 % a;
   const double* in_slab = in + c + a * m * e;
   double* out_slab = out + c + a * n * e;
   double* v = scratch.data();
-  double* first = v + width;
-  double* last = first + width;
-  double* acc = in_place ? out_slab + off * a : last + width;
+  double* pin_values = v + width;  // num_pins rows
+  double* acc = in_place ? out_slab + off * a : pin_values + num_pins * width;
   const int64_t stride = in_place ? a : width;
   for (int j = 0; j < n_free; ++j) std::fill_n(acc + j * stride, width, 0.0);
-  if (ends_ == EndCondition::kInterpolate) {
-    GatherRow(in, a, m, 0, q0, q1, first);
-    GatherRow(in, a, m, m - 1, q0, q1, last);
-  } else {
-    std::fill_n(first, width, 0.0);
-    std::fill_n(last, width, 0.0);
+  for (int p = 0; p < num_pins; ++p) {
+    double* value = pin_values + p * width;
+    if (zero_pins_) {
+      std::fill_n(value, width, 0.0);
+    } else {
+      GatherRow(in, a, m, pins_[p].data_row, q0, q1, value);
+    }
   }
   for (int i = 0; i < static_cast<int>(rows_.size()); ++i) {
     const RowSource& row = rows_[i];
     const double* rhs = v;
-    const bool corrected =
-        ends_ == EndCondition::kInterpolate && (row.first_coef != 0.0 || row.last_coef != 0.0);
+    const bool corrected = !zero_pins_ && row.pinned_end > row.pinned_begin;
     if (row.data_row < 0) {
       std::fill_n(v, width, 0.0);
     } else if (in_place && !corrected) {
@@ -221,19 +281,22 @@ void DirectionFit::ApplyBlock(const double* in, int64_t a, int64_t q0, int64_t q
       GatherRow(in, a, m, row.data_row, q0, q1, v);
     }
     if (corrected) {
-      for (int64_t x = 0; x < width; ++x) {
-        v[x] -= row.first_coef * first[x] + row.last_coef * last[x];
+      for (int t = row.pinned_begin; t < row.pinned_end; ++t) {
+        const double coef = pinned_terms_[t].coef;
+        const double* value = pin_values + pinned_terms_[t].pin * width;
+        for (int64_t x = 0; x < width; ++x) v[x] -= coef * value[x];
       }
     }
     qr_.ReduceRow(i, rhs, acc, width, stride);
   }
   qr_.BackSubstitute(acc, width, stride);
   if (!in_place) {
-    for (int j = 0; j < n_free; ++j) ScatterRow(acc + j * width, a, n, j + off, q0, q1, out);
+    for (int j = 0; j < n_free; ++j) {
+      ScatterRow(acc + j * width, a, n, free_columns_[j], q0, q1, out);
+    }
   }
-  if (off == 1) {
-    ScatterRow(first, a, n, 0, q0, q1, out);
-    ScatterRow(last, a, n, n - 1, q0, q1, out);
+  for (int p = 0; p < num_pins; ++p) {
+    ScatterRow(pin_values + p * width, a, n, pins_[p].control, q0, q1, out);
   }
 }
 

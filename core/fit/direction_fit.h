@@ -8,6 +8,9 @@
 //   kInterpolate: p_0 = x_0 and p_{n-1} = x_{m-1} (the clamped spline interpolates the data
 //                 end points; only the interior controls are fitted);
 //   kZero:        p_0 = p_{n-1} = 0 (used to fit a correction with the boundary held).
+// Interior controls can be pinned too: at a feature point (a knot of multiplicity order - 1 at
+// params[r]) only one basis function is nonzero, and pinning its control to x_r makes the fit
+// pass through the feature point exactly, each side fitted on its own.
 #ifndef SPLINEGRID_CORE_FIT_DIRECTION_FIT_H_
 #define SPLINEGRID_CORE_FIT_DIRECTION_FIT_H_
 
@@ -25,11 +28,23 @@ namespace splinegrid {
 
 enum class EndCondition { kFree, kInterpolate, kZero };
 
+// An interior control value fixed to a data value: p_control = x_{data_row} (0 with kZero).
+struct Pin {
+  int control = 0;
+  int data_row = 0;
+};
+
 // An extra least-squares row over control values: sum_t values[t] p_{first + t} ~ 0.
 struct PenaltyRow {
   int first = 0;
   std::vector<double> values;
 };
+
+// Whether the data at `params` determine every control that is not pinned (the
+// Schoenberg-Whitney condition: the free controls can be matched, in order, to distinct data
+// points inside their supports). Then the least-squares problem has full rank. Cost O(n + m).
+bool SchoenbergWhitneyHolds(const KnotVector& knots, std::span<const double> params,
+                            std::span<const int> pinned_controls);
 
 class DirectionFit {
  public:
@@ -39,6 +54,7 @@ class DirectionFit {
   // penalties, FAILED_PRECONDITION when the data leave a control point undetermined.
   static absl::StatusOr<DirectionFit> Create(const KnotVector& knots,
                                              std::span<const double> params, EndCondition ends,
+                                             std::span<const Pin> interior_pins = {},
                                              std::span<const PenaltyRow> penalties = {});
 
   int num_points() const { return num_points_; }
@@ -51,25 +67,31 @@ class DirectionFit {
                      const CancelCheck& cancel = {}) const;
 
  private:
-  // One row of the factored system: where its right-hand side comes from and the coefficients
-  // of the fixed end controls, which move to the right-hand side.
+  // One row of the factored system: where its right-hand side comes from, and the pinned
+  // controls it touches (their terms move to the right-hand side).
   struct RowSource {
-    int data_row;             // row of the data, or -1 for a penalty row (zero right side)
-    double first_coef = 0.0;  // coefficient of p_0 (fixed ends only)
-    double last_coef = 0.0;   // coefficient of p_{n-1}
+    int data_row;        // row of the data, or -1 for a penalty row (zero right side)
+    int pinned_begin;    // its pinned terms: pinned_terms_[pinned_begin .. pinned_end)
+    int pinned_end;
+  };
+  struct PinnedTerm {
+    int pin;             // index into pins_
+    double coef;
   };
 
-  DirectionFit(int m, int n, EndCondition ends, BandedQR qr, std::vector<RowSource> rows)
-      : num_points_(m), num_controls_(n), ends_(ends), qr_(std::move(qr)), rows_(std::move(rows)) {}
+  DirectionFit() = default;
 
   void ApplyBlock(const double* in, int64_t a, int64_t q0, int64_t q1, double* out,
                   std::vector<double>& scratch) const;
 
-  int num_points_;
-  int num_controls_;
-  EndCondition ends_;
-  BandedQR qr_;                  // over the free controls
-  std::vector<RowSource> rows_;  // in the order they were added to qr_
+  int num_points_ = 0;
+  int num_controls_ = 0;
+  bool zero_pins_ = false;             // kZero: pinned controls are 0
+  std::vector<Pin> pins_;              // ends first (if any), then interior pins
+  std::vector<int> free_columns_;      // free index -> control index
+  BandedQR qr_{0, 1};                  // over the free controls
+  std::vector<RowSource> rows_;        // in the order they were added to qr_
+  std::vector<PinnedTerm> pinned_terms_;
 };
 
 }  // namespace splinegrid

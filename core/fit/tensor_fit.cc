@@ -67,7 +67,7 @@ absl::Status FitOptions::Validate(const Extents& points) const {
 absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
                                        const std::array<std::vector<double>, 3>& params,
                                        const std::array<KnotVector, 3>& knots, EndCondition ends,
-                                       const CancelCheck& cancel) {
+                                       const CancelCheck& cancel, const DirectionPins& pins) {
   const Extents& m = block.extents();
   std::vector<DirectionFit> fits;
   fits.reserve(3);
@@ -76,7 +76,7 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
       return absl::InvalidArgumentError(absl::StrCat("direction ", d, ": ", params[d].size(),
                                                      " parameters for ", m[d], " points"));
     }
-    absl::StatusOr<DirectionFit> fit = DirectionFit::Create(knots[d], params[d], ends);
+    absl::StatusOr<DirectionFit> fit = DirectionFit::Create(knots[d], params[d], ends, pins[d]);
     if (!fit.ok()) {
       return absl::Status(fit.status().code(),
                           absl::StrCat("direction ", std::string(1, kDirectionNames[d]), ": ",
@@ -119,11 +119,16 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
 absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
                                            const std::array<std::vector<double>, 3>& params,
                                            const StructuredBlock& block,
-                                           const CancelCheck& cancel) {
+                                           const CancelCheck& cancel,
+                                           std::span<const double> tolerance) {
   GridEvaluator evaluator(spline, params, /*first_derivatives=*/false);
   if (evaluator.extents() != block.extents() || spline.spatial_dim() != block.spatial_dim()) {
     return absl::InvalidArgumentError("spline parameters and data block differ in shape");
   }
+  if (!tolerance.empty() && static_cast<int64_t>(tolerance.size()) != block.num_points()) {
+    return absl::InvalidArgumentError("tolerance: one value per point is needed");
+  }
+  double max_ratio_squared = -1.0;
   const int s = block.spatial_dim();
   const int ni = block.extent(0), nj = block.extent(1);
   // Lines are evaluated in batches (about 32k points) and compared with the data; the squared
@@ -163,15 +168,27 @@ absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
       sum_squares += partial_sum[t];
       batch_max = std::max(batch_max, partial_max[t]);
     }
+    auto index_of = [&](int64_t at) -> Extents {
+      const int64_t line = l0 + at / ni;
+      return {static_cast<int>(at % ni), static_cast<int>(line % nj), static_cast<int>(line / nj)};
+    };
     if (batch_max > max_squared) {
       max_squared = batch_max;
-      const int64_t at = std::find(d2.begin(), d2.begin() + count, batch_max) - d2.begin();
-      const int64_t line = l0 + at / ni;
-      dev.max_at = {static_cast<int>(at % ni), static_cast<int>(line % nj),
-                    static_cast<int>(line / nj)};
+      dev.max_at = index_of(std::find(d2.begin(), d2.begin() + count, batch_max) - d2.begin());
+    }
+    if (!tolerance.empty()) {
+      const double* tol = tolerance.data() + l0 * ni;
+      for (int64_t q = 0; q < count; ++q) {
+        const double r2 = d2[q] / (tol[q] * tol[q]);
+        if (r2 > max_ratio_squared) {
+          max_ratio_squared = r2;
+          dev.max_ratio_at = index_of(q);
+        }
+      }
     }
   }
   dev.max = std::sqrt(std::max(max_squared, 0.0));
+  dev.max_ratio = std::sqrt(std::max(max_ratio_squared, 0.0));
   dev.rms = std::sqrt(sum_squares / static_cast<double>(dev.num_points));
   return dev;
 }

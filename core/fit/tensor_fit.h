@@ -54,6 +54,9 @@ struct Deviation {
   double rms = 0.0;            // root mean square of the distances
   Extents max_at = {0, 0, 0};  // grid index (i, j, k) of the largest distance
   int64_t num_points = 0;
+  // With per-point tolerances: the largest distance / tolerance and where it is (else 0).
+  double max_ratio = 0.0;
+  Extents max_ratio_at = {0, 0, 0};
 };
 
 struct FitSummary {
@@ -76,19 +79,25 @@ struct FittedBlock {
 // points, FAILED_PRECONDITION if the data leave control points undetermined, CANCELLED.
 absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOptions& options);
 
+// Interior pins per direction (see DirectionFit): feature points the fit passes through.
+using DirectionPins = std::array<std::vector<Pin>, 3>;
+
 // The tensor least-squares solve with given parameters and knot vectors (one of each per
 // direction; a direction with one point has params {0} and the default KnotVector).
 absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
                                        const std::array<std::vector<double>, 3>& params,
                                        const std::array<KnotVector, 3>& knots, EndCondition ends,
-                                       const CancelCheck& cancel = {});
+                                       const CancelCheck& cancel = {},
+                                       const DirectionPins& pins = {});
 
-// Distances between `spline` evaluated at `params` and the points of `block` (same extents).
-// Cost O(k points); memory O(one grid line).
+// Distances between `spline` evaluated at `params` and the points of `block` (same extents);
+// with `tolerance` (one positive value per point, point order) also the largest ratio of
+// distance to tolerance. Cost O(k points); memory O(a batch of grid lines).
 absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
                                            const std::array<std::vector<double>, 3>& params,
                                            const StructuredBlock& block,
-                                           const CancelCheck& cancel = {});
+                                           const CancelCheck& cancel = {},
+                                           std::span<const double> tolerance = {});
 
 }  // namespace splinegrid
 

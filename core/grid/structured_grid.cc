@@ -30,9 +30,12 @@ absl::Status ValidateExtents(const Extents& extents, const std::string& what, in
                                                      "]"));
     }
   }
-  if (NumPoints(extents) > max_points) {
+  // Each extent is at most 2^24 here, so the product of the first two fits in int64; compare
+  // the third by division so that the full product cannot overflow.
+  const int64_t plane = int64_t{extents[0]} * extents[1];
+  if (plane > max_points || extents[2] > max_points / plane) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": ", extents[0], " x ", extents[1], " x ",
-                                                   extents[2], " = ", NumPoints(extents),
+                                                   extents[2],
                                                    " points exceeds the limit of ", max_points));
   }
   return absl::OkStatus();
