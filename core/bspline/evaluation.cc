@@ -115,19 +115,20 @@ void GridEvaluator::ComputePlane(int k) {
   plane_ = k;
 }
 
-void GridEvaluator::EvaluateCurve(double* points, double* du, double* dv, double* dw) const {
-  constexpr int64_t kChunk = 4096;
+void GridEvaluator::EvaluateCurve(int i_begin, int i_end, double* points, double* du, double* dv,
+                                  double* dw) const {
+  constexpr int kChunk = 4096;
   const int s = spatial_dim_;
-  const int64_t n = extents_[0];
-  for (int64_t q0 = 0; q0 < n; q0 += kChunk) {
-    const int64_t count = std::min(kChunk, n - q0);
+  for (int q0 = i_begin; q0 < i_end; q0 += kChunk) {
+    const int count = std::min(kChunk, i_end - q0);
+    const int64_t at = int64_t{s} * (q0 - i_begin);
     const SampledBasis basis = SampleBasis(
         knots_u_, std::span<const double>(params_u_.data() + q0, count), derivatives_ ? 1 : 0);
-    ContractDirection(control_.data(), s, 1, basis, 0, points + s * q0);
+    ContractDirection(control_.data(), s, 1, basis, 0, points + at);
     if (derivatives_) {
-      ContractDirection(control_.data(), s, 1, basis, 1, du + s * q0);
-      std::fill_n(dv + s * q0, s * count, 0.0);
-      std::fill_n(dw + s * q0, s * count, 0.0);
+      ContractDirection(control_.data(), s, 1, basis, 1, du + at);
+      std::fill_n(dv + at, int64_t{s} * count, 0.0);
+      std::fill_n(dw + at, int64_t{s} * count, 0.0);
     }
   }
 }
@@ -135,32 +136,40 @@ void GridEvaluator::EvaluateCurve(double* points, double* du, double* dv, double
 void GridEvaluator::EvaluateLines(int64_t begin, int64_t end, double* points, double* du,
                                   double* dv, double* dw) {
   SG_CHECK(begin >= 0 && begin <= end && end <= num_lines());
-  SG_CHECK(!derivatives_ || (du && dv && dw));
-  if (curve_) {
-    if (begin < end) EvaluateCurve(points, du, dv, dw);
-    return;
+  const int64_t size = line_size();
+  auto at = [&](double* p, int64_t line) { return p ? p + (line - begin) * size : nullptr; };
+  for (int64_t line = begin; line < end; ++line) {
+    EvaluateLineRange(line, 0, extents_[0], at(points, line), at(du, line), at(dv, line),
+                      at(dw, line));
   }
+}
+
+void GridEvaluator::EvaluateLineRange(int64_t line, int i_begin, int i_end, double* points,
+                                      double* du, double* dv, double* dw) {
+  SG_CHECK(line >= 0 && line < num_lines() && 0 <= i_begin && i_begin <= i_end &&
+           i_end <= extents_[0]);
+  SG_CHECK(!derivatives_ || (du && dv && dw));
+  if (curve_) return EvaluateCurve(i_begin, i_end, points, du, dv, dw);
   const int64_t row = line_size();
+  const int64_t first = int64_t{spatial_dim_} * i_begin;
+  const int64_t length = int64_t{spatial_dim_} * (i_end - i_begin);
   const int order = basis_v_.order;
   const double* rows[kMaxOrder];
   auto gather = [&](const std::vector<double>& z, int j) {
-    const double* first = z.data() + row * basis_v_.first[j];
-    for (int t = 0; t < order; ++t) rows[t] = first + row * t;
+    const double* start = z.data() + row * basis_v_.first[j] + first;
+    for (int t = 0; t < order; ++t) rows[t] = start + row * t;
   };
-  for (int64_t line = begin; line < end; ++line) {
-    const int j = static_cast<int>(line % extents_[1]);
-    const int k = static_cast<int>(line / extents_[1]);
-    if (k != plane_) ComputePlane(k);
-    const int64_t offset = (line - begin) * row;
-    gather(z_, j);
-    WeightedRowSum(rows, basis_v_.Row(j, 0), order, row, points + offset);
-    if (!derivatives_) continue;
-    WeightedRowSum(rows, basis_v_.Row(j, 1), order, row, dv + offset);
-    gather(z_du_, j);
-    WeightedRowSum(rows, basis_v_.Row(j, 0), order, row, du + offset);
-    gather(z_dw_, j);
-    WeightedRowSum(rows, basis_v_.Row(j, 0), order, row, dw + offset);
-  }
+  const int j = static_cast<int>(line % extents_[1]);
+  const int k = static_cast<int>(line / extents_[1]);
+  if (k != plane_) ComputePlane(k);
+  gather(z_, j);
+  WeightedRowSum(rows, basis_v_.Row(j, 0), order, length, points);
+  if (!derivatives_) return;
+  WeightedRowSum(rows, basis_v_.Row(j, 1), order, length, dv);
+  gather(z_du_, j);
+  WeightedRowSum(rows, basis_v_.Row(j, 0), order, length, du);
+  gather(z_dw_, j);
+  WeightedRowSum(rows, basis_v_.Row(j, 0), order, length, dw);
 }
 
 StructuredBlock EvaluateGrid(const TensorSpline& spline,

@@ -70,9 +70,14 @@ class GridEvaluator {
   void EvaluateLines(int64_t begin, int64_t end, double* points, double* du = nullptr,
                      double* dv = nullptr, double* dw = nullptr);
 
+  // Points i_begin <= i < i_end of one line, for lines too long for one piece of a stream.
+  void EvaluateLineRange(int64_t line, int i_begin, int i_end, double* points, double* du = nullptr,
+                         double* dv = nullptr, double* dw = nullptr);
+
  private:
   void ComputePlane(int k);
-  void EvaluateCurve(double* points, double* du, double* dv, double* dw) const;
+  void EvaluateCurve(int i_begin, int i_end, double* points, double* du, double* dv,
+                     double* dw) const;
 
   int spatial_dim_;
   bool derivatives_;

@@ -31,12 +31,9 @@ DirectionView ViewOf(const StructuredBlock& block, int d) {
 
 // For every data index r of direction d: max over the grid lines of d of
 // |(I - P_d) X| / tolerance, where P_d fits each line with `knots`.
-absl::StatusOr<std::vector<double>> DirectionResidualRatio(const StructuredBlock& block, int d,
-                                                           const std::vector<double>& params,
-                                                           const KnotVector& knots,
-                                                           const std::vector<Pin>& pins,
-                                                           std::span<const double> tolerance,
-                                                           const CancelCheck& cancel) {
+absl::StatusOr<std::vector<double>> DirectionResidualRatio(
+    const StructuredBlock& block, int d, const std::vector<double>& params, const KnotVector& knots,
+    const std::vector<Pin>& pins, std::span<const double> tolerance, const CancelCheck& cancel) {
   const DirectionView v = ViewOf(block, d);
   const int s = block.spatial_dim();
   SG_ASSIGN_OR_RETURN(DirectionFit fit,
@@ -56,8 +53,8 @@ absl::StatusOr<std::vector<double>> DirectionResidualRatio(const StructuredBlock
           const double diff = fitted[base + s * x + c] - data[base + s * x + c];
           d2 += diff * diff;
         }
-        const double tol = tolerance.size() == 1 ? tolerance[0]
-                                                 : tolerance[x + v.points_a * (r + v.m * e)];
+        const double tol =
+            tolerance.size() == 1 ? tolerance[0] : tolerance[x + v.points_a * (r + v.m * e)];
         worst[r] = std::max(worst[r], std::sqrt(d2) / tol);
       }
     }
@@ -89,9 +86,8 @@ std::vector<int> DetectFeatures(const StructuredBlock& block, int d,
           l1 += a * a;
           l2 += b * b;
         }
-        angle[r] = l1 > 0.0 && l2 > 0.0
-                       ? std::acos(std::clamp(dot / std::sqrt(l1 * l2), -1.0, 1.0))
-                       : 0.0;
+        angle[r] =
+            l1 > 0.0 && l2 > 0.0 ? std::acos(std::clamp(dot / std::sqrt(l1 * l2), -1.0, 1.0)) : 0.0;
       }
       for (int64_t r = 1; r + 1 < v.m; ++r) {
         const double neighbours = std::max(angle[r - 1], r + 2 < v.m ? angle[r + 1] : 0.0);
@@ -160,10 +156,10 @@ int SplitSpans(const std::vector<double>& params, const std::vector<double>& rat
   for (size_t span = 0; span + 1 < breaks.size(); ++span) {
     const double lo = breaks[span], hi = breaks[span + 1];
     // Data strictly inside the span.
-    const int r0 = static_cast<int>(std::upper_bound(params.begin(), params.end(), lo) -
-                                    params.begin());
-    const int r1 = static_cast<int>(std::lower_bound(params.begin(), params.end(), hi) -
-                                    params.begin());
+    const int r0 =
+        static_cast<int>(std::upper_bound(params.begin(), params.end(), lo) - params.begin());
+    const int r1 =
+        static_cast<int>(std::lower_bound(params.begin(), params.end(), hi) - params.begin());
     if (r1 - r0 < 2) continue;
     double worst = 0.0;
     for (int r = std::max(r0 - 1, 0); r <= std::min(r1, m - 1); ++r) {
@@ -203,15 +199,15 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
         "max_controls_per_direction = ", options.max_controls_per_direction, " is negative"));
   }
   if (tolerance.size() != 1 && static_cast<int64_t>(tolerance.size()) != block.num_points()) {
-    return absl::InvalidArgumentError(absl::StrCat("tolerance: ", tolerance.size(),
-                                                   " values for ", block.num_points(),
+    return absl::InvalidArgumentError(absl::StrCat("tolerance: ", tolerance.size(), " values for ",
+                                                   block.num_points(),
                                                    " points; give one or one per point"));
   }
   for (size_t p = 0; p < tolerance.size(); ++p) {
     if (!(tolerance[p] > 0.0) || !std::isfinite(tolerance[p])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "tolerance", tolerance.size() == 1 ? "" : absl::StrCat("[", p, "]"), " = ",
-          tolerance[p], "; tolerances must be positive and finite"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("tolerance", tolerance.size() == 1 ? "" : absl::StrCat("[", p, "]"), " = ",
+                       tolerance[p], "; tolerances must be positive and finite"));
     }
   }
   SG_RETURN_IF_ERROR(ValidateFinite(block, "points"));
@@ -262,9 +258,9 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
   };
   auto fit = [&]() -> absl::StatusOr<std::pair<TensorSpline, Deviation>> {
     SG_RETURN_IF_ERROR(build_knots());
-    SG_ASSIGN_OR_RETURN(TensorSpline spline,
-                        FitTensor(block, params, knots, EndCondition::kInterpolate,
-                                  options.cancel, pins));
+    SG_ASSIGN_OR_RETURN(
+        TensorSpline spline,
+        FitTensor(block, params, knots, EndCondition::kInterpolate, options.cancel, pins));
     SG_ASSIGN_OR_RETURN(Deviation dev,
                         MeasureDeviation(spline, params, block, options.cancel, tol_points));
     return std::make_pair(std::move(spline), dev);
@@ -280,8 +276,8 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
       if (m[d] == 1 || num_controls(d) >= cap[d]) continue;
       any_room = true;
       SG_ASSIGN_OR_RETURN(std::vector<double> ratio,
-                          DirectionResidualRatio(block, d, params[d], knots[d], pins[d],
-                                                 tolerance, options.cancel));
+                          DirectionResidualRatio(block, d, params[d], knots[d], pins[d], tolerance,
+                                                 options.cancel));
       added += SplitSpans(params[d], ratio, share[d], cap[d] - num_controls(d), dk[d]);
     }
     if (!any_room) break;
@@ -337,10 +333,8 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
   summary.deviation = dev;
   summary.num_points = block.num_points();
   summary.num_control_points = result.fitted.spline.num_control_points();
-  summary.compression_ratio =
-      static_cast<double>(summary.num_points) / summary.num_control_points;
-  summary.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.compression_ratio = static_cast<double>(summary.num_points) / summary.num_control_points;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

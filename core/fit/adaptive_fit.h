@@ -51,9 +51,9 @@ struct ToleranceFitOptions {
 
 struct ToleranceFitResult {
   FittedBlock fitted;
-  bool met = false;           // every point within its tolerance
-  std::string unmet_reason;   // why not, when !met
-  double worst_ratio = 0.0;   // max over points of deviation / tolerance
+  bool met = false;          // every point within its tolerance
+  std::string unmet_reason;  // why not, when !met
+  double worst_ratio = 0.0;  // max over points of deviation / tolerance
   Extents worst_at = {0, 0, 0};
   int iterations = 0;
   int knots_inserted = 0;

@@ -87,8 +87,7 @@ bool SchoenbergWhitneyHolds(const KnotVector& knots, std::span<const double> par
 }
 
 absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
-                                                  std::span<const double> params,
-                                                  EndCondition ends,
+                                                  std::span<const double> params, EndCondition ends,
                                                   std::span<const Pin> interior_pins,
                                                   std::span<const PenaltyRow> penalties) {
   const int m = static_cast<int>(params.size());
@@ -102,8 +101,8 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   }
   for (int i = 1; i < m; ++i) {
     if (!(params[i] > params[i - 1])) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "parameters are not strictly increasing at ", i, ": ", params[i - 1], ", ", params[i]));
+      return absl::InvalidArgumentError(absl::StrCat("parameters are not strictly increasing at ",
+                                                     i, ": ", params[i - 1], ", ", params[i]));
     }
   }
   DirectionFit fit;
@@ -145,9 +144,8 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   for (const PenaltyRow& p : penalties) {
     const int size = static_cast<int>(p.values.size());
     if (p.first < 0 || size < 1 || p.first + size > n) {
-      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first,
-                                                     " with ", size, " entries exceeds ", n,
-                                                     " controls"));
+      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first, " with ",
+                                                     size, " entries exceeds ", n, " controls"));
     }
     sorted_penalties.push_back(&p);
     bandwidth = std::max(bandwidth, size);
@@ -196,8 +194,8 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   }
   if (n_free > 0) {
     if (absl::Status rank = fit.qr_.CheckRank(); !rank.ok()) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          rank.message(), " (", n, " controls of order ", k, " for ", m, " points)"));
+      return absl::FailedPreconditionError(
+          absl::StrCat(rank.message(), " (", n, " controls of order ", k, " for ", m, " points)"));
     }
   }
   return fit;
@@ -212,8 +210,7 @@ absl::Status DirectionFit::Apply(const double* in, int64_t a, int64_t b, double*
   }
   // Keep the accumulator (free controls x width) around 128 KiB so it stays in L2.
   const int64_t n_free = std::max(qr_.num_cols(), 1);
-  const int64_t width =
-      std::min(std::clamp<int64_t>((16384 / n_free) / 8 * 8, 8, 1024), columns);
+  const int64_t width = std::min(std::clamp<int64_t>((16384 / n_free) / 8 * 8, 8, 1024), columns);
   // v, one row per pin, accumulator.
   std::vector<double> scratch((n_free + 1 + pins_.size()) * width);
   if (a >= width) {

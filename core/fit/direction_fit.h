@@ -70,12 +70,12 @@ class DirectionFit {
   // One row of the factored system: where its right-hand side comes from, and the pinned
   // controls it touches (their terms move to the right-hand side).
   struct RowSource {
-    int data_row;        // row of the data, or -1 for a penalty row (zero right side)
-    int pinned_begin;    // its pinned terms: pinned_terms_[pinned_begin .. pinned_end)
+    int data_row;      // row of the data, or -1 for a penalty row (zero right side)
+    int pinned_begin;  // its pinned terms: pinned_terms_[pinned_begin .. pinned_end)
     int pinned_end;
   };
   struct PinnedTerm {
-    int pin;             // index into pins_
+    int pin;  // index into pins_
     double coef;
   };
 
@@ -86,11 +86,11 @@ class DirectionFit {
 
   int num_points_ = 0;
   int num_controls_ = 0;
-  bool zero_pins_ = false;             // kZero: pinned controls are 0
-  std::vector<Pin> pins_;              // ends first (if any), then interior pins
-  std::vector<int> free_columns_;      // free index -> control index
-  BandedQR qr_{0, 1};                  // over the free controls
-  std::vector<RowSource> rows_;        // in the order they were added to qr_
+  bool zero_pins_ = false;         // kZero: pinned controls are 0
+  std::vector<Pin> pins_;          // ends first (if any), then interior pins
+  std::vector<int> free_columns_;  // free index -> control index
+  BandedQR qr_{0, 1};              // over the free controls
+  std::vector<RowSource> rows_;    // in the order they were added to qr_
   std::vector<PinnedTerm> pinned_terms_;
 };
 

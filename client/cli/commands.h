@@ -1,0 +1,26 @@
+// The `splinegrid` subcommands. Each takes its positional arguments (after the subcommand) and
+// reads the global flags; it prints its result to stdout (human-readable, or JSON with --json)
+// and returns the status that decides the exit code.
+#ifndef SPLINEGRID_CLIENT_CLI_COMMANDS_H_
+#define SPLINEGRID_CLIENT_CLI_COMMANDS_H_
+
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+
+namespace splinegrid::cli {
+
+using Args = std::vector<std::string>;
+
+absl::Status Serve(const Args& args);
+absl::Status Fit(const Args& args);
+absl::Status Get(const Args& args);
+absl::Status List(const Args& args);
+absl::Status Eval(const Args& args);
+absl::Status Remove(const Args& args);
+absl::Status Health(const Args& args);
+
+}  // namespace splinegrid::cli
+
+#endif  // SPLINEGRID_CLIENT_CLI_COMMANDS_H_

@@ -1,0 +1,37 @@
+#include "client/cli/flags.h"
+
+#include "absl/flags/flag.h"
+
+ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to (host:port)");
+ABSL_FLAG(bool, json, false, "print results as JSON");
+ABSL_FLAG(absl::Duration, timeout, absl::Minutes(10), "deadline of each call");
+
+ABSL_FLAG(std::string, name, "", "fit: id of the new grid (default: from the file name)");
+ABSL_FLAG(double, tol, 0.0, "fit: largest allowed deviation, in the grid's length unit");
+ABSL_FLAG(std::string, ctl, "", "fit: control points per direction, e.g. 24,16 or 24,16,8");
+ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
+ABSL_FLAG(bool, planar, true, "fit: store the 2D view of grids held as two planes (CFL3D style)");
+ABSL_FLAG(int, max_ctl, 0, "fit --tol: most control points per direction (0: no cap)");
+
+ABSL_FLAG(int64_t, revision, 0, "get/eval: revision (0: latest)");
+ABSL_FLAG(bool, full, false, "get: include knots, control points and distributions");
+
+ABSL_FLAG(int, level, -1, "eval: refinement level (0 = original points)");
+ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
+ABSL_FLAG(std::string, block, "", "eval: blocks to evaluate, e.g. 0 or 0,3 (default: all)");
+ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
+ABSL_FLAG(std::string, o, "", "eval: output file (.vts, .vtm, .x binary or .xyz text Plot3D)");
+ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
+ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
+
+ABSL_FLAG(std::string, service, "splinegrid.v1.SplineGrid",
+          "health: service to check (empty: the whole server)");
+
+ABSL_FLAG(std::string, address, "localhost:50051", "serve: address to listen on");
+ABSL_FLAG(int, threads, 0, "serve: worker threads (0: one per core)");
+ABSL_FLAG(int64_t, memory_budget_mb, 4096, "serve: memory budget for grids and work, MiB");
+ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,
+          "serve: the most points one evaluation may ask for");
+ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(10),
+          "serve: time in-flight calls get on SIGTERM before they are cancelled");
+ABSL_FLAG(bool, log_calls, true, "serve: one log line per call on stderr");

@@ -1,0 +1,43 @@
+// Flags of the `splinegrid` tool (defined in flags.cc).
+#ifndef SPLINEGRID_CLIENT_CLI_FLAGS_H_
+#define SPLINEGRID_CLIENT_CLI_FLAGS_H_
+
+#include <cstdint>
+#include <string>
+
+#include "absl/flags/declare.h"
+#include "absl/time/time.h"
+
+// Client side.
+ABSL_DECLARE_FLAG(std::string, server);
+ABSL_DECLARE_FLAG(bool, json);
+ABSL_DECLARE_FLAG(absl::Duration, timeout);
+// fit
+ABSL_DECLARE_FLAG(std::string, name);
+ABSL_DECLARE_FLAG(double, tol);
+ABSL_DECLARE_FLAG(std::string, ctl);
+ABSL_DECLARE_FLAG(int, order);
+ABSL_DECLARE_FLAG(bool, planar);
+ABSL_DECLARE_FLAG(int, max_ctl);
+// get
+ABSL_DECLARE_FLAG(int64_t, revision);
+ABSL_DECLARE_FLAG(bool, full);
+// eval
+ABSL_DECLARE_FLAG(int, level);
+ABSL_DECLARE_FLAG(std::string, res);
+ABSL_DECLARE_FLAG(std::string, block);
+ABSL_DECLARE_FLAG(std::string, box);
+ABSL_DECLARE_FLAG(std::string, o);
+ABSL_DECLARE_FLAG(bool, derivs);
+ABSL_DECLARE_FLAG(bool, float32);
+// health
+ABSL_DECLARE_FLAG(std::string, service);
+// serve
+ABSL_DECLARE_FLAG(std::string, address);
+ABSL_DECLARE_FLAG(int, threads);
+ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);
+ABSL_DECLARE_FLAG(int64_t, max_output_points);
+ABSL_DECLARE_FLAG(absl::Duration, shutdown_grace);
+ABSL_DECLARE_FLAG(bool, log_calls);
+
+#endif  // SPLINEGRID_CLIENT_CLI_FLAGS_H_

@@ -1,0 +1,55 @@
+// splinegrid: the command-line tool of the splinegrid service.
+//
+//   splinegrid serve [--address host:port] [--threads N] [--memory_budget_mb M]
+//   splinegrid fit FILE [--name N] [--tol T | --ctl a,b,c]
+//   splinegrid get NAME [--full]      splinegrid list      splinegrid rm NAME
+//   splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}
+//   splinegrid health
+// Client commands talk to --server (default localhost:50051); --json prints JSON.
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "client/cli/commands.h"
+
+namespace {
+
+constexpr char kUsage[] =
+    "splinegrid: structured grids as B-spline mappings.\n"
+    "  splinegrid serve [--address localhost:50051] [--threads N] [--memory_budget_mb M]\n"
+    "  splinegrid fit FILE [--name N] [--tol T | --ctl a,b,c]\n"
+    "  splinegrid get NAME [--full] | list | rm NAME | health\n"
+    "  splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}\n"
+    "Client commands use --server host:port (default localhost:50051) and --json.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage(kUsage);
+  std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
+  if (positional.size() < 2) {
+    std::fprintf(stderr, "%s\n", kUsage);
+    return 2;
+  }
+  using Command = absl::Status (*)(const splinegrid::cli::Args&);
+  const std::map<std::string, Command> commands = {
+      {"serve", splinegrid::cli::Serve},  {"fit", splinegrid::cli::Fit},
+      {"get", splinegrid::cli::Get},      {"list", splinegrid::cli::List},
+      {"eval", splinegrid::cli::Eval},    {"rm", splinegrid::cli::Remove},
+      {"health", splinegrid::cli::Health}};
+  const auto command = commands.find(positional[1]);
+  if (command == commands.end()) {
+    std::fprintf(stderr, "unknown command '%s'\n%s\n", positional[1], kUsage);
+    return 2;
+  }
+  const splinegrid::cli::Args args(positional.begin() + 2, positional.end());
+  const absl::Status status = command->second(args);
+  if (!status.ok()) {
+    std::fprintf(stderr, "splinegrid %s: %s\n", positional[1], status.ToString().c_str());
+    return status.code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
+  }
+  return 0;
+}

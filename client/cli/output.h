@@ -1,0 +1,41 @@
+// Printing for the `splinegrid` tool: tables, JSON and a progress line on terminals.
+#ifndef SPLINEGRID_CLIENT_CLI_OUTPUT_H_
+#define SPLINEGRID_CLIENT_CLI_OUTPUT_H_
+
+#include <string>
+
+#include "client/client.h"
+#include "google/protobuf/message.h"
+
+namespace splinegrid::cli {
+
+// The message as JSON (proto3 JSON mapping, field names as in the .proto).
+std::string ToJson(const google::protobuf::Message& message);
+
+// "225x65x1".
+std::string FormatExtents(const v1::Extents& extents);
+
+// The fit report: totals and one line per block.
+std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit);
+
+// One grid: source, revisions, blocks.
+std::string FormatGrid(const v1::Grid& grid);
+
+// A progress callback that redraws "label 12.3 / 45.6 MiB (27%)" on stderr when it is a
+// terminal (and prints nothing otherwise); Done() ends the line.
+class ProgressLine {
+ public:
+  explicit ProgressLine(std::string label);
+  client::ProgressFn callback();
+  void Done();
+
+ private:
+  std::string label_;
+  bool enabled_;
+  bool drawn_ = false;
+  int64_t last_ = -1;
+};
+
+}  // namespace splinegrid::cli
+
+#endif  // SPLINEGRID_CLIENT_CLI_OUTPUT_H_

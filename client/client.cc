@@ -1,0 +1,257 @@
+#include "client/client.h"
+
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+#include "third_party/grpc_health/health.grpc.pb.h"
+
+namespace splinegrid::client {
+namespace {
+
+constexpr int64_t kUploadChunkBytes = 1 << 20;
+
+Extents ExtentsOf(const v1::Extents& e) { return {e.i(), e.j(), e.k()}; }
+
+}  // namespace
+
+absl::Status FromGrpc(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+std::string GridName(const std::string& name_or_id) {
+  return name_or_id.rfind("grids/", 0) == 0 ? name_or_id : absl::StrCat("grids/", name_or_id);
+}
+
+Client::Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
+    : channel_(std::move(channel)), stub_(v1::SplineGrid::NewStub(channel_)), options_(options) {}
+
+std::unique_ptr<Client> Client::Connect(const std::string& target, ClientOptions options) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(8 << 20);
+  return std::make_unique<Client>(
+      grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), args), options);
+}
+
+std::unique_ptr<grpc::ClientContext> Client::NewContext() const {
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() +
+                        absl::ToChronoNanoseconds(options_.timeout));
+  return context;
+}
+
+absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const std::string& grid_id,
+                                              const std::string& display_name, bool planar_view,
+                                              const ProgressFn& progress) {
+  auto context = NewContext();
+  v1::Grid grid;
+  auto writer = stub_->ImportGrid(context.get(), &grid);
+  v1::ImportGridRequest request;
+  v1::ImportHeader* header = request.mutable_header();
+  header->set_grid_id(grid_id);
+  header->set_display_name(display_name);
+  header->mutable_plot3d()->set_total_bytes(static_cast<int64_t>(bytes.size()));
+  header->mutable_plot3d()->set_planar_view(planar_view);
+  bool open = writer->Write(request);
+  for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
+    request.Clear();
+    request.set_plot3d_chunk(bytes.substr(at, kUploadChunkBytes));
+    open = writer->Write(request);
+    if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
+  }
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  if (!status.ok()) return FromGrpc(status);
+  return grid;
+}
+
+absl::StatusOr<v1::Grid> Client::ImportPoints(const MultiBlockGrid& source,
+                                              const std::string& grid_id,
+                                              const std::string& display_name,
+                                              const ProgressFn& progress) {
+  if (source.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  auto context = NewContext();
+  v1::Grid grid;
+  auto writer = stub_->ImportGrid(context.get(), &grid);
+  v1::ImportGridRequest request;
+  v1::ImportHeader* header = request.mutable_header();
+  header->set_grid_id(grid_id);
+  header->set_display_name(display_name);
+  header->mutable_points()->set_spatial_dim(source.blocks.front().spatial_dim());
+  int64_t total = 0;
+  for (const StructuredBlock& block : source.blocks) {
+    v1::Extents* e = header->mutable_points()->add_blocks();
+    e->set_i(block.extent(0));
+    e->set_j(block.extent(1));
+    e->set_k(block.extent(2));
+    total += static_cast<int64_t>(block.coords().size() * sizeof(double));
+  }
+  bool open = writer->Write(request);
+  int64_t done = 0;
+  constexpr int64_t kValues = kUploadChunkBytes / sizeof(double);
+  for (size_t b = 0; open && b < source.blocks.size(); ++b) {
+    const std::span<const double> coords = source.blocks[b].coords();
+    for (int64_t at = 0; open && at < static_cast<int64_t>(coords.size()); at += kValues) {
+      request.Clear();
+      v1::PointChunk* chunk = request.mutable_points();
+      chunk->set_block(static_cast<int>(b));
+      const int64_t n = std::min<int64_t>(kValues, coords.size() - at);
+      chunk->mutable_coordinates()->Assign(coords.begin() + at, coords.begin() + at + n);
+      open = writer->Write(request);
+      done += n * static_cast<int64_t>(sizeof(double));
+      if (progress) progress(done, total);
+    }
+  }
+  writer->WritesDone();
+  const grpc::Status status = writer->Finish();
+  if (!status.ok()) return FromGrpc(status);
+  return grid;
+}
+
+absl::StatusOr<v1::FitGridResponse> Client::Fit(const std::string& name, const v1::FitSpec& spec) {
+  auto context = NewContext();
+  v1::FitGridRequest request;
+  request.set_name(GridName(name));
+  *request.mutable_spec() = spec;
+  v1::FitGridResponse response;
+  const grpc::Status status = stub_->FitGrid(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
+absl::StatusOr<v1::Grid> Client::Get(const std::string& name, int64_t revision, v1::GridView view,
+                                     const std::vector<int>& blocks) {
+  auto context = NewContext();
+  v1::GetGridRequest request;
+  request.set_name(GridName(name));
+  request.set_revision(revision);
+  request.set_view(view);
+  for (int b : blocks) request.add_blocks(b);
+  v1::Grid grid;
+  const grpc::Status status = stub_->GetGrid(context.get(), request, &grid);
+  if (!status.ok()) return FromGrpc(status);
+  return grid;
+}
+
+absl::StatusOr<std::vector<v1::Grid>> Client::List() {
+  std::vector<v1::Grid> grids;
+  v1::ListGridsRequest request;
+  request.set_page_size(500);
+  for (;;) {
+    auto context = NewContext();
+    v1::ListGridsResponse response;
+    const grpc::Status status = stub_->ListGrids(context.get(), request, &response);
+    if (!status.ok()) return FromGrpc(status);
+    for (v1::Grid& grid : *response.mutable_grids()) grids.push_back(std::move(grid));
+    if (response.next_page_token().empty()) return grids;
+    request.set_page_token(response.next_page_token());
+  }
+}
+
+absl::Status Client::Delete(const std::string& name) {
+  auto context = NewContext();
+  v1::DeleteGridRequest request;
+  request.set_name(GridName(name));
+  google::protobuf::Empty empty;
+  return FromGrpc(stub_->DeleteGrid(context.get(), request, &empty));
+}
+
+absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
+                                               const ProgressFn& progress) {
+  request.set_name(GridName(request.name()));
+  auto context = NewContext();
+  auto reader = stub_->EvaluateGrid(context.get(), request);
+  v1::EvaluateGridResponse message;
+  EvaluatedGrid result;
+  std::vector<int> slot;  // block index -> position in result.blocks
+  int64_t total_values = 0, received = 0;
+  int s = 3;
+  while (reader->Read(&message)) {
+    if (message.has_header()) {
+      const v1::EvaluationHeader& h = message.header();
+      result.revision = h.revision();
+      s = h.spatial_dim();
+      for (const v1::EvaluatedBlock& eb : h.blocks()) {
+        if (eb.block() >= static_cast<int>(slot.size())) slot.resize(eb.block() + 1, -1);
+        slot[eb.block()] = static_cast<int>(result.blocks.size());
+        EvaluatedBlock block{eb.block(), StructuredBlock(ExtentsOf(eb.extents()), s), {}, {}, {}};
+        if (h.derivatives()) {
+          block.du.resize(block.points.coords().size());
+          block.dv.resize(block.points.coords().size());
+          block.dw.resize(block.points.coords().size());
+        }
+        total_values +=
+            static_cast<int64_t>(block.points.coords().size()) * (h.derivatives() ? 4 : 1);
+        result.blocks.push_back(std::move(block));
+      }
+      continue;
+    }
+    const v1::EvaluationChunk& chunk = message.chunk();
+    if (chunk.block() < 0 || chunk.block() >= static_cast<int>(slot.size()) ||
+        slot[chunk.block()] < 0) {
+      context->TryCancel();
+      return absl::DataLossError(absl::StrCat("chunk for unannounced block ", chunk.block()));
+    }
+    EvaluatedBlock& block = result.blocks[slot[chunk.block()]];
+    double* target = nullptr;
+    switch (chunk.field()) {
+      case v1::FIELD_POINTS:
+        target = block.points.coords().data();
+        break;
+      case v1::FIELD_DU:
+        target = block.du.data();
+        break;
+      case v1::FIELD_DV:
+        target = block.dv.data();
+        break;
+      case v1::FIELD_DW:
+        target = block.dw.data();
+        break;
+      default:
+        break;
+    }
+    const int64_t n = chunk.values_size() + chunk.float_values_size();
+    if (!target || chunk.offset() < 0 ||
+        chunk.offset() + n > static_cast<int64_t>(block.points.coords().size())) {
+      context->TryCancel();
+      return absl::DataLossError("a chunk does not fit its block");
+    }
+    if (chunk.values_size() > 0) {
+      std::memcpy(target + chunk.offset(), chunk.values().data(), n * sizeof(double));
+    } else {
+      for (int64_t x = 0; x < n; ++x) target[chunk.offset() + x] = chunk.float_values(x);
+    }
+    received += n;
+    if (progress) progress(received * 8, total_values * 8);
+  }
+  const grpc::Status status = reader->Finish();
+  if (!status.ok()) return FromGrpc(status);
+  if (received != total_values) {
+    return absl::DataLossError(
+        absl::StrCat("received ", received, " of ", total_values, " values"));
+  }
+  return result;
+}
+
+absl::StatusOr<v1::EvaluatePointsResponse> Client::EvaluatePoints(
+    v1::EvaluatePointsRequest request) {
+  request.set_name(GridName(request.name()));
+  auto context = NewContext();
+  v1::EvaluatePointsResponse response;
+  const grpc::Status status = stub_->EvaluatePoints(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
+absl::StatusOr<std::string> Client::Health(const std::string& service) {
+  auto stub = grpc::health::v1::Health::NewStub(channel_);
+  auto context = NewContext();
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(service);
+  grpc::health::v1::HealthCheckResponse response;
+  const grpc::Status status = stub->Check(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return grpc::health::v1::HealthCheckResponse::ServingStatus_Name(response.status());
+}
+
+}  // namespace splinegrid::client

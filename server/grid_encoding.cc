@@ -1,0 +1,114 @@
+#include "server/grid_encoding.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "proto/convert/convert.h"
+
+namespace splinegrid::server {
+namespace {
+
+void EncodeTime(absl::Time time, google::protobuf::Timestamp* out) {
+  const int64_t nanos = absl::ToUnixNanos(time);
+  out->set_seconds(nanos / 1000000000);
+  out->set_nanos(static_cast<int32_t>(nanos % 1000000000));
+}
+
+v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
+  switch (origin) {
+    case RevisionOrigin::kFit:
+      return v1::REVISION_ORIGIN_FIT;
+  }
+  return v1::REVISION_ORIGIN_UNSPECIFIED;
+}
+
+}  // namespace
+
+void EncodeBlockFit(const BlockFit& block, const GridFitOptions& options,
+                    v1::BlockFitSummary* out) {
+  EncodeFitSummary(block.fitted.summary, out);
+  if (options.tolerance) {
+    out->set_tolerance_met(block.tolerance_met);
+    out->set_unmet_reason(block.unmet_reason);
+  }
+}
+
+absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
+                        const std::vector<int>& blocks, v1::Grid* out) {
+  out->set_name(absl::StrCat("grids/", grid.id));
+  out->set_display_name(grid.display_name);
+  EncodeTime(grid.create_time, out->mutable_create_time());
+  const MultiBlockGrid& source = grid.source->grid;
+  v1::SourceGrid* src = out->mutable_source();
+  src->set_spatial_dim(source.blocks.front().spatial_dim());
+  int64_t points = 0;
+  for (const StructuredBlock& block : source.blocks) {
+    EncodeExtents(block.extents(), src->add_blocks());
+    points += block.num_points();
+  }
+  src->set_num_points(points);
+  src->set_format(grid.source->format);
+  for (const auto& r : grid.revisions) {
+    v1::RevisionInfo* info = out->add_revisions();
+    info->set_revision(r->number);
+    EncodeTime(r->create_time, info->mutable_create_time());
+    info->set_origin(EncodeOrigin(r->origin));
+  }
+  if (grid.revisions.empty()) {
+    if (revision != 0) {
+      return absl::NotFoundError(absl::StrCat("grids/", grid.id, " has no revision ", revision,
+                                              " (it has not been fitted yet)"));
+    }
+    return absl::OkStatus();
+  }
+  out->set_latest_revision(grid.revisions.back()->number);
+  absl::StatusOr<std::shared_ptr<const GridRevision>> found = grid.FindRevision(revision);
+  if (!found.ok()) return found.status();
+  const GridRevision& rev = **found;
+  const int num_blocks = static_cast<int>(rev.blocks.size());
+  for (int b : blocks) {
+    if (b < 0 || b >= num_blocks) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("blocks: ", b, " is outside [0, ", num_blocks - 1, "]"));
+    }
+  }
+  v1::Revision* r = out->mutable_revision();
+  r->set_revision(rev.number);
+  EncodeTime(rev.create_time, r->mutable_create_time());
+  r->set_origin(EncodeOrigin(rev.origin));
+  EncodeFitSpec(rev.fit_options, r->mutable_fit_spec());
+  r->set_num_control_points(rev.num_control_points());
+  r->set_compression_ratio(static_cast<double>(points) /
+                           std::max<int64_t>(rev.num_control_points(), 1));
+  r->set_max_deviation(rev.max_deviation());
+  const bool full = view == v1::GRID_VIEW_FULL;
+  auto wanted = [&](int b) {
+    return blocks.empty() || std::find(blocks.begin(), blocks.end(), b) != blocks.end();
+  };
+  if (full) {
+    // Refuse before building a message that cannot be sent.
+    int64_t estimate = 0;
+    for (int b = 0; b < num_blocks; ++b) {
+      if (wanted(b)) estimate += FittedBlockBytes(rev.blocks[b].fitted);
+    }
+    if (estimate > kMaxMessageBytes) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "the FULL view of grids/", grid.id, " needs about ", estimate >> 10,
+          " KiB, over the 4 MiB message limit; ask for fewer blocks at a time (field blocks)"));
+    }
+  }
+  for (int b = 0; b < num_blocks; ++b) {
+    v1::SplineBlock* block = r->add_blocks();
+    EncodeSplineBlock(rev.blocks[b].fitted, b, full && wanted(b), block);
+    EncodeBlockFit(rev.blocks[b], rev.fit_options, block->mutable_fit());
+  }
+  const int64_t bytes = static_cast<int64_t>(out->ByteSizeLong());
+  if (bytes > kMaxMessageBytes) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "the FULL view of grids/", grid.id, " is ", bytes >> 10,
+        " KiB, over the 4 MiB message limit; ask for fewer blocks at a time (field blocks)"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace splinegrid::server

@@ -1,0 +1,27 @@
+// Stored grids as splinegrid.v1.Grid messages.
+#ifndef SPLINEGRID_SERVER_GRID_ENCODING_H_
+#define SPLINEGRID_SERVER_GRID_ENCODING_H_
+
+#include <vector>
+
+#include "absl/status/status.h"
+#include "server/grid_store.h"
+#include "splinegrid/v1/splinegrid_service.pb.h"
+
+namespace splinegrid::server {
+
+// Largest message the server builds: gRPC's default 4 MiB receive limit, less headroom.
+inline constexpr int64_t kMaxMessageBytes = (int64_t{4} << 20) - (64 << 10);
+
+// Fills `out` with `grid` and its revision `revision` (0: latest; none before the first fit).
+// FULL view adds knots, control points and distributions of `blocks` (empty: all); a result
+// over kMaxMessageBytes is RESOURCE_EXHAUSTED, naming the size and suggesting `blocks`.
+absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
+                        const std::vector<int>& blocks, v1::Grid* out);
+
+// A block's fit summary including the tolerance outcome.
+void EncodeBlockFit(const BlockFit& block, const GridFitOptions& options, v1::BlockFitSummary* out);
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_GRID_ENCODING_H_

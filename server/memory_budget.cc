@@ -1,0 +1,43 @@
+#include "server/memory_budget.h"
+
+#include "absl/strings/str_cat.h"
+
+namespace splinegrid::server {
+
+MemoryReservation::MemoryReservation(MemoryReservation&& other) noexcept
+    : budget_(other.budget_), bytes_(other.bytes_) {
+  other.budget_ = nullptr;
+  other.bytes_ = 0;
+}
+
+MemoryReservation& MemoryReservation::operator=(MemoryReservation&& other) noexcept {
+  if (this != &other) {
+    if (budget_) budget_->Release(bytes_);
+    budget_ = other.budget_;
+    bytes_ = other.bytes_;
+    other.budget_ = nullptr;
+    other.bytes_ = 0;
+  }
+  return *this;
+}
+
+MemoryReservation::~MemoryReservation() {
+  if (budget_) budget_->Release(bytes_);
+}
+
+absl::StatusOr<MemoryReservation> MemoryBudget::Reserve(int64_t bytes, const std::string& what) {
+  if (bytes < 0) bytes = 0;
+  int64_t used = used_.load();
+  for (;;) {
+    if (bytes > limit_ - used) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          what, " needs ", (bytes + (1 << 20) - 1) >> 20,
+          " MiB but the server's memory budget has ", std::max<int64_t>(limit_ - used, 0) >> 20,
+          " MiB of ", limit_ >> 20, " MiB left (flag --memory_budget_mb)"));
+    }
+    if (used_.compare_exchange_weak(used, used + bytes)) break;
+  }
+  return MemoryReservation(this, bytes);
+}
+
+}  // namespace splinegrid::server

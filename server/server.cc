@@ -1,0 +1,87 @@
+#include "server/server.h"
+
+#include <signal.h>
+
+#include <cstdio>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "grpcpp/ext/proto_server_reflection_plugin.h"
+#include "grpcpp/health_check_service_interface.h"
+
+namespace splinegrid::server {
+
+absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& options) {
+  if (options.worker_threads < 0 || options.max_queued_tasks < 1 ||
+      options.memory_budget_bytes < 1 || options.max_output_points < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "server options out of range: worker_threads = ", options.worker_threads,
+        ", max_queued_tasks = ", options.max_queued_tasks, ", memory_budget_bytes = ",
+        options.memory_budget_bytes, ", max_output_points = ", options.max_output_points));
+  }
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  std::unique_ptr<Server> server(new Server());
+  server->state_ = std::make_unique<ServiceState>(options);
+  server->service_ = std::make_unique<SplineGridService>(server->state_.get());
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(), &server->port_);
+  builder.RegisterService(server->service_.get());
+  server->server_ = builder.BuildAndStart();
+  if (!server->server_ || server->port_ == 0) {
+    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.address));
+  }
+  grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
+  health->SetServingStatus(true);
+  health->SetServingStatus(kServiceName, true);
+  return server;
+}
+
+Server::~Server() { Shutdown(); }
+
+std::shared_ptr<grpc::Channel> Server::InProcessChannel() {
+  return server_->InProcessChannel(grpc::ChannelArguments());
+}
+
+void Server::Shutdown() {
+  std::call_once(shutdown_once_, [this] {
+    if (!server_) return;
+    grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();
+    health->SetServingStatus(kServiceName, false);
+    health->SetServingStatus(false);
+    state_->draining.store(true);
+    server_->Shutdown(std::chrono::system_clock::now() +
+                      absl::ToChronoNanoseconds(state_->options.shutdown_grace));
+    server_->Wait();
+  });
+}
+
+void Server::Wait() {
+  if (server_) server_->Wait();
+}
+
+absl::Status RunServerUntilSignal(const ServerOptions& options) {
+  // Block the signals in every thread (gRPC's and the pool's inherit the mask) and take them
+  // synchronously in this one.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  absl::StatusOr<std::unique_ptr<Server>> server = Server::Start(options);
+  if (!server.ok()) return server.status();
+  std::fprintf(stderr, "splinegrid serving on port %d (%s), %d workers, memory budget %lld MiB\n",
+               (*server)->port(), options.address.c_str(), (*server)->state().pool.num_threads(),
+               static_cast<long long>(options.memory_budget_bytes >> 20));
+  int received = 0;
+  sigwait(&signals, &received);
+  std::fprintf(stderr, "splinegrid: %s received: draining (up to %s) and shutting down\n",
+               received == SIGTERM ? "SIGTERM" : "SIGINT",
+               absl::FormatDuration(options.shutdown_grace).c_str());
+  (*server)->Shutdown();
+  server->reset();
+  std::fprintf(stderr, "splinegrid: stopped\n");
+  return absl::OkStatus();
+}
+
+}  // namespace splinegrid::server

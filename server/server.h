@@ -1,0 +1,55 @@
+// A running splinegrid server: the SplineGrid service plus grpc.health.v1 (overall and for
+// "splinegrid.v1.SplineGrid") and server reflection.
+#ifndef SPLINEGRID_SERVER_SERVER_H_
+#define SPLINEGRID_SERVER_SERVER_H_
+
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "grpcpp/grpcpp.h"
+#include "server/server_options.h"
+#include "server/service.h"
+
+namespace splinegrid::server {
+
+inline constexpr char kServiceName[] = "splinegrid.v1.SplineGrid";
+
+class Server {
+ public:
+  // Builds, starts and marks the server SERVING. Errors: INVALID_ARGUMENT for bad options,
+  // UNAVAILABLE when the address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<Server>> Start(const ServerOptions& options);
+  ~Server();
+
+  // The bound port (useful with port 0).
+  int port() const { return port_; }
+
+  // A channel to this server that bypasses the network (for tests).
+  std::shared_ptr<grpc::Channel> InProcessChannel();
+
+  // NOT_SERVING, refuse new calls (UNAVAILABLE), let in-flight calls finish within
+  // options.shutdown_grace, cancel the rest, stop the workers. Idempotent.
+  void Shutdown();
+
+  // Blocks until Shutdown has completed.
+  void Wait();
+
+  const ServiceState& state() const { return *state_; }
+
+ private:
+  Server() = default;
+
+  std::unique_ptr<ServiceState> state_;
+  std::unique_ptr<SplineGridService> service_;
+  std::unique_ptr<grpc::Server> server_;
+  int port_ = 0;
+  std::once_flag shutdown_once_;
+};
+
+// Starts a server and runs it until SIGTERM or SIGINT, then shuts down gracefully.
+// Returns OK after a clean shutdown.
+absl::Status RunServerUntilSignal(const ServerOptions& options);
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_SERVER_H_

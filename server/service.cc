@@ -1,0 +1,189 @@
+#include "server/service.h"
+
+#include <chrono>
+#include <thread>
+
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
+#include "server/grid_encoding.h"
+
+namespace splinegrid::server {
+namespace {
+
+int DefaultThreads(int requested) {
+  if (requested > 0) return requested;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+}  // namespace
+
+ServiceState::ServiceState(const ServerOptions& opts)
+    : options(opts),
+      budget(opts.memory_budget_bytes),
+      pool(DefaultThreads(opts.worker_threads), opts.max_queued_tasks) {}
+
+grpc::Status ToGrpcStatus(const absl::Status& status) {
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+}
+
+CancelCheck CallCancelCheck(grpc::CallbackServerContext* context) {
+  const auto deadline = context->deadline();
+  return [context, deadline] {
+    return context->IsCancelled() || std::chrono::system_clock::now() > deadline;
+  };
+}
+
+bool IsValidGridId(const std::string& id) {
+  if (id.empty() || id.size() > 63 || !(id[0] >= 'a' && id[0] <= 'z')) return false;
+  for (char c : id) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
+  }
+  return true;
+}
+
+absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field) {
+  constexpr char kPrefix[] = "grids/";
+  if (name.rfind(kPrefix, 0) != 0 || !IsValidGridId(name.substr(sizeof(kPrefix) - 1))) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, " = '", name, "' is not a grid name (grids/{id}, id of [a-z0-9-], 1-63 chars)"));
+  }
+  return name.substr(sizeof(kPrefix) - 1);
+}
+
+grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerContext* context,
+                                                       CallLog log,
+                                                       std::function<absl::Status()> work) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (state_->draining.load()) {
+    const absl::Status status = absl::UnavailableError("the server is shutting down");
+    log.Finish(status);
+    reactor->Finish(ToGrpcStatus(status));
+    return reactor;
+  }
+  auto task = [reactor, log, work = std::move(work)] {
+    const absl::Status status = work();
+    log.Finish(status);
+    reactor->Finish(ToGrpcStatus(status));
+  };
+  if (!state_->pool.TrySubmit(std::move(task))) {
+    const absl::Status status =
+        absl::ResourceExhaustedError("the server is busy: its work queue is full; retry later");
+    log.Finish(status);
+    reactor->Finish(ToGrpcStatus(status));
+  }
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerContext* context,
+                                                       CallLog log,
+                                                       const std::function<absl::Status()>& work) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const absl::Status status =
+      state_->draining.load() ? absl::UnavailableError("the server is shutting down") : work();
+  log.Finish(status);
+  reactor->Finish(ToGrpcStatus(status));
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext* context,
+                                                     const v1::FitGridRequest* request,
+                                                     v1::FitGridResponse* response) {
+  CallLog log("FitGrid", request->name(), state_->options.log_calls);
+  CancelCheck cancel = CallCancelCheck(context);
+  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(GridFitOptions options, ParseFitSpec(request->spec()));
+    const MultiBlockGrid& source = grid->source->grid;
+    SG_RETURN_IF_ERROR(options.Validate(source));
+    // Working memory of a fit: about the intermediate nets plus the parametrisation, bounded
+    // by the source size.
+    SG_ASSIGN_OR_RETURN(MemoryReservation work,
+                        state_->budget.Reserve(grid->source->memory.bytes(), "the fit"));
+    SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source, options, cancel));
+    GridRevision revision;
+    revision.create_time = absl::Now();
+    revision.origin = RevisionOrigin::kFit;
+    revision.fit_options = options;
+    int64_t bytes = 0;
+    for (const BlockFit& block : fit.blocks) bytes += FittedBlockBytes(block.fitted);
+    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(bytes, "the fitted revision"));
+    revision.blocks = std::move(fit.blocks);
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
+                        state_->store.AddRevision(id, std::move(revision)));
+    const GridRevision& published = *stored->revisions.back();
+    response->set_revision(published.number);
+    for (const BlockFit& block : published.blocks) {
+      EncodeBlockFit(block, published.fit_options, response->add_blocks());
+    }
+    response->set_num_points(fit.num_points);
+    response->set_num_control_points(fit.num_control_points);
+    response->set_compression_ratio(static_cast<double>(fit.num_points) /
+                                    std::max<int64_t>(fit.num_control_points, 1));
+    response->set_max_deviation(fit.max_deviation);
+    response->set_seconds(fit.seconds);
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext* context,
+                                                     const v1::GetGridRequest* request,
+                                                     v1::Grid* response) {
+  CallLog log("GetGrid", request->name(), state_->options.log_calls);
+  auto work = [this, request, response]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    if (request->revision() < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("revision = ", request->revision(), " is negative"));
+    }
+    const std::vector<int> blocks(request->blocks().begin(), request->blocks().end());
+    return EncodeGrid(*grid, request->revision(), request->view(), blocks, response);
+  };
+  // Encoding a FULL view copies control nets: pool work; the basic view is a lookup.
+  if (request->view() == v1::GRID_VIEW_FULL) return RunOnPool(context, log, work);
+  return RunInline(context, log, work);
+}
+
+grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerContext* context,
+                                                       const v1::ListGridsRequest* request,
+                                                       v1::ListGridsResponse* response) {
+  CallLog log("ListGrids", "", state_->options.log_calls);
+  return RunInline(context, log, [this, request, response]() -> absl::Status {
+    const int size = request->page_size();
+    if (size < 0 || size > 1000) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("page_size = ", size, " is outside [0, 1000]"));
+    }
+    std::string after;
+    if (!request->page_token().empty() &&
+        (!absl::WebSafeBase64Unescape(request->page_token(), &after) || !IsValidGridId(after))) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("page_token = '", request->page_token(), "' is not a token of ListGrids"));
+    }
+    bool more = false;
+    const auto page = state_->store.List(after, size == 0 ? 50 : size, &more);
+    for (const auto& grid : page) {
+      SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response->add_grids()));
+    }
+    if (more && !page.empty()) {
+      response->set_next_page_token(absl::WebSafeBase64Escape(page.back()->id));
+    }
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerContext* context,
+                                                        const v1::DeleteGridRequest* request,
+                                                        google::protobuf::Empty* /*response*/) {
+  CallLog log("DeleteGrid", request->name(), state_->options.log_calls);
+  return RunInline(context, log, [this, request]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    return state_->store.Delete(id);
+  });
+}
+
+}  // namespace splinegrid::server

@@ -1,0 +1,82 @@
+// The splinegrid.v1.SplineGrid service: short callback handlers that validate, hand the work
+// to the worker pool and Finish. The numerics live in core/, the conversions in proto/convert.
+#ifndef SPLINEGRID_SERVER_SERVICE_H_
+#define SPLINEGRID_SERVER_SERVICE_H_
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "grpcpp/grpcpp.h"
+#include "server/call_log.h"
+#include "server/grid_store.h"
+#include "server/memory_budget.h"
+#include "server/server_options.h"
+#include "server/worker_pool.h"
+#include "splinegrid/v1/splinegrid_service.grpc.pb.h"
+
+namespace splinegrid::server {
+
+// What every call may use: the store, the pool, the budget and the configuration.
+struct ServiceState {
+  explicit ServiceState(const ServerOptions& opts);
+
+  ServerOptions options;
+  GridStore store;
+  MemoryBudget budget;
+  WorkerPool pool;
+  std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
+};
+
+// absl::Status -> grpc::Status (the codes are the same numbers).
+grpc::Status ToGrpcStatus(const absl::Status& status);
+
+// A check for the kernel's cancellation polls: the call was cancelled or its deadline passed.
+CancelCheck CallCancelCheck(grpc::CallbackServerContext* context);
+
+// "grids/{id}" -> id, or INVALID_ARGUMENT naming `field` and the value.
+absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field);
+
+// Whether `id` is a valid grid id: 1-63 characters of [a-z0-9-], starting with a letter.
+bool IsValidGridId(const std::string& id);
+
+class SplineGridService final : public v1::SplineGrid::CallbackService {
+ public:
+  explicit SplineGridService(ServiceState* state) : state_(state) {}
+
+  grpc::ServerReadReactor<v1::ImportGridRequest>* ImportGrid(grpc::CallbackServerContext* context,
+                                                             v1::Grid* response) override;
+  grpc::ServerUnaryReactor* FitGrid(grpc::CallbackServerContext* context,
+                                    const v1::FitGridRequest* request,
+                                    v1::FitGridResponse* response) override;
+  grpc::ServerUnaryReactor* GetGrid(grpc::CallbackServerContext* context,
+                                    const v1::GetGridRequest* request, v1::Grid* response) override;
+  grpc::ServerUnaryReactor* ListGrids(grpc::CallbackServerContext* context,
+                                      const v1::ListGridsRequest* request,
+                                      v1::ListGridsResponse* response) override;
+  grpc::ServerUnaryReactor* DeleteGrid(grpc::CallbackServerContext* context,
+                                       const v1::DeleteGridRequest* request,
+                                       google::protobuf::Empty* response) override;
+  grpc::ServerWriteReactor<v1::EvaluateGridResponse>* EvaluateGrid(
+      grpc::CallbackServerContext* context, const v1::EvaluateGridRequest* request) override;
+  grpc::ServerUnaryReactor* EvaluatePoints(grpc::CallbackServerContext* context,
+                                           const v1::EvaluatePointsRequest* request,
+                                           v1::EvaluatePointsResponse* response) override;
+
+ private:
+  // Runs `work` on the worker pool and finishes the call with its status (UNAVAILABLE while
+  // draining, RESOURCE_EXHAUSTED when the pool's queue is full).
+  grpc::ServerUnaryReactor* RunOnPool(grpc::CallbackServerContext* context, CallLog log,
+                                      std::function<absl::Status()> work);
+  // Runs cheap, non-numeric `work` right here and finishes the call.
+  grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
+                                      const std::function<absl::Status()>& work);
+
+  ServiceState* state_;
+};
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_SERVICE_H_

@@ -1,0 +1,43 @@
+// A fixed set of threads running submitted tasks from a bounded queue. RPC handlers hand their
+// numerics to the pool so that gRPC's threads never compute; a full queue is reported to the
+// caller (RESOURCE_EXHAUSTED) instead of queueing without bound.
+#ifndef SPLINEGRID_SERVER_WORKER_POOL_H_
+#define SPLINEGRID_SERVER_WORKER_POOL_H_
+
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace splinegrid::server {
+
+class WorkerPool {
+ public:
+  // Starts `threads` workers (>= 1); at most `max_queued` tasks wait at any time.
+  WorkerPool(int threads, int max_queued);
+  // Runs the queued tasks to the end, then joins the workers.
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  // Queues `task`; false (and the task is dropped) when the queue is full or the pool stopped.
+  bool TrySubmit(std::function<void()> task);
+
+  int num_threads() const { return static_cast<int>(threads_.size()); }
+
+ private:
+  void Run();
+
+  const int max_queued_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> queue_;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_WORKER_POOL_H_
