@@ -12,6 +12,7 @@
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
+#include "server/happens_before.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
@@ -31,6 +32,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   EvaluateReactor(ServiceState* state, grpc::CallbackServerContext* context,
                   const v1::EvaluateGridRequest* request)
       : state_(state),
+        context_(context),
         request_(request),
         cancel_(CallCancelCheck(context)),
         log_("EvaluateGrid", request->name(), state->options.log_calls) {
@@ -42,6 +44,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   }
 
   void OnWriteDone(bool ok) override {
+    SG_HAPPENS_AFTER(this);
     {
       std::lock_guard<std::mutex> lock(mu_);
       writing_ = false;
@@ -51,7 +54,10 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     Pump();
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    SG_HAPPENS_AFTER(this);
+    delete this;
+  }
 
  private:
   bool float_values() const { return request_->precision() == v1::PRECISION_FLOAT; }
@@ -95,12 +101,18 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     v1::EvaluationHeader* h = header->mutable_header();
     const int s = revision_->blocks.front().fitted.spline.spatial_dim();
     int64_t total = 0, work_bytes = 0;
+    std::vector<bool> seen(num_blocks, false);
     for (size_t q = 0; q < blocks.size(); ++q) {
       const int b = blocks[q];
       if (b < 0 || b >= num_blocks) {
         return absl::InvalidArgumentError(
             absl::StrCat("blocks[", q, "] = ", b, " is outside [0, ", num_blocks - 1, "]"));
       }
+      if (seen[b]) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("blocks[", q, "] = ", b, " is repeated; name each block once"));
+      }
+      seen[b] = true;
       const FittedBlock& fitted = revision_->blocks[b].fitted;
       absl::StatusOr<Extents> extents = SampleExtents(fitted.distribution, resolution);
       if (!extents.ok()) {
@@ -167,10 +179,14 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     }
     if (finish) {
       log_.Finish(final_status);
+      SG_HAPPENS_BEFORE(this);
       Finish(ToGrpcStatus(final_status));
       return;
     }
-    if (next) StartWrite(next);
+    if (next) {
+      SG_HAPPENS_BEFORE(this);
+      StartWrite(next);
+    }
     if (produce && !state_->pool.TrySubmit([this] { Produce(); })) {
       {
         std::lock_guard<std::mutex> lock(mu_);
@@ -189,7 +205,8 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
         if (!status_.ok() || ready_.size() + num_fields() > kMaxReady) break;
       }
       if (cancel_()) {
-        status = absl::CancelledError("EvaluateGrid was cancelled or its deadline passed");
+        status = ExplainCancellation(
+            context_, absl::CancelledError("EvaluateGrid was cancelled by the client"));
         break;
       }
       std::vector<std::unique_ptr<v1::EvaluateGridResponse>> step;
@@ -274,6 +291,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   }
 
   ServiceState* state_;
+  grpc::CallbackServerContext* context_;
   const v1::EvaluateGridRequest* request_;
   CancelCheck cancel_;
   CallLog log_;

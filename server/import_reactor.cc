@@ -9,6 +9,7 @@
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/grid_encoding.h"
+#include "server/happens_before.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
@@ -22,10 +23,12 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
       Fail(absl::UnavailableError("the server is shutting down"));
       return;
     }
+    SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
 
   void OnReadDone(bool ok) override {
+    SG_HAPPENS_AFTER(this);
     if (!ok) {  // the client closed its side: everything has arrived
       if (!state_->pool.TrySubmit([this] { Complete(); })) {
         Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
@@ -36,14 +39,19 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
       Fail(status);
       return;
     }
+    SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    SG_HAPPENS_AFTER(this);
+    delete this;
+  }
 
  private:
   void Fail(const absl::Status& status) {
     log_.Finish(status);
+    SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
   }
 
@@ -206,6 +214,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
   void Complete() {
     const absl::Status status = Store();
     log_.Finish(status);
+    SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
   }
 

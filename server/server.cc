@@ -25,10 +25,12 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   server->state_ = std::make_unique<ServiceState>(options);
   server->service_ = std::make_unique<SplineGridService>(server->state_.get());
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(), &server->port_);
+  if (!options.address.empty()) {
+    builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(), &server->port_);
+  }
   builder.RegisterService(server->service_.get());
   server->server_ = builder.BuildAndStart();
-  if (!server->server_ || server->port_ == 0) {
+  if (!server->server_ || (!options.address.empty() && server->port_ == 0)) {
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.address));
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
@@ -53,6 +55,9 @@ void Server::Shutdown() {
     server_->Shutdown(std::chrono::system_clock::now() +
                       absl::ToChronoNanoseconds(state_->options.shutdown_grace));
     server_->Wait();
+    // Every call has finished; the workers have nothing left but returning from their last
+    // task. Joining them here orders all their work before the service is destroyed.
+    state_->pool.Stop();
   });
 }
 

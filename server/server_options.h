@@ -10,7 +10,8 @@
 namespace splinegrid::server {
 
 struct ServerOptions {
-  // host:port to listen on; port 0 picks a free port (see Server::port()).
+  // host:port to listen on; port 0 picks a free port (see Server::port()); empty: no network
+  // port, only Server::InProcessChannel (tests).
   std::string address = "localhost:50051";
   // Threads of the worker pool that runs fits and evaluations; 0: one per core.
   int worker_threads = 0;

@@ -9,6 +9,7 @@
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/grid_encoding.h"
+#include "server/happens_before.h"
 
 namespace splinegrid::server {
 namespace {
@@ -34,6 +35,14 @@ CancelCheck CallCancelCheck(grpc::CallbackServerContext* context) {
   return [context, deadline] {
     return context->IsCancelled() || std::chrono::system_clock::now() > deadline;
   };
+}
+
+absl::Status ExplainCancellation(grpc::CallbackServerContext* context, absl::Status status) {
+  if (status.code() == absl::StatusCode::kCancelled &&
+      std::chrono::system_clock::now() > context->deadline()) {
+    return absl::DeadlineExceededError("the call's deadline passed before the work was done");
+  }
+  return status;
 }
 
 bool IsValidGridId(const std::string& id) {
@@ -63,8 +72,10 @@ grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerConte
     reactor->Finish(ToGrpcStatus(status));
     return reactor;
   }
-  auto task = [reactor, log, work = std::move(work)] {
-    const absl::Status status = work();
+  SG_HAPPENS_BEFORE(reactor);
+  auto task = [reactor, context, log, work = std::move(work)] {
+    SG_HAPPENS_AFTER(reactor);
+    const absl::Status status = ExplainCancellation(context, work());
     log.Finish(status);
     reactor->Finish(ToGrpcStatus(status));
   };

@@ -36,6 +36,10 @@ grpc::Status ToGrpcStatus(const absl::Status& status);
 // A check for the kernel's cancellation polls: the call was cancelled or its deadline passed.
 CancelCheck CallCancelCheck(grpc::CallbackServerContext* context);
 
+// `status`, except that a CANCELLED caused by the call's expired deadline becomes
+// DEADLINE_EXCEEDED (the kernel only knows "stop").
+absl::Status ExplainCancellation(grpc::CallbackServerContext* context, absl::Status status);
+
 // "grids/{id}" -> id, or INVALID_ARGUMENT naming `field` and the value.
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field);
 

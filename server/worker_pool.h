@@ -17,13 +17,16 @@ class WorkerPool {
  public:
   // Starts `threads` workers (>= 1); at most `max_queued` tasks wait at any time.
   WorkerPool(int threads, int max_queued);
-  // Runs the queued tasks to the end, then joins the workers.
+  // Stop().
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   // Queues `task`; false (and the task is dropped) when the queue is full or the pool stopped.
   bool TrySubmit(std::function<void()> task);
+
+  // Refuses new tasks, runs the queued ones to the end and joins the workers. Idempotent.
+  void Stop();
 
   int num_threads() const { return static_cast<int>(threads_.size()); }
 

@@ -16,9 +16,13 @@ void BasisFunctions(const KnotVector& knots, int span, double u, double* values)
     right[j] = t[span + j] - u;
     double saved = 0.0;
     for (int r = 0; r < j; ++r) {
-      const double temp = values[r] / (right[r + 1] + left[j - r]);
-      values[r] = saved + right[r + 1] * temp;
-      saved = left[j - r] * temp;
+      // The weights right / (right + left) and left / (right + left) are divided out separately
+      // so that a zero left (u at a knot of multiplicity k - 1, or a clamped end) gives a
+      // weight of exactly 1: the one nonzero basis function there is exactly 1.
+      const double den = right[r + 1] + left[j - r];
+      const double v = values[r];
+      values[r] = saved + (right[r + 1] / den) * v;
+      saved = (left[j - r] / den) * v;
     }
     values[j] = saved;
   }
@@ -38,9 +42,9 @@ void BasisDerivatives(const KnotVector& knots, int span, double u, int max_deriv
     double saved = 0.0;
     for (int r = 0; r < j; ++r) {
       ndu[j][r] = right[r + 1] + left[j - r];
-      const double temp = ndu[r][j - 1] / ndu[j][r];
-      ndu[r][j] = saved + right[r + 1] * temp;
-      saved = left[j - r] * temp;
+      const double v = ndu[r][j - 1];
+      ndu[r][j] = saved + (right[r + 1] / ndu[j][r]) * v;
+      saved = (left[j - r] / ndu[j][r]) * v;
     }
     ndu[j][j] = saved;
   }

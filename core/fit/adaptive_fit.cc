@@ -136,9 +136,13 @@ std::vector<Pin> FeaturePins(const KnotVector& knots, const std::vector<int>& fe
 bool WellPosed(const DirectionKnots& dk, const std::vector<double>& params) {
   absl::StatusOr<KnotVector> knots = BuildKnots(dk, params);
   if (!knots.ok()) return false;
+  const std::vector<Pin> pins = FeaturePins(*knots, dk.features, params);
   std::vector<int> pinned = {0, knots->num_controls() - 1};
-  for (const Pin& pin : FeaturePins(*knots, dk.features, params)) pinned.push_back(pin.control);
-  return SchoenbergWhitneyHolds(*knots, params, pinned);
+  for (const Pin& pin : pins) pinned.push_back(pin.control);
+  if (!SchoenbergWhitneyHolds(*knots, params, pinned)) return false;
+  // Schoenberg-Whitney is structural; the factorisation also rejects numerically singular
+  // configurations (strongly graded knots) that the fit itself would reject.
+  return DirectionFit::Create(*knots, params, EndCondition::kInterpolate, pins).ok();
 }
 
 // Splits knot spans whose worst ratio exceeds `limit` at the middle of their data (worst span
@@ -229,7 +233,10 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
     if (m[d] > 2 && options.detect_features && dk[d].order > 1) {
       for (int r : DetectFeatures(block, d, options)) {
         dk[d].features.push_back(r);
-        if (!WellPosed(dk[d], params[d])) dk[d].features.pop_back();
+        const int controls =
+            static_cast<int>(dk[d].interior.size() + dk[d].features.size() * (dk[d].order - 1)) +
+            dk[d].order;
+        if (controls > cap[d] || !WellPosed(dk[d], params[d])) dk[d].features.pop_back();
       }
     }
   }
@@ -298,6 +305,9 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
         const double knot = dk[d].interior[i];
         dk[d].interior.erase(dk[d].interior.begin() + i);
         absl::StatusOr<std::pair<TensorSpline, Deviation>> trial = fit();
+        if (!trial.ok() && trial.status().code() == absl::StatusCode::kCancelled) {
+          return trial.status();
+        }
         if (trial.ok() && trial->second.max_ratio <= 1.0) {
           current = *std::move(trial);
           ++result.knots_removed;

@@ -30,16 +30,24 @@ void BandedQR::AddRow(int first, std::span<const double> values) {
   double* h = scratch_.data();
   std::fill(h, h + w, 0.0);
   std::copy(values.begin(), values.end(), h);
-  // Trailing zeros need no rotation.
-  int remaining = static_cast<int>(values.size());
-  while (remaining > 0 && h[remaining - 1] == 0.0) --remaining;
+  // Rotate until the row is annihilated. Rotating against R row j can fill the row in up to
+  // column j + w - 1 (R rows reach that far when an earlier row with the same first column was
+  // wider), so the count of rotations is not the row's own length: trailing zeros are trimmed
+  // after every rotation instead.
+  auto last_nonzero = [&] {
+    int last = w;
+    while (last > 0 && h[last - 1] == 0.0) --last;
+    return last;
+  };
   int count = 0;
-  for (int j = first; remaining > 0; ++j, --remaining, ++count) {
+  for (int j = first; j < num_cols_ && last_nonzero() > 0; ++j, ++count) {
     // Invariant: h[t] is the entry of the row in column j + t.
     double c = 1.0, s = 0.0;
     double* rj = r_.data() + static_cast<size_t>(j) * w;
     if (h[0] != 0.0) {
-      const double norm = std::sqrt(rj[0] * rj[0] + h[0] * h[0]);
+      // hypot, not sqrt(a^2 + b^2): the squares of tiny entries (rounding residues can reach
+      // 1e-160 and below) underflow to 0, which made norm = 0 and c = 0 / 0 = NaN.
+      const double norm = std::hypot(rj[0], h[0]);
       c = rj[0] / norm;
       s = h[0] / norm;
       rj[0] = norm;

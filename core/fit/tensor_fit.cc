@@ -118,8 +118,7 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
 
 absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
                                            const std::array<std::vector<double>, 3>& params,
-                                           const StructuredBlock& block,
-                                           const CancelCheck& cancel,
+                                           const StructuredBlock& block, const CancelCheck& cancel,
                                            std::span<const double> tolerance) {
   GridEvaluator evaluator(spline, params, /*first_derivatives=*/false);
   if (evaluator.extents() != block.extents() || spline.spatial_dim() != block.spatial_dim()) {

@@ -33,16 +33,21 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
   SG_ASSIGN_OR_RETURN(const IndexBox box, CheckedBox(distribution, resolution));
   Extents extents;
   if (resolution.kind == Resolution::Kind::kLevel) {
-    if (resolution.level < 0 || resolution.level > kMaxRefinementLevel) {
-      return absl::InvalidArgumentError(absl::StrCat("refinement_level = ", resolution.level,
-                                                     " is outside [0, ", kMaxRefinementLevel, "]"));
+    if (resolution.level < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("refinement_level = ", resolution.level, " is negative"));
+    }
+    if (resolution.level > kMaxRefinementLevel) {
+      return absl::OutOfRangeError(absl::StrCat("refinement_level = ", resolution.level,
+                                                " is above the highest level, ",
+                                                kMaxRefinementLevel));
     }
     for (int d = 0; d < 3; ++d) {
       const int64_t n = (int64_t{box.end[d]} - box.begin[d]) * (int64_t{1} << resolution.level) + 1;
       if (n > (int64_t{1} << 30)) {
-        return absl::InvalidArgumentError(absl::StrCat("refinement_level = ", resolution.level,
-                                                       " gives ", n, " points in direction ",
-                                                       std::string(1, kNames[d])));
+        return absl::OutOfRangeError(absl::StrCat("refinement_level = ", resolution.level,
+                                                  " gives ", n, " points in direction ",
+                                                  std::string(1, kNames[d])));
       }
       extents[d] = static_cast<int>(n);
     }
@@ -50,9 +55,13 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
   }
   for (int d = 0; d < 3; ++d) {
     const int n = resolution.counts[d];
-    if (n < 1 || n > (1 << 30)) {
+    if (n < 1) {
       return absl::InvalidArgumentError(
-          absl::StrCat("counts.", std::string(1, kNames[d]), " = ", n, " is outside [1, 2^30]"));
+          absl::StrCat("counts.", std::string(1, kNames[d]), " = ", n, " is below 1"));
+    }
+    if (n > (1 << 30)) {
+      return absl::OutOfRangeError(
+          absl::StrCat("counts.", std::string(1, kNames[d]), " = ", n, " is above 2^30"));
     }
     if (n > 1 && box.begin[d] == box.end[d]) {
       return absl::InvalidArgumentError(

@@ -34,9 +34,10 @@ struct Resolution {
 inline constexpr int kMaxRefinementLevel = 20;
 
 // The point counts that `resolution` gives on a block with `distribution`, without building
-// the parameters (for size checks). Errors: INVALID_ARGUMENT naming the field and value for a
-// negative or too high level, counts below 1, a box outside the block or with end < begin;
-// counts in a direction with one original point must be 1.
+// the parameters (for size checks). Errors, naming the field and value: INVALID_ARGUMENT for a
+// negative level, counts below 1, a box outside the block or with end < begin, counts above 1
+// in a direction with one original point; OUT_OF_RANGE for a level above kMaxRefinementLevel or
+// more than 2^30 points in a direction.
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
                                       const Resolution& resolution);
 

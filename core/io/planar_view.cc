@@ -59,7 +59,9 @@ bool Within(double difference, double tol) { return std::abs(difference) <= tol;
 // Checks whether the planes 0 and 1 along direction `d` (extent 2) of 3D `block` form a
 // two-plane block with tolerance `tol`.
 PlaneCheck CheckPlanes(const StructuredBlock& block, int d, double tol) {
-  const auto [a, b] = OtherDirections(d);
+  // Plain variables, not a structured binding: lambdas capture those portably.
+  const auto others = OtherDirections(d);
+  const int a = others.first, b = others.second;
   auto point = [&](int plane, int ia, int ib) {
     int index[3];
     index[d] = plane;

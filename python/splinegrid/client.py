@@ -1,0 +1,581 @@
+"""A Python client of the splinegrid.v1 service (same semantics as the C++ client/client.h).
+
+Conventions
+-----------
+Names
+    A grid may be named ``"foo"`` or ``"grids/foo"``; both mean the resource ``grids/foo``.
+
+Arrays
+    Points are NumPy arrays shaped ``(nk, nj, ni, s)`` in C order, so the last index before the
+    coordinate, ``i``, is the fastest in memory, exactly the service's packed layout
+    ("coordinates interleaved, i fastest"). ``s`` is the number of coordinates, 2 or 3. The
+    element ``points[k, j, i]`` is the point of grid index ``(i, j, k)``. Uploads also accept
+    ``(nj, ni, s)`` (a surface, nk = 1) and ``(ni, s)`` (a curve); results are always 4-D (use
+    ``points[0]`` for the ``(nj, ni, s)`` view of a 2-D block).
+
+Deadlines
+    Every call gets a deadline of ``timeout`` seconds from its start (each page of ``list``,
+    each attempt of ``import_plot3d`` and each batch of ``evaluate_points`` separately).
+
+Errors
+    A failed call raises :class:`SplinegridError`, which keeps the gRPC status code name (e.g.
+    ``"NOT_FOUND"``) and the server's message; it subclasses ``grpc.RpcError`` and chains the
+    original error as ``__cause__``. A stream that ends inconsistently (missing or misplaced
+    chunks) raises it with code ``"DATA_LOSS"``. Arguments that are wrong before any call is
+    made raise ``ValueError``.
+
+Results
+    Resources come back as the generated protos (``Grid``, ``FitGridResponse``; their fields
+    are documented in ``proto/splinegrid/v1/*.proto``); bulk numbers as NumPy arrays.
+
+Bulk data (uploads, evaluation chunks, EvaluatePoints) is moved between wire bytes and NumPy
+arrays without a step per value, see ``_wire``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from dataclasses import dataclass
+from typing import Iterable, Iterator, NamedTuple, Optional, Sequence, Union
+
+import grpc
+import numpy as np
+import numpy.typing as npt
+from google.protobuf.message import Message
+
+from splinegrid import _wire
+from splinegrid.v1 import grid_pb2
+from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
+from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
+
+__all__ = [
+    "SERVICE",
+    "Client",
+    "EvaluatedBlock",
+    "EvaluatedGrid",
+    "EvaluatedPoints",
+    "SplinegridError",
+    "grid_name",
+]
+
+SERVICE = "splinegrid.v1.SplineGrid"
+UPLOAD_CHUNK_BYTES = 1 << 20  # Plot3D bytes or point coordinates per upload message
+MAX_RECEIVE_BYTES = 8 << 20
+LIST_PAGE_SIZE = 500
+POINTS_BATCH_BYTES = 3 << 20  # EvaluatePoints request or response size per call
+
+PathOrBytes = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview]
+Triple = Sequence[int]  # (i, j) or (i, j, k)
+Blocks = Union[None, int, Iterable[int]]
+
+_FIELD_NAMES = {
+    service_pb2.FIELD_POINTS: "points",
+    service_pb2.FIELD_DU: "du",
+    service_pb2.FIELD_DV: "dv",
+    service_pb2.FIELD_DW: "dw",
+}
+_HEALTH_STATUS = ("UNKNOWN", "SERVING", "NOT_SERVING", "SERVICE_UNKNOWN")
+
+
+class SplinegridError(grpc.RpcError):
+    """A failed call: ``code`` is the gRPC status code name, ``message`` the server's message."""
+
+    def __init__(self, code: str, message: str) -> None:
+        super().__init__(f"{code}: {message}")
+        self.code = code
+        self.message = message
+
+    @property
+    def status_code(self) -> Optional[grpc.StatusCode]:
+        """``code`` as a ``grpc.StatusCode`` (None if gRPC has no such code)."""
+        return grpc.StatusCode.__members__.get(self.code)
+
+    @classmethod
+    def from_rpc_error(cls, error: grpc.RpcError) -> SplinegridError:
+        code = error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
+        details = error.details() if hasattr(error, "details") else str(error)
+        return cls(code.name, details or "")
+
+
+@dataclass
+class EvaluatedBlock:
+    """One evaluated block: ``points`` and, when asked for, ``du``/``dv``/``dw``.
+
+    All arrays are shaped ``(nk, nj, ni, s)`` (C order, i fastest); the derivatives are
+    dX/du, dX/dv, dX/dw with respect to the block's spline parameters.
+    """
+
+    block: int
+    points: np.ndarray
+    du: Optional[np.ndarray] = None
+    dv: Optional[np.ndarray] = None
+    dw: Optional[np.ndarray] = None
+
+
+class EvaluatedGrid(list[EvaluatedBlock]):
+    """The blocks of one evaluation in the order asked for: a list with two more attributes,
+    the ``revision`` that was evaluated and ``spatial_dim`` (s)."""
+
+    def __init__(self, revision: int, spatial_dim: int,
+                 blocks: Iterable[EvaluatedBlock] = ()) -> None:
+        super().__init__(blocks)
+        self.revision = revision
+        self.spatial_dim = spatial_dim
+
+
+@dataclass
+class EvaluatedPoints:
+    """The result of :meth:`Client.evaluate_points`: arrays shaped ``(N, s)``."""
+
+    revision: int
+    points: np.ndarray
+    du: Optional[np.ndarray] = None
+    dv: Optional[np.ndarray] = None
+    dw: Optional[np.ndarray] = None
+
+
+def grid_name(name_or_id: str) -> str:
+    """``"foo"`` or ``"grids/foo"`` -> ``"grids/foo"``."""
+    return name_or_id if name_or_id.startswith("grids/") else f"grids/{name_or_id}"
+
+
+class Client:
+    """A connection to a splinegrid server (an insecure channel to ``target``).
+
+    Use it as a context manager, or call :meth:`close`. ``timeout`` is the deadline of every
+    call in seconds. ``stub`` is the generated ``SplineGridStub`` for anything not wrapped here
+    (its calls get neither deadlines nor error translation).
+    """
+
+    def __init__(self, target: str = "localhost:50051", timeout: float = 120.0) -> None:
+        if not timeout > 0:
+            raise ValueError(f"timeout = {timeout}; must be positive")
+        self.target = target
+        self.timeout = timeout
+        self._channel = grpc.insecure_channel(
+            target, options=[("grpc.max_receive_message_length", MAX_RECEIVE_BYTES)])
+        self.stub = service_grpc.SplineGridStub(self._channel)
+        # The bulk methods exchange hand-encoded bytes (see _wire) instead of generated classes.
+        self._import_grid = self._channel.stream_unary(
+            f"/{SERVICE}/ImportGrid", request_serializer=_serialize,
+            response_deserializer=grid_pb2.Grid.FromString)
+        self._evaluate_grid = self._channel.unary_stream(
+            f"/{SERVICE}/EvaluateGrid", request_serializer=_serialize,
+            response_deserializer=_decode_evaluate_response)
+        self._evaluate_points = self._channel.unary_unary(
+            f"/{SERVICE}/EvaluatePoints", request_serializer=_serialize,
+            response_deserializer=_decode_points_response)
+        self._health_check = self._channel.unary_unary(
+            "/grpc.health.v1.Health/Check", request_serializer=_encode_health_request,
+            response_deserializer=_decode_health_response)
+
+    def close(self) -> None:
+        self._channel.close()
+
+    def __enter__(self) -> Client:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    # Import
+
+    def import_plot3d(self, path_or_bytes: PathOrBytes, grid_id: str = "",
+                      display_name: str = "",
+                      planar_view: Optional[bool] = None) -> grid_pb2.Grid:
+        """Uploads a Plot3D file (a path, or its bytes) as a new grid; returns it (BASIC view).
+
+        The file goes in 1 MiB pieces after an ImportHeader. ``grid_id`` is the new name's last
+        segment ("" lets the server pick). ``planar_view=True`` stores the 2-D view of a grid
+        held as two planes (CFL3D style) and fails for any other grid; ``False`` stores the
+        file as read. ``None`` means "planar exactly when the file is a two-plane grid": the
+        upload is tried with True and, if the server answers INVALID_ARGUMENT because the file
+        is not a two-plane grid, repeated with False. That costs a second upload for ordinary
+        files; pass False (or True) when you know.
+        """
+        data = _read_bytes(path_or_bytes)
+        if planar_view is not None:
+            return self._import_plot3d(data, grid_id, display_name, planar_view)
+        try:
+            return self._import_plot3d(data, grid_id, display_name, True)
+        except SplinegridError as error:
+            message = error.message.lower()
+            if error.code != "INVALID_ARGUMENT" or not ("two-plane" in message
+                                                        or "planar" in message):
+                raise
+        return self._import_plot3d(data, grid_id, display_name, False)
+
+    def _import_plot3d(self, data: memoryview, grid_id: str, display_name: str,
+                       planar_view: bool) -> grid_pb2.Grid:
+        header = service_pb2.ImportHeader(
+            grid_id=_grid_id(grid_id), display_name=display_name,
+            plot3d=service_pb2.Plot3dSource(total_bytes=len(data), planar_view=planar_view))
+
+        def requests() -> Iterator[Union[bytes, Message]]:
+            yield service_pb2.ImportGridRequest(header=header)
+            for at in range(0, len(data), UPLOAD_CHUNK_BYTES):
+                # ImportGridRequest.plot3d_chunk (field 2), without copying into a message.
+                yield _wire.length_delimited(2, data[at:at + UPLOAD_CHUNK_BYTES].tobytes())
+
+        with _translated_errors():
+            return self._import_grid(requests(), timeout=self.timeout)
+
+    def import_points(self, blocks: Sequence[npt.ArrayLike], grid_id: str = "",
+                      display_name: str = "") -> grid_pb2.Grid:
+        """Uploads point blocks as a new grid; returns it (BASIC view).
+
+        Each block is an array shaped ``(nk, nj, ni, s)``, ``(nj, ni, s)`` or ``(ni, s)`` (C
+        order: i fastest; see the module docstring), with the same s (2 or 3) for all blocks.
+        The coordinates go as PointChunk messages of at most 1 MiB of values each.
+        """
+        arrays = [_as_block(b, n) for n, b in enumerate(blocks)]
+        if not arrays:
+            raise ValueError("blocks is empty: a grid needs a block")
+        s = arrays[0].shape[-1]
+        if any(a.shape[-1] != s for a in arrays):
+            raise ValueError("all blocks must have the same number of coordinates (last axis)")
+        header = service_pb2.ImportHeader(
+            grid_id=_grid_id(grid_id), display_name=display_name,
+            points=service_pb2.PointsSource(
+                spatial_dim=s,
+                blocks=[grid_pb2.Extents(i=a.shape[2], j=a.shape[1], k=a.shape[0])
+                        for a in arrays]))
+        values_per_chunk = UPLOAD_CHUNK_BYTES // 8
+
+        def requests() -> Iterator[Union[bytes, Message]]:
+            yield service_pb2.ImportGridRequest(header=header)
+            for b, array in enumerate(arrays):
+                flat = array.reshape(-1)
+                prefix = service_pb2.PointChunk(block=b).SerializeToString()
+                for at in range(0, flat.size, values_per_chunk):
+                    # PointChunk {block, coordinates} as ImportGridRequest.points (field 3).
+                    chunk = prefix + _wire.packed_doubles(2, flat[at:at + values_per_chunk])
+                    yield _wire.length_delimited(3, chunk)
+
+        with _translated_errors():
+            return self._import_grid(requests(), timeout=self.timeout)
+
+    # Fit and the grid resource
+
+    def fit(self, name: str, control_counts: Optional[Triple] = None,
+            tolerance: Optional[float] = None, order: int = 4,
+            max_controls: int = 0) -> service_pb2.FitGridResponse:
+        """Fits the grid's source points; the result is stored as a new revision.
+
+        Give either ``control_counts`` ``(a, b)`` or ``(a, b, c)`` (control points per
+        direction i, j, k for every block; 0 or a missing entry: as many as points) or a
+        ``tolerance`` (largest deviation, in the grid's length unit; knots are added until it
+        is met or ``max_controls`` per direction, 0 = no cap, is reached). Neither: interpolate.
+
+        Returns the FitGridResponse proto: ``revision``, ``num_points``,
+        ``num_control_points``, ``compression_ratio``, ``max_deviation``, ``seconds`` and
+        ``blocks``, one BlockFitSummary per block (points, control points, ratio, max/RMS
+        deviation and where, and with a tolerance ``tolerance_met``/``unmet_reason``).
+        """
+        if control_counts is not None and tolerance is not None:
+            raise ValueError("give control_counts or tolerance, not both")
+        spec = grid_pb2.FitSpec(order=order, max_controls_per_direction=max_controls)
+        if tolerance is not None:
+            spec.tolerance = tolerance
+        elif control_counts is not None:
+            spec.control_counts.CopyFrom(_extents(control_counts, "control_counts", fill=0))
+        request = service_pb2.FitGridRequest(name=grid_name(name), spec=spec)
+        with _translated_errors():
+            return self.stub.FitGrid(request, timeout=self.timeout)
+
+    def get(self, name: str, revision: int = 0, full: bool = False,
+            blocks: Iterable[int] = ()) -> grid_pb2.Grid:
+        """The grid with revision ``revision`` (0: latest). ``full`` adds knots, control points
+        and point distributions (of ``blocks`` only, when given)."""
+        request = service_pb2.GetGridRequest(
+            name=grid_name(name), revision=revision, blocks=list(blocks),
+            view=service_pb2.GRID_VIEW_FULL if full else service_pb2.GRID_VIEW_BASIC)
+        with _translated_errors():
+            return self.stub.GetGrid(request, timeout=self.timeout)
+
+    def list(self) -> list[grid_pb2.Grid]:
+        """Every grid (BASIC view), ordered by name, following the pages."""
+        grids: list[grid_pb2.Grid] = []
+        request = service_pb2.ListGridsRequest(page_size=LIST_PAGE_SIZE)
+        with _translated_errors():
+            while True:
+                response = self.stub.ListGrids(request, timeout=self.timeout)
+                grids.extend(response.grids)
+                if not response.next_page_token:
+                    return grids
+                request.page_token = response.next_page_token
+
+    def delete(self, name: str) -> None:
+        with _translated_errors():
+            self.stub.DeleteGrid(service_pb2.DeleteGridRequest(name=grid_name(name)),
+                                 timeout=self.timeout)
+
+    # Evaluation
+
+    def evaluate(self, name: str, level: Optional[int] = None,
+                 counts: Optional[Triple] = None, blocks: Blocks = None,
+                 index_box: Optional[tuple[Triple, Triple]] = None,
+                 derivatives: bool = False, dtype: npt.DTypeLike = np.float64,
+                 revision: int = 0) -> EvaluatedGrid:
+        """Evaluates blocks of a revision (0: latest) on a grid of parameters.
+
+        Resolution: ``level`` l puts 2^l - 1 new points in every original interval (0, the
+        default, gives the original points), or ``counts`` ``(ni, nj[, nk])`` points per
+        direction (a missing entry: 1; a count of 1 takes the first index of the block or box),
+        both following the original clustering. ``blocks``: an
+        index or indices (None: all, in order). ``index_box``: ``(begin, end)``, each
+        ``(i, j[, k])`` in original grid indices, inclusive at both ends (missing: 0).
+        ``dtype`` float32 transfers single precision (half the bytes).
+
+        Returns an :class:`EvaluatedGrid`, a list of :class:`EvaluatedBlock` whose arrays are
+        shaped ``(nk, nj, ni, s)`` with ``dtype``.
+        """
+        out_dtype = np.dtype(dtype)
+        if out_dtype not in (np.float64, np.float32):
+            raise ValueError(f"dtype = {out_dtype}; use float64 or float32")
+        if level is not None and counts is not None:
+            raise ValueError("give level or counts, not both")
+        block_list = _block_list(blocks)
+        if len(set(block_list)) != len(block_list):
+            # The chunks name blocks by index, so a repeated block could not be told apart.
+            raise ValueError(f"blocks = {block_list} repeats a block")
+        request = service_pb2.EvaluateGridRequest(
+            name=grid_name(name), revision=revision, blocks=block_list,
+            derivatives=derivatives,
+            precision=(service_pb2.PRECISION_FLOAT if out_dtype == np.float32
+                       else service_pb2.PRECISION_DOUBLE))
+        if counts is not None:
+            request.counts.CopyFrom(_extents(counts, "counts", fill=1))
+        else:
+            request.refinement_level = 0 if level is None else level
+        if index_box is not None:
+            begin, end = index_box
+            request.index_box.begin.CopyFrom(_extents(begin, "index_box begin", fill=0))
+            request.index_box.end.CopyFrom(_extents(end, "index_box end", fill=0))
+        with _translated_errors():
+            call = self._evaluate_grid(request, timeout=self.timeout)
+            try:
+                return _assemble(call, out_dtype)
+            except SplinegridError:
+                call.cancel()
+                raise
+
+    def evaluate_points(self, name: str, params: npt.ArrayLike,
+                        blocks: Union[int, npt.ArrayLike] = 0, derivatives: bool = False,
+                        revision: int = 0) -> EvaluatedPoints:
+        """Evaluates N parameter points ``params`` (shape ``(N, 3)``: u, v, w in [0, 1]; use
+        w = 0 for a 2-D block) of block ``blocks`` (one index for all, or one per point).
+
+        Returns :class:`EvaluatedPoints` with arrays shaped ``(N, s)``. Requests and responses
+        must stay under gRPC's 4 MiB message limit, so large N is sent in several calls (each
+        with its own deadline), all pinned to the revision the first one evaluated.
+        """
+        uvw = np.ascontiguousarray(params, dtype=_wire.DOUBLE)
+        if uvw.ndim == 1 and uvw.size == 3:
+            uvw = uvw.reshape(1, 3)
+        if uvw.ndim != 2 or uvw.shape[1] != 3:
+            raise ValueError(f"params has shape {uvw.shape}; expected (N, 3)")
+        block_array = np.asarray(blocks, dtype=np.int64).reshape(-1)
+        if block_array.size not in (1, len(uvw)):
+            raise ValueError(f"{block_array.size} blocks for {len(uvw)} points; give one, "
+                             "or one per point")
+        # Bytes per point: 24 of parameters + up to 5 of block index in the request; up to
+        # 3 coordinates x (1 or 4 fields) x 9 in the response (the server's own estimate).
+        per_point = max(29, 3 * (4 if derivatives else 1) * 9)
+        batch = max(1, POINTS_BATCH_BYTES // per_point)
+        parts: list[EvaluatedPoints] = []
+        with _translated_errors():
+            for at in range(0, max(len(uvw), 1), batch):
+                head = service_pb2.EvaluatePointsRequest(
+                    name=grid_name(name), revision=revision, derivatives=derivatives,
+                    blocks=(block_array if block_array.size == 1
+                            else block_array[at:at + batch]).tolist())
+                request = head.SerializeToString() + _wire.packed_doubles(  # + parameters
+                    4, uvw[at:at + batch])
+                parts.append(self._evaluate_points(request, timeout=self.timeout))
+                revision = parts[0].revision
+        if len(parts) == 1:
+            return parts[0]
+        joined = {f: np.concatenate([getattr(part, f) for part in parts])
+                  for f in (("points", "du", "dv", "dw") if derivatives else ("points",))}
+        return EvaluatedPoints(revision, **joined)
+
+    # Health
+
+    def health(self, service: str = SERVICE) -> str:
+        """The grpc.health.v1 status of ``service`` ("" = the whole server): "SERVING",
+        "NOT_SERVING", ... A service the server does not know raises NOT_FOUND."""
+        with _translated_errors():
+            return self._health_check(service, timeout=self.timeout)
+
+
+# Helpers
+
+
+@contextlib.contextmanager
+def _translated_errors() -> Iterator[None]:
+    """grpc.RpcError -> SplinegridError (chained)."""
+    try:
+        yield
+    except SplinegridError:
+        raise
+    except grpc.RpcError as error:
+        raise SplinegridError.from_rpc_error(error) from error
+
+
+def _data_loss(message: str) -> SplinegridError:
+    return SplinegridError("DATA_LOSS", message)
+
+
+def _serialize(message: Union[bytes, Message]) -> bytes:
+    """Requests that are already encoded pass through; messages are serialized."""
+    return message if isinstance(message, bytes) else message.SerializeToString()
+
+
+def _read_bytes(path_or_bytes: PathOrBytes) -> memoryview:
+    if isinstance(path_or_bytes, (bytes, bytearray, memoryview)):
+        return memoryview(path_or_bytes).cast("B")
+    with open(path_or_bytes, "rb") as file:
+        return memoryview(file.read())
+
+
+def _grid_id(grid_id: str) -> str:
+    """The id part of "foo" or "grids/foo"."""
+    return grid_id[len("grids/"):] if grid_id.startswith("grids/") else grid_id
+
+
+def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
+    values = [int(v) for v in values]
+    if not 1 <= len(values) <= 3:
+        raise ValueError(f"{what} = {values}; give 1 to 3 integers (i, j, k)")
+    i, j, k = values + [fill] * (3 - len(values))
+    return grid_pb2.Extents(i=i, j=j, k=k)
+
+
+def _block_list(blocks: Blocks) -> list[int]:
+    if blocks is None:
+        return []
+    if isinstance(blocks, (int, np.integer)):
+        return [int(blocks)]
+    return [int(b) for b in blocks]
+
+
+def _as_block(block: npt.ArrayLike, index: int) -> np.ndarray:
+    """An upload block as a C-ordered little-endian float64 array (nk, nj, ni, s)."""
+    array = np.asarray(block, dtype=np.float64)
+    if not 2 <= array.ndim <= 4 or array.shape[-1] not in (2, 3):
+        raise ValueError(f"blocks[{index}] has shape {array.shape}; expected (nk, nj, ni, s), "
+                         "(nj, ni, s) or (ni, s) with s = 2 or 3")
+    array = array.reshape((1,) * (4 - array.ndim) + array.shape)
+    return np.ascontiguousarray(array, dtype=_wire.DOUBLE)
+
+
+class _Chunk(NamedTuple):
+    block: int
+    field: int
+    offset: int
+    values: np.ndarray
+
+
+def _decode_evaluate_response(data: bytes) -> Union[service_pb2.EvaluationHeader, _Chunk]:
+    """An EvaluateGridResponse: the header as a proto, a chunk with its values as an array."""
+    part: Union[service_pb2.EvaluationHeader, _Chunk, None] = None
+    for number, wire_type, value in _wire.fields(data):
+        if number == 1 and wire_type == _wire.LENGTH_DELIMITED:
+            part = service_pb2.EvaluationHeader.FromString(value.tobytes())
+        elif number == 2 and wire_type == _wire.LENGTH_DELIMITED:
+            part = _decode_chunk(value)
+    if part is None:
+        raise ValueError("an EvaluateGridResponse with neither header nor chunk")
+    return part
+
+
+def _decode_chunk(data: memoryview) -> _Chunk:
+    """An EvaluationChunk (fields: 1 block, 2 field, 3 offset, 4 values, 5 float_values)."""
+    ints = {1: 0, 2: 0, 3: 0}
+    floats = _wire.FloatFields()
+    for number, wire_type, value in _wire.fields(data):
+        if number in ints and wire_type == _wire.VARINT:
+            ints[number] = _wire.signed(value)
+        elif number == 4:
+            floats.add(4, wire_type, value, _wire.DOUBLE)
+        elif number == 5:
+            floats.add(5, wire_type, value, _wire.FLOAT)
+    values = floats.get(4, _wire.DOUBLE)
+    if values.size == 0:
+        values = floats.get(5, _wire.FLOAT)
+    return _Chunk(ints[1], ints[2], ints[3], values)
+
+
+def _assemble(messages: Iterable[Union[service_pb2.EvaluationHeader, _Chunk]],
+              dtype: np.dtype) -> EvaluatedGrid:
+    """Reassembles an EvaluateGrid stream into preallocated arrays."""
+    result: Optional[EvaluatedGrid] = None
+    targets: dict[tuple[int, int], np.ndarray] = {}  # (block, field) -> flat view
+    missing = 0  # values announced but not received yet
+    for part in messages:
+        if isinstance(part, service_pb2.EvaluationHeader):
+            if result is not None:
+                raise _data_loss("a second header")
+            s = part.spatial_dim
+            result = EvaluatedGrid(part.revision, s)
+            fields = list(_FIELD_NAMES.items())[:4 if part.derivatives else 1]
+            for announced in part.blocks:
+                if (announced.block, service_pb2.FIELD_POINTS) in targets:
+                    raise _data_loss(f"block {announced.block} announced twice")
+                e = announced.extents
+                arrays = {attribute: np.empty((e.k, e.j, e.i, s), dtype=dtype)
+                          for _, attribute in fields}
+                for field, attribute in fields:
+                    targets[announced.block, field] = arrays[attribute].reshape(-1)
+                    missing += arrays[attribute].size
+                result.append(EvaluatedBlock(announced.block, **arrays))
+            continue
+        if result is None:
+            raise _data_loss("a chunk before the header")
+        target = targets.get((part.block, part.field))
+        end = part.offset + part.values.size
+        if target is None or part.offset < 0 or end > target.size:
+            raise _data_loss(f"a chunk (block {part.block}, field {part.field}, values "
+                             f"[{part.offset}, {end})) that does not fit what the header "
+                             "announced")
+        target[part.offset:end] = part.values
+        missing -= part.values.size
+    if result is None:
+        raise _data_loss("the stream ended without a header")
+    if missing != 0:
+        raise _data_loss(f"{missing} announced values did not arrive")
+    return result
+
+
+def _decode_points_response(data: bytes) -> EvaluatedPoints:
+    """An EvaluatePointsResponse (1 revision, 2 spatial_dim, 3 points, 4-6 du, dv, dw)."""
+    ints = {1: 0, 2: 0}
+    floats = _wire.FloatFields()
+    for number, wire_type, value in _wire.fields(data):
+        if number in ints and wire_type == _wire.VARINT:
+            ints[number] = _wire.signed(value)
+        elif 3 <= number <= 6:
+            floats.add(number, wire_type, value, _wire.DOUBLE)
+    s = ints[2] or 1
+    points, du, dv, dw = (floats.get(n, _wire.DOUBLE).reshape(-1, s) for n in range(3, 7))
+    if du.size == 0:
+        return EvaluatedPoints(ints[1], points)
+    return EvaluatedPoints(ints[1], points, du, dv, dw)
+
+
+# grpc.health.v1: Debian's python3-grpcio does not ship grpc_health, and the two messages are
+# one field each, so they are encoded by hand: HealthCheckRequest {string service = 1;},
+# HealthCheckResponse {ServingStatus status = 1;} (an enum, i.e. a varint).
+
+def _encode_health_request(service: str) -> bytes:
+    return _wire.length_delimited(1, service.encode()) if service else b""
+
+
+def _decode_health_response(data: bytes) -> str:
+    status = 0
+    for number, wire_type, value in _wire.fields(data):
+        if number == 1 and wire_type == _wire.VARINT:
+            status = int(value)
+    return _HEALTH_STATUS[status] if status < len(_HEALTH_STATUS) else str(status)

@@ -1,0 +1,79 @@
+// An in-process splinegrid server and client for service tests.
+#ifndef SPLINEGRID_TESTS_SERVER_SERVICE_FIXTURE_H_
+#define SPLINEGRID_TESTS_SERVER_SERVICE_FIXTURE_H_
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "client/client.h"
+#include "core/io/file_util.h"
+#include "gtest/gtest.h"
+#include "server/server.h"
+
+namespace splinegrid::testing {
+
+inline std::string SharedData(const std::string& relative) {
+  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
+    return std::string(dir) + "/" + relative;
+  }
+  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
+}
+
+class ServiceTest : public ::testing::Test {
+ protected:
+  // Options of the server under test; tests may change them before StartServer().
+  server::ServerOptions options_ = [] {
+    server::ServerOptions o;
+    o.address = "";  // in-process only
+    o.log_calls = false;
+    o.worker_threads = 2;
+    return o;
+  }();
+
+  void SetUp() override { StartServer(); }
+
+  void StartServer() {
+    server_.reset();
+    server_ = server::Server::Start(options_).value();
+    client::ClientOptions client_options;
+    client_options.timeout = absl::Seconds(60);
+    client_ = std::make_unique<client::Client>(server_->InProcessChannel(), client_options);
+  }
+
+  // Imports a shared Plot3D file under `id` (planar view for two-plane files).
+  v1::Grid ImportShared(const std::string& relative, const std::string& id, bool planar = false) {
+    const std::string bytes = ReadFileToString(SharedData(relative)).value();
+    absl::StatusOr<v1::Grid> grid = client_->ImportPlot3d(bytes, id, relative, planar);
+    EXPECT_TRUE(grid.ok()) << grid.status();
+    return grid.ok() ? *grid : v1::Grid();
+  }
+
+  // Fits `id` with `counts` control points per direction (0: interpolation).
+  v1::FitGridResponse FitCounts(const std::string& id, int ci, int cj, int ck = 0) {
+    v1::FitSpec spec;
+    spec.mutable_control_counts()->set_i(ci);
+    spec.mutable_control_counts()->set_j(cj);
+    spec.mutable_control_counts()->set_k(ck);
+    absl::StatusOr<v1::FitGridResponse> fit = client_->Fit(id, spec);
+    EXPECT_TRUE(fit.ok()) << fit.status();
+    return fit.ok() ? *fit : v1::FitGridResponse();
+  }
+
+  // Waits until the memory budget is back to `bytes` (in-flight work released), up to 5 s.
+  bool WaitForBudget(int64_t bytes) {
+    for (int i = 0; i < 500; ++i) {
+      if (server_->state().budget.used() == bytes) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+
+  std::unique_ptr<server::Server> server_;
+  std::unique_ptr<client::Client> client_;
+};
+
+}  // namespace splinegrid::testing
+
+#endif  // SPLINEGRID_TESTS_SERVER_SERVICE_FIXTURE_H_
