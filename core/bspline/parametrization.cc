@@ -1,6 +1,7 @@
 #include "core/bspline/parametrization.h"
 
 #include <cmath>
+#include <memory>
 
 #include "core/util/check.h"
 
@@ -30,10 +31,10 @@ inline double Increment(double d2) {
   }
 }
 
-// A plane of points with each coordinate in its own contiguous array (structure of arrays),
-// so that distances between neighbours vectorise without shuffling interleaved coordinates.
+// A row of points with each coordinate in its own contiguous array (structure of arrays), so
+// that distances between neighbours vectorise without shuffling interleaved coordinates.
 template <int S>
-struct PlaneSoA {
+struct RowSoA {
   std::array<std::vector<double>, S> x;
   void Load(const double* points, int64_t count) {
     for (int c = 0; c < S; ++c) {
@@ -44,11 +45,11 @@ struct PlaneSoA {
   }
 };
 
-// out[i] = Increment(|q_i - p_i|^2) for i < count, where p_i = (a[0][i], a[1][i], ...) and
-// q_i the same in b.
+// out[i] = Increment(|b_i - a_i|^2) for i < count, points of rows a and b from the given
+// offsets.
 template <int S, Parametrization P>
-void SegmentIncrements(const PlaneSoA<S>& a, int64_t a_offset, const PlaneSoA<S>& b,
-                       int64_t b_offset, int64_t count, double* __restrict out) {
+void SegmentIncrements(const RowSoA<S>& a, int64_t a_offset, const RowSoA<S>& b, int64_t b_offset,
+                       int64_t count, double* __restrict out) {
   const double* pa[S];
   const double* pb[S];
   for (int c = 0; c < S; ++c) {
@@ -58,6 +59,17 @@ void SegmentIncrements(const PlaneSoA<S>& a, int64_t a_offset, const PlaneSoA<S>
   for (int64_t i = 0; i < count; ++i) {
     double d2 = 0.0;
     for (int c = 0; c < S; ++c) d2 += (pb[c][i] - pa[c][i]) * (pb[c][i] - pa[c][i]);
+    out[i] = Increment<P>(d2);
+  }
+}
+
+// The same for interleaved points (rows of different k-planes, read once each).
+template <int S, Parametrization P>
+void SegmentIncrements(const double* __restrict a, const double* __restrict b, int64_t count,
+                       double* __restrict out) {
+  for (int64_t i = 0; i < count; ++i) {
+    double d2 = 0.0;
+    for (int c = 0; c < S; ++c) d2 += (b[S * i + c] - a[S * i + c]) * (b[S * i + c] - a[S * i + c]);
     out[i] = Increment<P>(d2);
   }
 }
@@ -87,50 +99,60 @@ inline double InverseLength(double length) {
   return length > 0.0 && std::isfinite(length) ? 1.0 / length : 0.0;
 }
 
-// One sweep over the points, a k-plane at a time, computes the increments of all three
-// directions:
+// One sweep over the points, row by row, computes the increments of all three directions:
 //  - i: each grid row is a whole line, normalised at once;
-//  - j: a k-plane holds whole j-lines, normalised after the plane;
-//  - k: lines span the block; their increments are kept until all lengths are known.
-// Memory beyond the input: two planes and the k-increments (a third of a 3D volume's input).
+//  - j: a k-plane holds whole j-lines; their increments wait for the end of the plane;
+//  - k: lines span the block; their increments wait for the end of the block.
+// Memory beyond the input: two rows, the j-increments of one plane and the k-increments of the
+// block (each a third of the input at most; the first for surfaces, the second for volumes).
 template <int S, Parametrization P>
 std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
   const Extents& n = block.extents();
   const int64_t ni = n[0], nj = n[1], nk = n[2], plane = ni * nj;
   std::array<LineAverage, 3> avg;
   for (int d = 0; d < 3; ++d) avg[d].sum.assign(n[d] - 1, 0.0);
-  std::vector<double> row(ni), plane_j(plane), length_j(ni), length_k(plane, 0.0);
-  std::vector<double> inc_k((nk - 1) * plane);
-  PlaneSoA<S> current, previous;
+  // Fully written before read: left uninitialised (no memset of a third of the input).
+  std::unique_ptr<double[]> plane_j(new double[(nj - 1) * ni]);
+  std::unique_ptr<double[]> inc_k(new double[(nk - 1) * plane]);
+  std::vector<double> inc_i(ni), length_j(ni), length_k(nk > 1 ? plane : 0, 0.0);
+  const double* coords = block.coords().data();
+  RowSoA<S> row, next;
   for (int64_t k = 0; k < nk; ++k) {
-    current.Load(block.coords().data() + S * plane * k, plane);
-    for (int64_t j = 0; j < nj && ni > 1; ++j) {
-      SegmentIncrements<S, P>(current, ni * j, current, ni * j + 1, ni - 1, row.data());
-      if (const double inv = InverseLength(Dot(row.data(), nullptr, ni - 1)); inv > 0.0) {
-        for (int64_t i = 0; i + 1 < ni; ++i) avg[0].sum[i] += row[i] * inv;
-        ++avg[0].lines;
+    const double* plane_k = coords + S * plane * k;
+    row.Load(plane_k, ni);
+    std::fill(length_j.begin(), length_j.end(), 0.0);
+    for (int64_t j = 0; j < nj; ++j) {
+      if (ni > 1) {
+        SegmentIncrements<S, P>(row, 0, row, 1, ni - 1, inc_i.data());
+        if (const double inv = InverseLength(Dot(inc_i.data(), nullptr, ni - 1)); inv > 0.0) {
+          for (int64_t i = 0; i + 1 < ni; ++i) avg[0].sum[i] += inc_i[i] * inv;
+          ++avg[0].lines;
+        }
       }
+      if (j + 1 < nj) {
+        next.Load(plane_k + S * ni * (j + 1), ni);
+        double* inc = plane_j.get() + ni * j;
+        SegmentIncrements<S, P>(row, 0, next, 0, ni, inc);
+        for (int64_t i = 0; i < ni; ++i) length_j[i] += inc[i];
+      }
+      if (k + 1 < nk) {
+        const double* p = plane_k + S * ni * j;
+        double* inc = inc_k.get() + plane * k + ni * j;
+        SegmentIncrements<S, P>(p, p + S * plane, ni, inc);
+        double* length = length_k.data() + ni * j;
+        for (int64_t i = 0; i < ni; ++i) length[i] += inc[i];
+      }
+      std::swap(row, next);
     }
     if (nj > 1) {
-      SegmentIncrements<S, P>(current, 0, current, ni, plane - ni, plane_j.data());
-      std::fill(length_j.begin(), length_j.end(), 0.0);
-      for (int64_t j = 0; j + 1 < nj; ++j) {
-        for (int64_t i = 0; i < ni; ++i) length_j[i] += plane_j[ni * j + i];
-      }
       for (double& len : length_j) {
         len = InverseLength(len);
         avg[1].lines += len > 0.0 ? 1 : 0;
       }
       for (int64_t j = 0; j + 1 < nj; ++j) {
-        avg[1].sum[j] += Dot(plane_j.data() + ni * j, length_j.data(), ni);
+        avg[1].sum[j] += Dot(plane_j.get() + ni * j, length_j.data(), ni);
       }
     }
-    if (k > 0) {
-      double* inc = inc_k.data() + plane * (k - 1);
-      SegmentIncrements<S, P>(previous, 0, current, 0, plane, inc);
-      for (int64_t x = 0; x < plane; ++x) length_k[x] += inc[x];
-    }
-    std::swap(current, previous);
   }
   if (nk > 1) {
     for (double& len : length_k) {
@@ -138,7 +160,7 @@ std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
       avg[2].lines += len > 0.0 ? 1 : 0;
     }
     for (int64_t k = 0; k + 1 < nk; ++k) {
-      avg[2].sum[k] = Dot(inc_k.data() + plane * k, length_k.data(), plane);
+      avg[2].sum[k] = Dot(inc_k.get() + plane * k, length_k.data(), plane);
     }
   }
   return avg;

@@ -94,6 +94,8 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
   std::vector<double> control;        // output of the last pass
   const double* in = block.coords().data();
   for (int d = 2; d >= 0; --d) {
+    // A direction with one point and one control is the identity: no pass, no copy.
+    if (m[d] == 1 && knots[d].num_controls() == 1 && d > 0) continue;
     int64_t a = s, b = 1;
     for (int e = 0; e < d; ++e) a *= cur[e];
     for (int e = d + 1; e < 3; ++e) b *= cur[e];
@@ -196,7 +198,6 @@ absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOpti
   const auto start = std::chrono::steady_clock::now();
   const Extents& m = block.extents();
   SG_RETURN_IF_ERROR(options.Validate(m));
-  SG_RETURN_IF_ERROR(ValidateFinite(block, "points"));
   const std::array<std::vector<double>, 3> params =
       ParametrizeBlock(block, options.parametrization);
   std::array<KnotVector, 3> knots;
@@ -211,7 +212,15 @@ absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOpti
   }
   const EndCondition ends =
       options.interpolate_ends ? EndCondition::kInterpolate : EndCondition::kFree;
-  SG_ASSIGN_OR_RETURN(TensorSpline spline, FitTensor(block, params, knots, ends, options.cancel));
+  // Non-finite points are found without a pass of their own: every point reaches some control
+  // point with a nonzero weight (A^+ e_r != 0 for a nonzero row r of A), and NaN or Inf
+  // survives the rotations, so the fitted net is non-finite exactly when a point is. Only then
+  // is the block scanned, for an error that names the point.
+  absl::StatusOr<TensorSpline> fit = FitTensor(block, params, knots, ends, options.cancel);
+  if (!fit.ok() && fit.status().code() == absl::StatusCode::kInvalidArgument) {
+    SG_RETURN_IF_ERROR(ValidateFinite(block, "points"));
+  }
+  SG_ASSIGN_OR_RETURN(TensorSpline spline, std::move(fit));
   SG_ASSIGN_OR_RETURN(Deviation deviation, MeasureDeviation(spline, params, block, options.cancel));
   SG_ASSIGN_OR_RETURN(PointDistribution distribution, PointDistribution::Create(params));
 

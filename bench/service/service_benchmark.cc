@@ -1,0 +1,269 @@
+// Service benchmarks over loopback TCP. The server runs in a child process pinned to CPU 0
+// (one server core: the worker pool has one thread), the client in this process on CPU 1.
+//   BM_EvaluateGridStream    payload bytes/s of EvaluateGrid for a volume of >= 50M points
+//   BM_EvaluatePointsUnary   one-point EvaluatePoints calls with 16 in flight: calls/s, p50/p99
+//   BM_FitThroughApi         FitGrid latency for every shared grid
+//   BM_IdleServerMemory      resident memory of a started, idle server
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sched.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "bench/grid_samples.h"
+#include "benchmark/benchmark.h"
+#include "client/client.h"
+#include "core/io/file_util.h"
+#include "core/io/planar_view.h"
+#include "core/io/plot3d.h"
+
+namespace splinegrid::bench {
+namespace {
+
+void PinToCpu(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  sched_setaffinity(0, sizeof(set), &set);
+}
+
+// A port that was free a moment ago.
+int FreePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t len = sizeof(addr);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return ntohs(addr.sin_port);
+}
+
+// The real `splinegrid serve` in a child process pinned to CPU 0 (exec'd, not just forked: gRPC
+// does not survive fork), on a free loopback port, with one worker thread.
+class ServerProcess {
+ public:
+  ServerProcess() : port_(FreePort()) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the benchmark
+      PinToCpu(0);
+      const std::string binary = SPLINEGRID_BINARY_DIR "/splinegrid";
+      const std::string address = absl::StrCat("--address=127.0.0.1:", port_);
+      execl(binary.c_str(), binary.c_str(), "serve", address.c_str(), "--threads=1",
+            "--log_calls=false", "--max_output_points=2147483648", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    PinToCpu(1);
+    auto client = client::Client::Connect(target());
+    for (int i = 0; i < 200 && !client->Health().ok(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+  }
+  ~ServerProcess() {
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+  std::string target() const { return absl::StrCat("127.0.0.1:", port_); }
+  // Resident memory of the server process, MiB.
+  double ResidentMiB() const {
+    std::ifstream status(absl::StrCat("/proc/", pid_, "/status"));
+    std::string line;
+    while (std::getline(status, line)) {
+      if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+    }
+    return -1;
+  }
+
+ private:
+  int port_;
+  pid_t pid_ = -1;
+};
+
+ServerProcess& SharedServer() {
+  static ServerProcess* server = new ServerProcess();
+  return *server;
+}
+
+std::string SharedData(const std::string& relative) {
+  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
+}
+
+void BM_IdleServerMemory(benchmark::State& state) {
+  ServerProcess server;  // fresh: nothing imported
+  auto client = client::Client::Connect(server.target());
+  if (!client->Health().ok()) return state.SkipWithError("server not healthy");
+  for (auto _ : state) benchmark::DoNotOptimize(server.ResidentMiB());
+  state.counters["resident_MiB"] = server.ResidentMiB();
+}
+BENCHMARK(BM_IdleServerMemory)->Iterations(1);
+
+// A 64^3 volume fitted with 24^3 control points, evaluated at 370^3 = 50.65M points.
+void BM_EvaluateGridStream(benchmark::State& state) {
+  const bool single = state.range(0) == 1;
+  auto client = client::Client::Connect(SharedServer().target());
+  static bool imported = false;
+  if (!imported) {
+    MultiBlockGrid grid;
+    grid.blocks.push_back(CurvilinearBlock({64, 64, 64}));
+    if (!client->ImportPoints(grid, "volume", "").ok()) return state.SkipWithError("import");
+    v1::FitSpec spec;
+    spec.mutable_control_counts()->set_i(24);
+    spec.mutable_control_counts()->set_j(24);
+    spec.mutable_control_counts()->set_k(24);
+    if (!client->Fit("volume", spec).ok()) return state.SkipWithError("fit");
+    imported = true;
+  }
+  v1::EvaluateGridRequest request;
+  request.set_name("grids/volume");
+  request.mutable_counts()->set_i(370);
+  request.mutable_counts()->set_j(370);
+  request.mutable_counts()->set_k(370);
+  request.set_precision(single ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
+  int64_t bytes = 0, points = 0;
+  for (auto _ : state) {
+    grpc::ClientContext context;
+    auto reader = client->stub().EvaluateGrid(&context, request);
+    v1::EvaluateGridResponse message;
+    while (reader->Read(&message)) {
+      if (message.has_header()) {
+        points += message.header().total_points();
+        continue;
+      }
+      bytes += message.chunk().values_size() * 8 + message.chunk().float_values_size() * 4;
+    }
+    if (!reader->Finish().ok()) return state.SkipWithError("EvaluateGrid failed");
+  }
+  state.SetBytesProcessed(bytes);
+  state.SetItemsProcessed(points);
+}
+BENCHMARK(BM_EvaluateGridStream)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("float")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+
+// One-point EvaluatePoints calls, 16 in flight (callback API), latencies recorded per call.
+void BM_EvaluatePointsUnary(benchmark::State& state) {
+  constexpr int kInFlight = 16;
+  auto client = client::Client::Connect(SharedServer().target());
+  static bool imported = false;
+  if (!imported) {
+    const std::string bytes = ReadFileToString(SharedData("surfaces/m6_small.fmt")).value();
+    if (absl::Status s = client->ImportPlot3d(bytes, "m6", "", false).status(); !s.ok()) {
+      return state.SkipWithError(s.ToString().c_str());
+    }
+    v1::FitSpec spec;
+    spec.set_tolerance(1e-4);
+    if (!client->Fit("m6", spec).ok()) return state.SkipWithError("fit");
+    imported = true;
+  }
+  v1::EvaluatePointsRequest request;
+  request.set_name("grids/m6");
+  request.add_blocks(1);
+  request.add_parameters(0.3);
+  request.add_parameters(0.7);
+  request.add_parameters(0.0);
+  const int64_t calls = state.range(0);
+  std::vector<double> latencies;
+  latencies.reserve(calls);
+  std::mutex mu;
+  std::condition_variable done_cv;
+  int64_t started = 0, finished = 0;
+  std::atomic<int64_t> failures{0};
+  struct Call {
+    grpc::ClientContext context;
+    v1::EvaluatePointsResponse response;
+    std::chrono::steady_clock::time_point start;
+  };
+  std::function<void()> launch = [&] {
+    auto* call = new Call();
+    call->start = std::chrono::steady_clock::now();
+    client->stub().async()->EvaluatePoints(
+        &call->context, &request, &call->response, [&, call](grpc::Status status) {
+          const double us = std::chrono::duration<double, std::micro>(
+                                std::chrono::steady_clock::now() - call->start)
+                                .count();
+          delete call;
+          if (!status.ok()) ++failures;
+          bool more;
+          {
+            std::lock_guard<std::mutex> lock(mu);
+            latencies.push_back(us);
+            ++finished;
+            more = started < calls;
+            if (more) ++started;
+          }
+          if (more) {
+            launch();
+          } else {
+            done_cv.notify_all();
+          }
+        });
+  };
+  for (auto _ : state) {
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      started = std::min<int64_t>(kInFlight, calls);
+    }
+    for (int i = 0; i < std::min<int64_t>(kInFlight, calls); ++i) launch();
+    std::unique_lock<std::mutex> lock(mu);
+    done_cv.wait(lock, [&] { return finished == calls; });
+  }
+  if (failures > 0) return state.SkipWithError("some calls failed");
+  std::sort(latencies.begin(), latencies.end());
+  state.SetItemsProcessed(calls);
+  state.counters["p50_us"] = latencies[latencies.size() / 2];
+  state.counters["p99_us"] = latencies[latencies.size() * 99 / 100];
+}
+BENCHMARK(BM_EvaluatePointsUnary)
+    ->Arg(200000)
+    ->ArgName("calls")
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+// FitGrid latency through the API for each shared grid (tolerance 1e-3 in the file's unit).
+void BM_FitThroughApi(benchmark::State& state) {
+  static const std::vector<std::string> kFiles = {
+      "grids/n0012_113-33.p2dfmt",     "grids/n0012_225-65.p2dfmt", "grids/rae2822_257x97.fmt",
+      "grids/n0012_pitch_257x129.fmt", "surfaces/m6_small.fmt",     "surfaces/even_sphere.fmt",
+      "surfaces/ffd_box_6x2x6.fmt"};
+  const std::string& file = kFiles[state.range(0)];
+  state.SetLabel(file);
+  auto client = client::Client::Connect(SharedServer().target());
+  const std::string bytes = ReadFileToString(SharedData(file)).value();
+  const bool planar = IsTwoPlaneGrid(ParsePlot3d(bytes, file).value());
+  const std::string id = absl::StrCat("fit-", state.range(0));
+  (void)client->Delete(id);
+  if (!client->ImportPlot3d(bytes, id, file, planar).ok()) return state.SkipWithError("import");
+  v1::FitSpec spec;
+  spec.set_tolerance(1e-3);
+  double ratio = 0.0;
+  for (auto _ : state) {
+    absl::StatusOr<v1::FitGridResponse> fit = client->Fit(id, spec);
+    if (!fit.ok()) return state.SkipWithError(std::string(fit.status().message()).c_str());
+    ratio = fit->compression_ratio();
+  }
+  state.counters["compression"] = ratio;
+}
+BENCHMARK(BM_FitThroughApi)->DenseRange(0, 6)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace splinegrid::bench

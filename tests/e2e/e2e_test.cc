@@ -1,0 +1,199 @@
+// End to end: the real `splinegrid serve` on a free loopback port, driven by the CLI and by the
+// Python example, then stopped with SIGTERM (exit code 0, one log line per call).
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/plot3d.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace splinegrid::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::string kBinary = SPLINEGRID_BINARY_DIR "/splinegrid";
+const std::string kSource = SPLINEGRID_SOURCE_DIR;
+
+std::string SharedData(const std::string& relative) {
+  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA"))
+    return std::string(dir) + "/" + relative;
+  return kSource + "/../shared/data/" + relative;
+}
+
+// A port that was free a moment ago (bind to port 0, read it back, close).
+int FreePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t len = sizeof(addr);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return ntohs(addr.sin_port);
+}
+
+struct Result {
+  int exit_code;
+  std::string out;  // stdout and stderr
+};
+
+// Runs a shell command and collects its output and exit code.
+Result RunCommand(const std::string& command) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class EndToEndTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    port_ = FreePort();
+    dir_ = std::filesystem::temp_directory_path() / absl::StrCat("splinegrid-e2e-", getpid());
+    std::filesystem::create_directories(dir_);
+    log_ = (dir_ / "server.log").string();
+    server_ = fork();
+    if (server_ == 0) {
+      freopen(log_.c_str(), "w", stderr);
+      const std::string address = absl::StrCat("--address=127.0.0.1:", port_);
+      execl(kBinary.c_str(), kBinary.c_str(), "serve", address.c_str(), "--threads=2",
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    for (int i = 0; i < 100; ++i) {
+      if (Cli("health").exit_code == 0) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    FAIL() << "the server did not become healthy:\n" << ReadLog();
+  }
+
+  void TearDown() override {
+    if (server_ > 0 && !stopped_) EXPECT_EQ(Stop(), 0) << ReadLog();
+    std::filesystem::remove_all(dir_);
+  }
+
+  // SIGTERM and the server's exit code.
+  int Stop() {
+    stopped_ = true;
+    kill(server_, SIGTERM);
+    int status = 0;
+    waitpid(server_, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  Result Cli(const std::string& args) {
+    return RunCommand(absl::StrCat(kBinary, " ", args, " --server=127.0.0.1:", port_));
+  }
+
+  std::string ReadLog() const {
+    std::ifstream in(log_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
+  int port_ = 0;
+  pid_t server_ = -1;
+  bool stopped_ = false;
+  std::filesystem::path dir_;
+  std::string log_;
+};
+
+TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
+  const Result fit = Cli(
+      absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=naca --ctl=40,16"));
+  ASSERT_EQ(fit.exit_code, 0) << fit.out;
+  EXPECT_THAT(fit.out, HasSubstr("grids/naca revision 1: 3729 points -> 640 control points"));
+
+  const Result tol = Cli(absl::StrCat("fit ", SharedData("grids/rae2822_257x97.fmt"),
+                                      " --name=rae --tol=1e-3 --json"));
+  ASSERT_EQ(tol.exit_code, 0) << tol.out;
+  EXPECT_THAT(tol.out, HasSubstr("\"tolerance_met\": true"));
+
+  const Result list = Cli("list");
+  ASSERT_EQ(list.exit_code, 0) << list.out;
+  EXPECT_THAT(list.out, HasSubstr("grids/naca"));
+  EXPECT_THAT(list.out, HasSubstr("grids/rae"));
+
+  const Result get = Cli("get naca --json");
+  ASSERT_EQ(get.exit_code, 0) << get.out;
+  EXPECT_THAT(get.out, HasSubstr("\"latest_revision\": \"1\""));
+
+  const std::string vts = (dir_ / "naca.vts").string();
+  const Result eval = Cli(absl::StrCat("eval naca --level=2 -o ", vts));
+  ASSERT_EQ(eval.exit_code, 0) << eval.out;
+  std::ifstream in(vts);
+  std::string head(400, '\0');
+  in.read(head.data(), head.size());
+  EXPECT_THAT(head, HasSubstr("WholeExtent=\"0 448 0 128 0 0\""));
+
+  const std::string xyz = (dir_ / "rae.xyz").string();
+  ASSERT_EQ(Cli(absl::StrCat("eval rae --res=300,50 -o ", xyz)).exit_code, 0);
+  const MultiBlockGrid back = ReadPlot3dFile(xyz).value();
+  EXPECT_EQ(back.blocks[0].extents(), (Extents{300, 50, 1}));
+
+  const std::string vtm = (dir_ / "both.vtm").string();
+  ASSERT_EQ(Cli(absl::StrCat("eval rae --level=0 --derivs -o ", vtm)).exit_code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "both" / "both_0.vts"));
+
+  EXPECT_EQ(Cli("rm naca").exit_code, 0);
+  const Result gone = Cli("get naca");
+  EXPECT_EQ(gone.exit_code, 1);
+  EXPECT_THAT(gone.out, HasSubstr("NOT_FOUND"));
+}
+
+TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
+  const Result missing = Cli("fit /nonexistent/grid.x");
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_THAT(missing.out, HasSubstr("/nonexistent/grid.x"));
+  const Result unknown = Cli(absl::StrCat("eval nope --level=0 -o ", (dir_ / "x.vts").string()));
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_THAT(unknown.out, HasSubstr("NOT_FOUND"));
+  const Result usage = Cli("eval nope");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_THAT(usage.out, HasSubstr("usage"));
+}
+
+TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
+  const Result python = RunCommand(
+      absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
+                   "/python/examples/fit_and_refine.py --server=127.0.0.1:", port_));
+  ASSERT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("(1, 257, 897, 2)"));  // level 2 of the 225 x 65 grid
+}
+
+TEST_F(EndToEndTest, SigtermDrainsAndExitsZeroWithOneLogLinePerCall) {
+  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedData("surfaces/m6_small.fmt"), " --name=m6 --ctl=8,8"))
+                .exit_code,
+            0);
+  EXPECT_EQ(Cli("health").exit_code, 0);
+  EXPECT_EQ(Stop(), 0);
+  const std::string log = ReadLog();
+  EXPECT_THAT(log, HasSubstr("ImportGrid grids/m6 OK"));
+  EXPECT_THAT(log, HasSubstr("FitGrid grids/m6 OK"));
+  EXPECT_THAT(log, HasSubstr("SIGTERM received"));
+  EXPECT_THAT(log, HasSubstr("stopped"));
+  // After the stop nothing answers.
+  EXPECT_NE(Cli("health --timeout=2s").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace splinegrid::testing
