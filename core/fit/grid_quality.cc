@@ -1,0 +1,403 @@
+#include "core/fit/grid_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/grid/sampling.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// A cell is skipped when |measure| <= kDegenerateRelTol * the block's median |measure| ...
+constexpr double kDegenerateRelTol = 1e-12;
+// ... or when one of its edges is at most kCollapsedEdgeRelTol * its longest edge.
+constexpr double kCollapsedEdgeRelTol = 1e-9;
+
+enum class CellKind { kPlanar, kSurface, kVolume };
+
+// Doubles per point and per measure: planar (2, 1), surface (3, 3), volume (3, 1).
+template <CellKind K>
+constexpr int kStride = K == CellKind::kPlanar ? 2 : 3;
+template <CellKind K>
+constexpr int kWidth = K == CellKind::kSurface ? 3 : 1;
+template <CellKind K>
+constexpr int kCorners = K == CellKind::kVolume ? 8 : 4;
+
+// Corner pointers of a cell in binary order.
+using Corners = std::array<const double*, 8>;
+
+void Cross(const double* a, const double* b, double* out) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+template <int S>
+void Diff(const double* a, const double* b, double* out) {
+  for (int c = 0; c < S; ++c) out[c] = a[c] - b[c];
+}
+
+// Signed volume of the trilinear hexahedron (see the header): the 6-tetrahedra volume around the
+// diagonal x0-x7 (Grandy's formula) plus, per face, half the tetrahedron between that face's two
+// triangulations.
+double HexVolume(const Corners& x) {
+  double d70[3], d10[3], d35[3], d40[3], d56[3], d20[3], d63[3];
+  Diff<3>(x[7], x[0], d70);
+  Diff<3>(x[1], x[0], d10);
+  Diff<3>(x[3], x[5], d35);
+  Diff<3>(x[4], x[0], d40);
+  Diff<3>(x[5], x[6], d56);
+  Diff<3>(x[2], x[0], d20);
+  Diff<3>(x[6], x[3], d63);
+  double c1[3], c2[3], c3[3];
+  Cross(d10, d35, c1);
+  Cross(d40, d56, c2);
+  Cross(d20, d63, c3);
+  double six_tets = 0.0;
+  for (int c = 0; c < 3; ++c) six_tets += d70[c] * (c1[c] + c2[c] + c3[c]);
+  // Faces a b c d in outward cyclic order, a-c the diagonal the six tetrahedra use.
+  static constexpr int kFaces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 4, 6, 2},
+                                       {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}};
+  double warp = 0.0;
+  for (const auto& f : kFaces) {
+    double ab[3], ac[3], ad[3], n[3];
+    Diff<3>(x[f[1]], x[f[0]], ab);
+    Diff<3>(x[f[2]], x[f[0]], ac);
+    Diff<3>(x[f[3]], x[f[0]], ad);
+    Cross(ac, ad, n);
+    warp += ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
+  }
+  return six_tets / 6.0 + warp / 12.0;
+}
+
+// The signed measure of a cell (kWidth<K> doubles).
+template <CellKind K>
+void Measure(const Corners& x, double* m) {
+  if constexpr (K == CellKind::kVolume) {
+    m[0] = HexVolume(x);
+  } else {
+    double d1[kStride<K>], d2[kStride<K>];
+    Diff<kStride<K>>(x[3], x[0], d1);
+    Diff<kStride<K>>(x[2], x[1], d2);
+    if constexpr (K == CellKind::kPlanar) {
+      m[0] = 0.5 * (d1[0] * d2[1] - d1[1] * d2[0]);
+    } else {
+      Cross(d1, d2, m);
+      for (int c = 0; c < 3; ++c) m[c] *= 0.5;
+    }
+  }
+}
+
+// Whether an edge of the cell is at most kCollapsedEdgeRelTol times its longest edge.
+template <CellKind K>
+bool HasCollapsedEdge(const Corners& x) {
+  double shortest = std::numeric_limits<double>::infinity(), longest = 0.0;
+  for (int a = 0; a < kCorners<K>; ++a) {
+    for (int bit = 1; bit < kCorners<K>; bit <<= 1) {
+      if (a & bit) continue;  // every edge once, from its lower corner
+      double d[kStride<K>];
+      Diff<kStride<K>>(x[a | bit], x[a], d);
+      double length2 = 0.0;
+      for (double v : d) length2 += v * v;
+      shortest = std::min(shortest, length2);
+      longest = std::max(longest, length2);
+    }
+  }
+  return shortest <= kCollapsedEdgeRelTol * kCollapsedEdgeRelTol * longest;
+}
+
+// The cells of a block (or refined block) as rows of its slowest active direction.
+struct RowLayout {
+  int fast_points = 1;        // points per row in the fastest active direction
+  int mid_points = 1;         // ... in the middle active direction (volumes; else 1)
+  int rows = 1;               // points in the slowest active direction
+  int64_t row_points = 1;     // fast_points * mid_points, contiguous in the block's order
+  int64_t lines_per_row = 1;  // GridEvaluator lines per row
+};
+
+RowLayout MakeLayout(const Extents& points, const std::array<int, 3>& active, int num_active) {
+  RowLayout layout;
+  layout.fast_points = points[active[0]];
+  if (num_active == 3) layout.mid_points = points[active[1]];
+  const int slowest = active[num_active - 1];
+  layout.rows = points[slowest];
+  layout.row_points = int64_t{layout.fast_points} * layout.mid_points;
+  // Rows along k span all j lines of a plane (one line when j is inactive); rows along j
+  // (k inactive) are single lines.
+  layout.lines_per_row = slowest == 2 ? points[1] : 1;
+  return layout;
+}
+
+// Calls f(I, J, corners) for every cell between rows `lo` and `hi` (J = 0 for surfaces).
+template <CellKind K, typename F>
+void ForEachCell(const double* lo, const double* hi, const RowLayout& layout, F&& f) {
+  constexpr int s = kStride<K>;
+  const int64_t n0 = layout.fast_points;
+  const int mid_cells = K == CellKind::kVolume ? layout.mid_points - 1 : 1;
+  Corners x{};
+  for (int J = 0; J < mid_cells; ++J) {
+    for (int I = 0; I + 1 < n0; ++I) {
+      const int64_t c = s * (I + n0 * J);
+      x[0] = lo + c;
+      x[1] = lo + c + s;
+      if constexpr (K == CellKind::kVolume) {
+        x[2] = lo + c + s * n0;
+        x[3] = x[2] + s;
+        x[4] = hi + c;
+        x[5] = hi + c + s;
+        x[6] = hi + c + s * n0;
+        x[7] = x[6] + s;
+      } else {
+        x[2] = hi + c;
+        x[3] = hi + c + s;
+      }
+      f(I, J, x);
+    }
+  }
+}
+
+enum CellState : uint8_t { kChecked = 0, kSkipped = 1, kBad = 2 };
+
+// Per original cell: weights w with ratio = <measure_fitted, w> / share, and its state.
+struct Reference {
+  std::vector<double> weight;  // kWidth doubles per cell
+  std::vector<uint8_t> state;
+  int fast_cells = 0, mid_cells = 1;
+};
+
+template <CellKind K>
+Reference BuildReference(const StructuredBlock& original, const RowLayout& layout) {
+  constexpr int width = kWidth<K>;
+  Reference ref;
+  ref.fast_cells = layout.fast_points - 1;
+  ref.mid_cells = K == CellKind::kVolume ? layout.mid_points - 1 : 1;
+  const int64_t cells = int64_t{ref.fast_cells} * ref.mid_cells * (layout.rows - 1);
+  ref.weight.resize(width * cells);
+  ref.state.assign(cells, kChecked);
+  std::vector<double> size(cells);
+  const double* coords = original.coords().data();
+  const int64_t row_size = kStride<K> * layout.row_points;
+  int64_t cell = 0;
+  for (int r = 0; r + 1 < layout.rows; ++r) {
+    const double* lo = coords + r * row_size;
+    ForEachCell<K>(lo, lo + row_size, layout, [&](int, int, const Corners& x) {
+      double* m = ref.weight.data() + width * cell;
+      Measure<K>(x, m);
+      double norm2 = 0.0;
+      for (int c = 0; c < width; ++c) norm2 += m[c] * m[c];
+      size[cell] = std::sqrt(norm2);
+      if (HasCollapsedEdge<K>(x)) ref.state[cell] = kSkipped;
+      ++cell;
+    });
+  }
+  std::vector<double> sorted = size;
+  std::nth_element(sorted.begin(), sorted.begin() + cells / 2, sorted.end());
+  const double threshold = kDegenerateRelTol * sorted[cells / 2];
+  for (int64_t q = 0; q < cells; ++q) {
+    double* w = ref.weight.data() + width * q;
+    const double norm2 = size[q] * size[q];
+    if (size[q] <= threshold || !(1.0 / norm2 < std::numeric_limits<double>::infinity())) {
+      ref.state[q] = kSkipped;
+    }
+    // w = m / |m|^2: 1 / m for one component, a / |a|^2 for area vectors.
+    for (int c = 0; c < width; ++c) w[c] = ref.state[q] == kSkipped ? 0.0 : w[c] / norm2;
+  }
+  return ref;
+}
+
+template <CellKind K>
+absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlock& original,
+                                  const std::array<int, 3>& active, int num_active,
+                                  const CellQualityOptions& options) {
+  constexpr int width = kWidth<K>;
+  Reference ref = BuildReference<K>(original, MakeLayout(original.extents(), active, num_active));
+  const double low = 1.0 / options.max_size_ratio, high = options.max_size_ratio;
+  const Extents controls = fitted.spline.control_extents();
+  const int fast = active[0];
+  CellQuality q;
+  int64_t worst_parent = 0;
+  for (int level = 0; level <= options.max_level; ++level) {
+    Resolution resolution;
+    resolution.level = level;
+    SG_ASSIGN_OR_RETURN(const auto params, SampleParameters(fitted.distribution, resolution));
+    // The share of its parent each refined interval gets: 1 / (du_sub / du_parent) per active
+    // direction (a = 0 fast, 1 mid for volumes, num_active - 1 slow).
+    std::array<std::vector<double>, 3> inverse_share;
+    for (int a = 0; a < num_active; ++a) {
+      const std::vector<double>& sub = params[active[a]];
+      const std::vector<double>& u = fitted.distribution.params(active[a]);
+      inverse_share[a].resize(sub.size() - 1);
+      for (size_t I = 0; I + 1 < sub.size(); ++I) {
+        const size_t p = I >> level;
+        inverse_share[a][I] = (u[p + 1] - u[p]) / (sub[I + 1] - sub[I]);
+      }
+    }
+    const std::vector<double>& slow_share = inverse_share[num_active - 1];
+    // Chunks of the fast direction, overlapping by one point: GridEvaluator holds the control
+    // net contracted in u, kStride * (chunk points) * n_v * n_w doubles, which the budget bounds
+    // (i fast only; otherwise that net is the control net itself).
+    const int fast_points = static_cast<int>(params[fast].size());
+    int chunk = fast_points;
+    if (fast == 0) {
+      const int64_t per_point = int64_t{kStride<K>} * controls[1] * controls[2];
+      chunk = static_cast<int>(
+          std::clamp<int64_t>(options.evaluator_budget / per_point, 2, fast_points));
+    }
+    std::array<std::vector<double>, 3> part = params;
+    for (int first = 0; first + 1 < fast_points; first += chunk - 1) {
+      const int last = std::min(fast_points - 1, first + chunk - 1);
+      part[fast].assign(params[fast].begin() + first, params[fast].begin() + last + 1);
+      GridEvaluator evaluator(fitted.spline, part, /*first_derivatives=*/false);
+      const RowLayout layout = MakeLayout(evaluator.extents(), active, num_active);
+      const int64_t row_size = kStride<K> * layout.row_points;
+      std::vector<double> lo(row_size), hi(row_size);
+      evaluator.EvaluateLines(0, layout.lines_per_row, lo.data());
+      for (int r = 0; r + 1 < layout.rows; ++r) {
+        SG_RETURN_IF_ERROR(PollCancel(options.cancel));
+        evaluator.EvaluateLines((r + 1) * layout.lines_per_row, (r + 2) * layout.lines_per_row,
+                                hi.data());
+        const int64_t parent_row = int64_t{ref.fast_cells} * ref.mid_cells * (r >> level);
+        ForEachCell<K>(lo.data(), hi.data(), layout, [&](int I, int J, const Corners& x) {
+          const int64_t parent =
+              parent_row + ((first + I) >> level) + int64_t{ref.fast_cells} * (J >> level);
+          uint8_t& state = ref.state[parent];
+          if (state == kSkipped) {
+            ++q.cells_skipped;
+            return;
+          }
+          double m[width];
+          Measure<K>(x, m);
+          const double* w = ref.weight.data() + width * parent;
+          double ratio = 0.0;
+          for (int c = 0; c < width; ++c) ratio += m[c] * w[c];
+          ratio *= inverse_share[0][first + I] * slow_share[r];
+          if constexpr (K == CellKind::kVolume) ratio *= inverse_share[1][J];
+          ++q.cells_checked;
+          if (ratio < q.min_ratio) {
+            q.min_ratio = ratio;
+            q.worst_level = level;
+            worst_parent = parent;
+          }
+          q.max_ratio = std::max(q.max_ratio, std::abs(ratio));
+          if (ratio <= 0.0) {
+            ++q.folded;
+            state = kBad;
+          } else if (ratio < low || ratio > high) {
+            ++q.out_of_size;
+            state = kBad;
+          }
+        });
+        std::swap(lo, hi);
+      }
+    }
+  }
+  // Parent index -> original-grid cell (lower corner).
+  auto to_cell = [&](int64_t parent) {
+    Extents cell = {0, 0, 0};
+    const int64_t per_row = int64_t{ref.fast_cells} * ref.mid_cells;
+    cell[active[0]] = static_cast<int>(parent % ref.fast_cells);
+    if (num_active == 3) {
+      cell[active[1]] = static_cast<int>(parent / ref.fast_cells % ref.mid_cells);
+    }
+    cell[active[num_active - 1]] = static_cast<int>(parent / per_row);
+    return cell;
+  };
+  if (q.cells_checked > 0) q.worst_cell = to_cell(worst_parent);
+  for (int64_t parent = 0; parent < static_cast<int64_t>(ref.state.size()); ++parent) {
+    if (ref.state[parent] != kBad) continue;
+    ++q.num_bad_cells;
+    if (static_cast<int64_t>(q.bad_cells.size()) < options.max_reported_cells) {
+      q.bad_cells.push_back(to_cell(parent));
+    }
+  }
+  return q;
+}
+
+std::string ExtentsString(const Extents& e) { return absl::StrCat(e[0], " x ", e[1], " x ", e[2]); }
+
+}  // namespace
+
+absl::Status CellQualityOptions::Validate() const {
+  if (max_level < 0 || max_level > kMaxRefinementLevel) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_level = ", max_level, " is not in [0, ", kMaxRefinementLevel, "]"));
+  }
+  if (!(max_size_ratio >= 1.0 && std::isfinite(max_size_ratio))) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_size_ratio = ", max_size_ratio, " is not a finite number >= 1"));
+  }
+  if (max_reported_cells < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_reported_cells = ", max_reported_cells, " is negative"));
+  }
+  if (evaluator_budget < 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("evaluator_budget = ", evaluator_budget, " is not positive"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
+                                             const StructuredBlock& original,
+                                             const CellQualityOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  Extents fitted_extents;
+  for (int d = 0; d < 3; ++d) fitted_extents[d] = fitted.distribution.num_points(d);
+  if (fitted_extents != original.extents()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("fitted block has extents ", ExtentsString(fitted_extents),
+                     " but the original block has ", ExtentsString(original.extents())));
+  }
+  if (fitted.spline.spatial_dim() != original.spatial_dim()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("fitted block has spatial_dim ", fitted.spline.spatial_dim(),
+                     " but the original block has spatial_dim ", original.spatial_dim()));
+  }
+  SG_RETURN_IF_ERROR(ValidateFinite(original, "original block"));
+  std::array<int, 3> active = {0, 0, 0};
+  int num_active = 0;
+  for (int d = 0; d < 3; ++d) {
+    if (original.extent(d) > 1) active[num_active++] = d;
+  }
+  if (num_active < 2) return CellQuality{};  // points and curves have no cells
+  if (num_active == 3) {
+    if (original.spatial_dim() != 3) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("block of ", ExtentsString(original.extents()),
+                       " points has three active directions but spatial_dim 2; volumes need 3"));
+    }
+    return Check<CellKind::kVolume>(fitted, original, active, num_active, options);
+  }
+  if (original.spatial_dim() == 2) {
+    return Check<CellKind::kPlanar>(fitted, original, active, num_active, options);
+  }
+  return Check<CellKind::kSurface>(fitted, original, active, num_active, options);
+}
+
+double PlanarCellArea(const std::array<Point3, 4>& corners) {
+  const Corners x = {corners[0].data(), corners[1].data(), corners[2].data(), corners[3].data()};
+  double m;
+  Measure<CellKind::kPlanar>(x, &m);
+  return m;
+}
+
+Point3 CellAreaVector(const std::array<Point3, 4>& corners) {
+  const Corners x = {corners[0].data(), corners[1].data(), corners[2].data(), corners[3].data()};
+  Point3 a;
+  Measure<CellKind::kSurface>(x, a.data());
+  return a;
+}
+
+double HexahedronVolume(const std::array<Point3, 8>& corners) {
+  Corners x;
+  for (int n = 0; n < 8; ++n) x[n] = corners[n].data();
+  return HexVolume(x);
+}
+
+}  // namespace splinegrid
