@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
+#include "core/fit/fairing.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -44,6 +45,10 @@ absl::Status FitOptions::Validate(const Extents& points) const {
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
   }
+  if (!(fairing >= 0.0) || !std::isfinite(fairing)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("fairing = ", fairing, " is not a finite number >= 0"));
+  }
   for (int d = 0; d < 3; ++d) {
     const int n = control_counts[d];
     if (points[d] == 1) {
@@ -67,7 +72,8 @@ absl::Status FitOptions::Validate(const Extents& points) const {
 absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
                                        const std::array<std::vector<double>, 3>& params,
                                        const std::array<KnotVector, 3>& knots, EndCondition ends,
-                                       const CancelCheck& cancel, const DirectionPins& pins) {
+                                       const CancelCheck& cancel, const DirectionPins& pins,
+                                       double fairing) {
   const Extents& m = block.extents();
   std::vector<DirectionFit> fits;
   fits.reserve(3);
@@ -76,7 +82,9 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
       return absl::InvalidArgumentError(absl::StrCat("direction ", d, ": ", params[d].size(),
                                                      " parameters for ", m[d], " points"));
     }
-    absl::StatusOr<DirectionFit> fit = DirectionFit::Create(knots[d], params[d], ends, pins[d]);
+    const std::vector<PenaltyRow> penalties = JumpPenaltyRows(knots[d], params[d], fairing);
+    absl::StatusOr<DirectionFit> fit =
+        DirectionFit::Create(knots[d], params[d], ends, pins[d], penalties);
     if (!fit.ok()) {
       return absl::Status(fit.status().code(),
                           absl::StrCat("direction ", std::string(1, kDirectionNames[d]), ": ",
@@ -216,7 +224,8 @@ absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOpti
   // point with a nonzero weight (A^+ e_r != 0 for a nonzero row r of A), and NaN or Inf
   // survives the rotations, so the fitted net is non-finite exactly when a point is. Only then
   // is the block scanned, for an error that names the point.
-  absl::StatusOr<TensorSpline> fit = FitTensor(block, params, knots, ends, options.cancel);
+  absl::StatusOr<TensorSpline> fit =
+      FitTensor(block, params, knots, ends, options.cancel, {}, options.fairing);
   if (!fit.ok() && fit.status().code() == absl::StatusCode::kInvalidArgument) {
     SG_RETURN_IF_ERROR(ValidateFinite(block, "points"));
   }

@@ -41,6 +41,8 @@ struct FitOptions {
   // Fix the end controls of every direction to the data (corners exact, boundaries from the
   // boundary data alone); see the file comment.
   bool interpolate_ends = true;
+  // Fairing weight lambda >= 0 (fairing.h); 0: plain least squares.
+  double fairing = 0.0;
   // Polled between work units; a fired check ends the fit with CANCELLED.
   CancelCheck cancel;
 
@@ -83,12 +85,14 @@ absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOpti
 using DirectionPins = std::array<std::vector<Pin>, 3>;
 
 // The tensor least-squares solve with given parameters and knot vectors (one of each per
-// direction; a direction with one point has params {0} and the default KnotVector).
+// direction; a direction with one point has params {0} and the default KnotVector). With
+// `fairing` = lambda > 0 every direction's fit also penalises the jumps of the highest
+// derivative at its simple knots (fairing.h).
 absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
                                        const std::array<std::vector<double>, 3>& params,
                                        const std::array<KnotVector, 3>& knots, EndCondition ends,
                                        const CancelCheck& cancel = {},
-                                       const DirectionPins& pins = {});
+                                       const DirectionPins& pins = {}, double fairing = 0.0);
 
 // Distances between `spline` evaluated at `params` and the points of `block` (same extents);
 // with `tolerance` (one positive value per point, point order) also the largest ratio of
