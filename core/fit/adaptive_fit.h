@@ -1,8 +1,8 @@
-// Least-squares fit to a tolerance with adaptively placed knots.
+// Least-squares fit of one block to a tolerance with adaptively placed knots.
 //
 // Starts from a single polynomial piece per direction and inserts knots where the fit is not
 // good enough, until every point is within its own tolerance (or a control-point cap stops it),
-// then removes knots that turn out unnecessary.
+// then removes knots that turn out unnecessary (adaptive_engine.h).
 //
 // Which direction needs knots: the tensor fit's error splits by direction,
 //   I - P_w P_v P_u = (I - P_u) + P_u (I - P_v) + P_u P_v (I - P_w),
@@ -13,11 +13,9 @@
 // but the combined fit still is, the shares shrink. The worst grid line thus drives the knots of
 // each direction (a span is refined if any line through it needs it).
 //
-// Feature points (kinks such as a C-grid's trailing edge on its wake cut) get a knot of
-// multiplicity order - 1 and a pinned control, so the fit passes through them exactly and each
-// side is smooth on its own: a kink is where the turning angle between consecutive segments of a
-// grid line is at least feature_angle_degrees, or at least feature_spike_degrees and
-// feature_spike_ratio times the turning at both neighbouring points of that line.
+// Feature points (kinks such as a C-grid's trailing edge on its wake cut, see refinement.h) get
+// a knot of multiplicity order - 1 and a pinned control, so the fit passes through them exactly
+// and each side is smooth on its own.
 #ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_FIT_H_
 #define SPLINEGRID_CORE_FIT_ADAPTIVE_FIT_H_
 
@@ -26,6 +24,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/fit/refinement.h"
 #include "core/fit/tensor_fit.h"
 
 namespace splinegrid {
@@ -41,11 +40,8 @@ struct ToleranceFitOptions {
   // After the tolerance is met, try to drop knots one by one and keep each removal that still
   // meets it (cost: one tensor fit per knot).
   bool remove_unneeded_knots = true;
-  // Kink detection (see the file comment); detect_features = false treats every line as smooth.
-  bool detect_features = true;
-  double feature_angle_degrees = 30.0;
-  double feature_spike_degrees = 4.0;
-  double feature_spike_ratio = 4.0;
+  // Kink detection (refinement.h); features.detect = false treats every line as smooth.
+  FeatureOptions features;
   CancelCheck cancel;
 };
 

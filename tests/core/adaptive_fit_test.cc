@@ -156,7 +156,7 @@ TEST(FitToToleranceTest, KinkIsAFeatureAndIsMetWithFewControls) {
 TEST(FitToToleranceTest, KinkWithoutFeatureDetectionNeedsManyMoreControls) {
   const StructuredBlock block = KinkedCurve();
   ToleranceFitOptions options;
-  options.detect_features = false;
+  options.features.detect = false;
   const absl::StatusOr<ToleranceFitResult> plain = Fit(block, 1e-5, options);
   // Not meeting a tolerance is not an error (adaptive_fit.h): a result must come back.
   ASSERT_TRUE(plain.ok()) << plain.status();
@@ -176,7 +176,7 @@ TEST(FitToToleranceTest, NoisyDataUnderACapIsReportedUnmet) {
     SCOPED_TRACE(detect_features ? "with feature detection" : "without feature detection");
     ToleranceFitOptions options;
     options.max_controls_per_direction = 12;
-    options.detect_features = detect_features;
+    options.features.detect = detect_features;
     const auto start = std::chrono::steady_clock::now();
     const absl::StatusOr<ToleranceFitResult> result = Fit(block, 1e-5, options);
     const double seconds =
@@ -282,7 +282,7 @@ void ExpectResultAtWallTolerance(const std::string& file) {
   for (bool detect_features : {true, false}) {
     SCOPED_TRACE(absl::StrCat(file, detect_features ? ", features" : ", no features"));
     ToleranceFitOptions options;
-    options.detect_features = detect_features;
+    options.features.detect = detect_features;
     const absl::StatusOr<ToleranceFitResult> result = Fit(block, 1.5e-4, options);
     ASSERT_TRUE(result.ok()) << result.status();
     ExpectConsistentSummary(*result, block, 1.5e-4);

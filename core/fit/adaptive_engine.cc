@@ -1,0 +1,439 @@
+#include "core/fit/adaptive_engine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <span>
+#include <tuple>
+
+#include "core/bspline/evaluation.h"
+#include "core/fit/refinement.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// Quality of a set of blocks, ordered: fewer bad original cells first, then fewer folded
+// (sub-)cells.
+struct QualityScore {
+  int64_t bad = 0;
+  int64_t folded = 0;
+  bool ok() const { return folded == 0 && bad == 0; }
+  friend bool operator<(const QualityScore& a, const QualityScore& b) {
+    return std::tie(a.bad, a.folded) < std::tie(b.bad, b.folded);
+  }
+  friend bool operator<=(const QualityScore& a, const QualityScore& b) { return !(b < a); }
+};
+
+// The fraction of the tolerances the knots are placed for when the fit is faired to tolerance.
+constexpr double kFairingHeadroom = 0.5;
+
+// The edge tolerance a quality round gives vertices of bad cells whose edges were not checked.
+constexpr double kLocalEdgeTolerance = 0.5;
+
+class Engine {
+ public:
+  Engine(const MultiBlockGrid& grid, SegmentModel& model,
+         std::vector<std::vector<double>>& tolerances, const EngineOptions& options)
+      : grid_(grid), model_(model), tolerances_(tolerances), options_(options) {
+    const int nb = static_cast<int>(grid.blocks.size());
+    fits_.resize(nb);
+    devs_.resize(nb);
+    quality_.resize(nb);
+    all_.resize(nb);
+    for (int b = 0; b < nb; ++b) all_[b] = b;
+    // Each class's share of the tolerance: 1 / the most active directions among its blocks.
+    shares_.resize(model.num_classes());
+    for (int c = 0; c < model.num_classes(); ++c) {
+      int active = 1;
+      for (const auto& mem : model.segment_class(c).members) {
+        active = std::max(active, ActiveDirections(grid.blocks[mem.block].extents()));
+      }
+      shares_[c] = 1.0 / active;
+    }
+    if (options.fairing.mode == FairingMode::kWeight) lambda_ = options.fairing.weight;
+    edge_tolerances_.resize(nb);
+    for (int b = 0; b < nb; ++b) {
+      edge_tolerances_[b].assign(grid.blocks[b].num_points(),
+                                 std::max(options.edge_tolerance, 0.0));
+    }
+  }
+
+  absl::StatusOr<EngineResult> Run() {
+    EngineResult result;
+    // Fairing to tolerance needs room: the knots are placed for a fraction of the tolerances,
+    // and the fairing may use the rest.
+    const bool fair = options_.fairing.mode == FairingMode::kToTolerance;
+    if (fair) ScaleTolerances(kFairingHeadroom);
+    SG_RETURN_IF_ERROR(FitBlocks(all_));
+    SG_RETURN_IF_ERROR(Refine(result));
+    if (options_.quality && Met()) SG_RETURN_IF_ERROR(ImproveQuality(result));
+    if (options_.remove_unneeded_knots && Met()) {
+      SG_ASSIGN_OR_RETURN(result.knots_removed, RemoveKnots());
+    }
+    if (fair) {
+      const bool met = Met();
+      ScaleTolerances(1.0 / kFairingHeadroom);
+      SG_RETURN_IF_ERROR(FitBlocks(all_));
+      if (met) {
+        for (int b : all_) result.unfaired.push_back(Fitted(b));
+        SG_RETURN_IF_ERROR(FairToTolerance());
+      }
+    }
+    result.met = Met();
+    result.fairing_weight = lambda_;
+    result.quality_met = !options_.quality || Score(all_).ok();
+    for (int b : all_) {
+      if (devs_[b].max_ratio >= result.worst_ratio) {
+        result.worst_ratio = devs_[b].max_ratio;
+        result.worst_block = b;
+        result.worst_at = devs_[b].max_ratio_at;
+      }
+      result.blocks.push_back(Fitted(b));
+      if (options_.quality) result.quality.push_back(quality_[b]);
+    }
+    return result;
+  }
+
+ private:
+  // Everything a step may have to undo.
+  struct State {
+    std::vector<std::vector<double>> class_knots;
+    std::vector<std::vector<double>> tolerances;
+    std::vector<std::vector<double>> edge_tolerances;
+    std::vector<TensorSpline> fits;
+    std::vector<Deviation> devs;
+    std::vector<CellQuality> quality;
+  };
+  State Save() const {
+    State s{{}, tolerances_, edge_tolerances_, fits_, devs_, quality_};
+    for (int c = 0; c < model_.num_classes(); ++c)
+      s.class_knots.push_back(model_.segment_class(c).knots);
+    return s;
+  }
+  void Load(const State& s) {
+    for (int c = 0; c < model_.num_classes(); ++c) model_.mutable_class(c).knots = s.class_knots[c];
+    tolerances_ = s.tolerances;
+    edge_tolerances_ = s.edge_tolerances;
+    fits_ = s.fits;
+    devs_ = s.devs;
+    quality_ = s.quality;
+  }
+
+  // The fits of some blocks (knot removal changes nothing else).
+  struct BlockState {
+    std::vector<TensorSpline> fits;
+    std::vector<Deviation> devs;
+    std::vector<CellQuality> quality;
+  };
+  BlockState SaveBlocks(const std::vector<int>& blocks) const {
+    BlockState s;
+    for (int b : blocks) {
+      s.fits.push_back(fits_[b]);
+      s.devs.push_back(devs_[b]);
+      s.quality.push_back(quality_[b]);
+    }
+    return s;
+  }
+  void LoadBlocks(const std::vector<int>& blocks, const BlockState& s) {
+    for (size_t i = 0; i < blocks.size(); ++i) {
+      fits_[blocks[i]] = s.fits[i];
+      devs_[blocks[i]] = s.devs[i];
+      quality_[blocks[i]] = s.quality[i];
+    }
+  }
+
+  void ScaleTolerances(double factor) {
+    for (std::vector<double>& t : tolerances_) {
+      for (double& x : t) x *= factor;
+    }
+    for (std::vector<double>& t : edge_tolerances_) {
+      for (double& x : t) x *= factor;
+    }
+  }
+
+  bool EdgesOn(int b) const {
+    const std::vector<double>& e = edge_tolerances_[b];
+    return std::any_of(e.begin(), e.end(), [](double x) { return x > 0.0; });
+  }
+  std::span<const double> EdgeTolerances(int b) const {
+    if (!EdgesOn(b)) return {};
+    return edge_tolerances_[b];
+  }
+
+  double WorstRatio(const std::vector<int>& blocks) const {
+    double worst = 0.0;
+    for (int b : blocks) worst = std::max(worst, devs_[b].max_ratio);
+    return worst;
+  }
+  bool Met() const { return WorstRatio(all_) <= 1.0; }
+
+  QualityScore Score(const std::vector<int>& blocks) const {
+    QualityScore s;
+    for (int b : blocks) {
+      s.bad += quality_[b].num_bad_cells;
+      s.folded += quality_[b].folded;
+    }
+    return s;
+  }
+
+  FittedBlock Fitted(int b) const {
+    std::array<std::vector<double>, 3> params;
+    std::array<std::vector<int>, 3> breaks;
+    for (int d = 0; d < 3; ++d) {
+      params[d] = model_.params(b, d);
+      breaks[d] = model_.splits(b, d);
+    }
+    FittedBlock fitted{fits_[b], PointDistribution::Create(params, breaks).value(), {}};
+    fitted.summary.deviation = devs_[b];
+    fitted.summary.num_points = grid_.blocks[b].num_points();
+    fitted.summary.num_control_points = fits_[b].num_control_points();
+    fitted.summary.compression_ratio =
+        static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
+    return fitted;
+  }
+
+  // Fits block b with the current knots and weight, measures it and (if asked) its quality.
+  absl::Status FitBlock(int b) {
+    std::array<std::vector<double>, 3> params;
+    std::array<KnotVector, 3> knots;
+    DirectionPins pins;
+    for (int d = 0; d < 3; ++d) {
+      params[d] = model_.params(b, d);
+      SG_ASSIGN_OR_RETURN(auto kp, model_.DirectionKnots(b, d));
+      knots[d] = std::move(kp.first);
+      pins[d] = std::move(kp.second);
+    }
+    SG_ASSIGN_OR_RETURN(fits_[b],
+                        FitTensor(grid_.blocks[b], params, knots, EndCondition::kInterpolate,
+                                  options_.cancel, pins, lambda_));
+    SG_ASSIGN_OR_RETURN(devs_[b], MeasureDeviation(fits_[b], params, grid_.blocks[b],
+                                                   options_.cancel, tolerances_[b]));
+    if (EdgesOn(b)) {
+      const StructuredBlock fitted = EvaluateGrid(fits_[b], params);
+      const ErrorAssessment a = AssessErrors(grid_.blocks[b], fitted.coords().data(),
+                                             tolerances_[b], edge_tolerances_[b]);
+      devs_[b].max_ratio = a.max_ratio;
+      devs_[b].max_ratio_at = a.max_at;
+    }
+    if (options_.quality) {
+      SG_ASSIGN_OR_RETURN(quality_[b], options_.quality(b, Fitted(b)));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status FitBlocks(const std::vector<int>& blocks) {
+    for (int b : blocks) SG_RETURN_IF_ERROR(FitBlock(b));
+    return absl::OkStatus();
+  }
+
+  // Step 1: knot insertion until every point is within its tolerance (or no room is left).
+  absl::Status Refine(EngineResult& result) {
+    for (int round = 0; !Met() && round < options_.max_iterations; ++round, ++result.iterations) {
+      SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
+      SG_ASSIGN_OR_RETURN(const int added, RefineOnce());
+      if (added < 0) break;  // no room anywhere
+      if (added == 0) continue;
+      result.knots_inserted += added;
+      SG_RETURN_IF_ERROR(FitBlocks(all_));
+    }
+    return absl::OkStatus();
+  }
+
+  // One refinement round; the number of knots added, or -1 if no class has room.
+  absl::StatusOr<int> RefineOnce() {
+    std::map<std::pair<int, int>, std::vector<double>> residuals;  // (block, dir) -> ratio
+    int added = 0;
+    bool any_room = false;
+    for (int c = 0; c < model_.num_classes(); ++c) {
+      SegmentModel::Class& cls = model_.mutable_class(c);
+      int room = std::numeric_limits<int>::max();
+      for (const auto& mem : cls.members) {
+        room = std::min(room, model_.cap(mem.block, mem.dir) - model_.Controls(mem.block, mem.dir));
+      }
+      if (room <= 0) continue;
+      any_room = true;
+      // The members' line-fit residual ratios, in class coordinates.
+      std::vector<double> ratio(cls.length + 1, 0.0);
+      for (const auto& mem : cls.members) {
+        const auto key = std::make_pair(mem.block, mem.dir);
+        if (!residuals.count(key)) {
+          SG_ASSIGN_OR_RETURN(auto kp, model_.DirectionKnots(mem.block, mem.dir));
+          SG_ASSIGN_OR_RETURN(residuals[key],
+                              DirectionResidualRatio(grid_.blocks[mem.block], mem.dir,
+                                                     model_.params(mem.block, mem.dir), kp.first,
+                                                     kp.second, tolerances_[mem.block],
+                                                     EdgeTolerances(mem.block), options_.cancel));
+        }
+        const std::vector<double>& res = residuals[key];
+        for (int r = mem.r0; r <= mem.r1; ++r) {
+          double& x = ratio[mem.ClassCoord(r)];
+          x = std::max(x, res[r]);
+        }
+      }
+      added += SplitSpans(cls.params, ratio, shares_[c], room, cls.knots,
+                          [&] { return model_.WellPosed(c); });
+    }
+    if (!any_room) return -1;
+    if (added == 0) {
+      bool all_tiny = true;
+      for (double& share : shares_) {
+        share *= 0.6;
+        all_tiny &= share < 1e-6;
+      }
+      if (all_tiny) return -1;
+    }
+    return added;
+  }
+
+  // Step 2: rounds of local refinement; the best state is kept, and the rounds stop after
+  // max_quality_rounds or two rounds in a row that do not improve on it.
+  absl::Status ImproveQuality(EngineResult& result) {
+    State best = Save();
+    QualityScore best_score = Score(all_);
+    int futile = 0;
+    while (!best_score.ok() && futile < 2 && result.quality_rounds < options_.max_quality_rounds) {
+      SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
+      ++result.quality_rounds;
+      TightenAroundBadCells();
+      SG_RETURN_IF_ERROR(FitBlocks(all_));
+      SG_RETURN_IF_ERROR(Refine(result));
+      const QualityScore score = Score(all_);
+      if (!Met()) break;
+      if (score < best_score) {
+        best = Save();
+        best_score = score;
+        futile = 0;
+      } else {
+        ++futile;
+      }
+    }
+    Load(best);
+    return absl::OkStatus();
+  }
+
+  // Refines locally around every rejected cell: halves the point tolerance (if bounded) and the
+  // edge tolerance of its vertices; where edges were not checked, they are from now on, to
+  // kLocalEdgeTolerance.
+  void TightenAroundBadCells() {
+    for (int b : all_) {
+      const StructuredBlock& block = grid_.blocks[b];
+      for (const Extents& cell : quality_[b].bad_cells) {
+        for (int dk = 0; dk <= (block.extent(2) > 1 ? 1 : 0); ++dk) {
+          for (int dj = 0; dj <= (block.extent(1) > 1 ? 1 : 0); ++dj) {
+            for (int di = 0; di <= (block.extent(0) > 1 ? 1 : 0); ++di) {
+              const int64_t p = block.Index(std::min(cell[0] + di, block.extent(0) - 1),
+                                            std::min(cell[1] + dj, block.extent(1) - 1),
+                                            std::min(cell[2] + dk, block.extent(2) - 1));
+              tolerances_[b][p] *= 0.5;
+              double& e = edge_tolerances_[b][p];
+              e = e > 0.0 ? 0.5 * e : kLocalEdgeTolerance;
+            }
+          }
+        }
+      }
+    }
+  }
+
+  // Whether `blocks` meet their tolerances and are no worse in quality than `before`.
+  bool Acceptable(const std::vector<int>& blocks, const QualityScore& before) const {
+    if (WorstRatio(blocks) > 1.0) return false;
+    return !options_.quality || Score(blocks) <= before;
+  }
+
+  // Step 3: tries each class knot; keeps a removal when every affected block still meets its
+  // tolerances and its quality is no worse.
+  absl::StatusOr<int> RemoveKnots() {
+    int removed = 0;
+    for (int c = 0; c < model_.num_classes(); ++c) {
+      SegmentModel::Class& cls = model_.mutable_class(c);
+      std::set<int> affected;
+      for (const auto& mem : cls.members) affected.insert(mem.block);
+      const std::vector<int> blocks(affected.begin(), affected.end());
+      for (size_t i = 0; i < cls.knots.size();) {
+        SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
+        const double knot = cls.knots[i];
+        const BlockState saved = SaveBlocks(blocks);
+        const QualityScore before = Score(blocks);
+        cls.knots.erase(cls.knots.begin() + i);
+        bool keep = model_.WellPosed(c);
+        if (keep) {
+          const absl::Status fit = FitBlocks(blocks);
+          if (fit.code() == absl::StatusCode::kCancelled) return fit;
+          keep = fit.ok() && Acceptable(blocks, before);
+        }
+        if (keep) {
+          ++removed;
+        } else {
+          LoadBlocks(blocks, saved);
+          cls.knots.insert(cls.knots.begin() + i, knot);
+          ++i;
+        }
+      }
+    }
+    return removed;
+  }
+
+  // Step 4: the largest lambda <= options.fairing.weight whose fits stay acceptable: decades
+  // downwards from the weight to 1e-14 of it, then four bisections of the last decade on a log
+  // scale (a factor 10^(1/16) = 1.15).
+  absl::Status FairToTolerance() {
+    const State unfaired = Save();
+    const QualityScore before = Score(all_);
+    auto acceptable_at = [&](double lambda) -> absl::StatusOr<bool> {
+      lambda_ = lambda;
+      const absl::Status fit = FitBlocks(all_);
+      if (fit.code() == absl::StatusCode::kCancelled) return fit;
+      return fit.ok() && Acceptable(all_, before);
+    };
+    double good = 0.0, bad = 0.0;
+    for (int e = 0; e <= 14; ++e) {
+      const double lambda = options_.fairing.weight * std::pow(10.0, -e);
+      SG_ASSIGN_OR_RETURN(const bool ok, acceptable_at(lambda));
+      if (ok) {
+        good = lambda;
+        break;
+      }
+      bad = lambda;
+    }
+    if (good > 0.0 && bad > 0.0) {
+      for (int step = 0; step < 4; ++step) {
+        const double mid = std::sqrt(good * bad);
+        SG_ASSIGN_OR_RETURN(const bool ok, acceptable_at(mid));
+        (ok ? good : bad) = mid;
+      }
+    }
+    if (good == 0.0) {
+      Load(unfaired);
+      lambda_ = 0.0;
+      return absl::OkStatus();
+    }
+    lambda_ = good;
+    return FitBlocks(all_);
+  }
+
+  const MultiBlockGrid& grid_;
+  SegmentModel& model_;
+  std::vector<std::vector<double>>& tolerances_;
+  std::vector<std::vector<double>> edge_tolerances_;  // per block, per point; 0: off
+  const EngineOptions& options_;
+  std::vector<int> all_;
+  std::vector<TensorSpline> fits_;
+  std::vector<Deviation> devs_;
+  std::vector<CellQuality> quality_;
+  std::vector<double> shares_;
+  double lambda_ = 0.0;
+};
+
+}  // namespace
+
+absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentModel& model,
+                                            std::vector<std::vector<double>>& tolerances,
+                                            const EngineOptions& options) {
+  Engine engine(grid, model, tolerances, options);
+  return engine.Run();
+}
+
+}  // namespace splinegrid

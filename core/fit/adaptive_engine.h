@@ -1,0 +1,78 @@
+// The knot refinement loop shared by single-block and multi-block tolerance fits.
+//
+// Given a SegmentModel (which directions share knots) and a tolerance per data point:
+//  1. Refine: fit every block (tensor least squares with the model's knots and pins); where some
+//     point misses its tolerance, split the knot spans of every class whose members' own line
+//     fits miss their share of the tolerance (refinement.h); when no class misses its share but
+//     the tensor fit still does, shrink the shares. Repeat until every point is within tolerance.
+//  2. Quality (optional): where cells fold or change size (grid_quality.h), halve the
+//     tolerances at their vertices and refine again ("refine locally"). A round is kept only if
+//     it improves the quality (fewer folded cells, then fewer bad cells); otherwise the best
+//     state so far is restored and the rounds stop. More knots cure cells a coarse fit spoils,
+//     but not the wiggles of a fit that already nearly interpolates a kink in the data, so the
+//     guard is what keeps this step from making things worse.
+//  3. Remove knots one at a time where the tolerances still hold and the quality is no worse.
+//  4. Fair (optional): a fixed weight for every fit, or, to tolerance, the largest weight that
+//     keeps every tolerance and the quality no worse (a search over decades, then bisection on
+//     a log scale). A fit that sits at its tolerance leaves fairing no room, so to fair to
+//     tolerance, steps 1-3 place the knots for half the tolerances and the fairing may use the
+//     other half; the unfaired fit with the same knots is returned too, to compare.
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_
+
+#include <functional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/fit/fairing.h"
+#include "core/fit/grid_quality.h"
+#include "core/fit/segment_model.h"
+#include "core/fit/tensor_fit.h"
+#include "core/util/cancellation.h"
+
+namespace splinegrid {
+
+struct EngineOptions {
+  // Relative accuracy of every grid edge vector (AssessErrors in refinement.h); 0: off.
+  double edge_tolerance = 0.0;
+  // Refinement rounds before giving up.
+  int max_iterations = 60;
+  // Try to drop every knot once the tolerances hold.
+  bool remove_unneeded_knots = true;
+  // The cell quality of block b's fit; unset: no quality check.
+  std::function<absl::StatusOr<CellQuality>(int b, const FittedBlock& fitted)> quality;
+  // Rounds of local tolerance tightening for quality before giving up.
+  int max_quality_rounds = 10;
+  FairingOptions fairing;
+  CancelCheck cancel;
+};
+
+struct EngineResult {
+  // summary.deviation: distances to the data; max_ratio/max_ratio_at are the largest ratio of
+  // AssessErrors (point tolerances and edge tolerance).
+  std::vector<FittedBlock> blocks;
+  // Per block, when options.quality is set.
+  std::vector<CellQuality> quality;
+  bool met = false;         // every point within its tolerance
+  bool quality_met = true;  // every block's cells acceptable (or no check)
+  int worst_block = 0;      // where the largest deviation / tolerance is
+  double worst_ratio = 0.0;
+  Extents worst_at = {0, 0, 0};
+  int iterations = 0;
+  int knots_inserted = 0;
+  int knots_removed = 0;
+  int quality_rounds = 0;
+  double fairing_weight = 0.0;  // lambda of the final fits
+  // Fairing to tolerance: the same knots without fairing (else empty).
+  std::vector<FittedBlock> unfaired;
+};
+
+// Runs the loop on `grid` with `model` (whose class knots it changes) and per-block, per-point
+// `tolerances` (which quality rounds tighten). Errors: CANCELLED; fit errors of the kernel.
+absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentModel& model,
+                                            std::vector<std::vector<double>>& tolerances,
+                                            const EngineOptions& options);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_

@@ -1,0 +1,285 @@
+#include "core/fit/multiblock_fit.h"
+
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/fit/adaptive_engine.h"
+#include "core/fit/segment_model.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// Refinement level of the wall curvature samples: three samples between grid points.
+constexpr int kCurvatureLevel = 2;
+
+// Union-find over (block, control index) pairs.
+class ControlSets {
+ public:
+  explicit ControlSets(const std::vector<FittedBlock>& blocks) {
+    offsets_.push_back(0);
+    for (const FittedBlock& b : blocks)
+      offsets_.push_back(offsets_.back() + b.spline.num_control_points());
+    parent_.resize(offsets_.back());
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  int64_t Id(int b, int64_t c) const { return offsets_[b] + c; }
+  int64_t Find(int64_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  // The smaller id becomes the representative: the first block in order owns a boundary.
+  void Union(int64_t x, int64_t y) {
+    x = Find(x);
+    y = Find(y);
+    if (x != y) parent_[std::max(x, y)] = std::min(x, y);
+  }
+  std::pair<int, int64_t> Locate(int64_t id) const {
+    const int b = static_cast<int>(std::upper_bound(offsets_.begin(), offsets_.end(), id) -
+                                   offsets_.begin()) -
+                  1;
+    return {b, id - offsets_[b]};
+  }
+  int64_t size() const { return offsets_.back(); }
+
+ private:
+  std::vector<int64_t> offsets_;
+  std::vector<int64_t> parent_;
+};
+
+// Makes the controls of every matched boundary bitwise identical: each set takes the value of
+// its first member. Returns the largest change (rounding only when the model is consistent).
+double CopySharedControls(const SegmentModel& model, const Connectivity& connectivity,
+                          std::vector<FittedBlock>& blocks) {
+  std::vector<Extents> extents;
+  for (const FittedBlock& b : blocks) extents.push_back(b.spline.control_extents());
+  ControlSets sets(blocks);
+  for (const auto& [x, y] : model.MatchedControls(connectivity, extents)) {
+    sets.Union(sets.Id(x.first, x.second), sets.Id(y.first, y.second));
+  }
+  double largest = 0.0;
+  for (int64_t id = 0; id < sets.size(); ++id) {
+    const int64_t root = sets.Find(id);
+    if (root == id) continue;
+    const auto [b, c] = sets.Locate(id);
+    const auto [rb, rc] = sets.Locate(root);
+    const int s = blocks[b].spline.spatial_dim();
+    double* dst = blocks[b].spline.mutable_control().data() + s * c;
+    const double* src = blocks[rb].spline.control().data() + s * rc;
+    for (int x = 0; x < s; ++x) {
+      largest = std::max(largest, std::abs(dst[x] - src[x]));
+      dst[x] = src[x];
+    }
+  }
+  return largest;
+}
+
+// Distances between the spline and the data at every point, and the largest per kind.
+absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
+                                              const StructuredBlock& block,
+                                              const std::vector<uint8_t>& kinds) {
+  std::array<std::vector<double>, 3> params;
+  for (int d = 0; d < 3; ++d) params[d] = fitted.distribution.params(d);
+  const StructuredBlock eval = EvaluateGrid(fitted.spline, params);
+  KindDeviation dev;
+  const int s = block.spatial_dim();
+  for (int64_t p = 0; p < block.num_points(); ++p) {
+    double d2 = 0.0;
+    for (int c = 0; c < s; ++c) {
+      const double diff = eval.coords()[s * p + c] - block.coords()[s * p + c];
+      d2 += diff * diff;
+    }
+    const double d = std::sqrt(d2);
+    const uint8_t k = kinds[p];
+    if (k == 0) dev.interior = std::max(dev.interior, d);
+    if (k & static_cast<uint8_t>(BoundaryKind::kWall)) dev.wall = std::max(dev.wall, d);
+    if (k & static_cast<uint8_t>(BoundaryKind::kInterface))
+      dev.interface = std::max(dev.interface, d);
+    if (k & static_cast<uint8_t>(BoundaryKind::kOuter)) dev.outer = std::max(dev.outer, d);
+  }
+  return dev;
+}
+
+// Largest distance between the two sides of every match, evaluated at levels 0..2 (points of
+// the coarse side only for hanging nodes).
+double MeasureGaps(const Connectivity& connectivity, const std::vector<FittedBlock>& blocks,
+                   int max_level) {
+  double gap = 0.0;
+  for (const BoundaryMatch& m : connectivity.matches) {
+    const FittedBlock& fa = blocks[m.a.face.block];
+    const FittedBlock& fb = blocks[m.b.face.block];
+    for (int level = 0; level <= (m.step == 1 ? max_level : 0); ++level) {
+      std::array<std::vector<double>, 3> pa, pb;
+      for (int d = 0; d < 3; ++d) {
+        pa[d] = fa.distribution.Refined(d, m.a.begin[d], m.a.end[d], level);
+      }
+      for (int e = 0; e < 3; ++e) {
+        pb[e] = fb.distribution.Refined(e, m.b.begin[e], m.b.end[e], m.step == 1 ? level : 0);
+        if (m.step == 2) {
+          std::vector<double> even;
+          for (size_t q = 0; q < pb[e].size(); q += (pb[e].size() > 1 ? 2 : 1))
+            even.push_back(pb[e][q]);
+          if (m.b.end[e] > m.b.begin[e]) pb[e] = even;
+        }
+      }
+      const StructuredBlock ea = EvaluateGrid(fa.spline, pa);
+      const StructuredBlock eb = EvaluateGrid(fb.spline, pb);
+      const int s = ea.spatial_dim();
+      for (int k = 0; k < ea.extent(2); ++k) {
+        for (int j = 0; j < ea.extent(1); ++j) {
+          for (int i = 0; i < ea.extent(0); ++i) {
+            // The index in b's evaluated range of a's evaluated point (i, j, k).
+            const Extents x = {i, j, k};
+            Extents y = {0, 0, 0};
+            for (int d = 0; d < 3; ++d) {
+              const int e = m.b_direction[d];
+              if (e < 0) continue;
+              y[e] = m.reversed[d] ? eb.extent(e) - 1 - x[d] : x[d];
+            }
+            double d2 = 0.0;
+            for (int c = 0; c < s; ++c) {
+              const double diff = ea.Point(i, j, k)[c] - eb.Point(y[0], y[1], y[2])[c];
+              d2 += diff * diff;
+            }
+            gap = std::max(gap, std::sqrt(d2));
+          }
+        }
+      }
+    }
+  }
+  return gap;
+}
+
+std::string KindNames(uint8_t mask) {
+  if (mask == 0) return "interior";
+  std::string names;
+  for (BoundaryKind k : {BoundaryKind::kWall, BoundaryKind::kInterface, BoundaryKind::kOuter}) {
+    if (mask & static_cast<uint8_t>(k)) {
+      absl::StrAppend(&names, names.empty() ? "" : "/", std::string(BoundaryKindName(k)));
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
+absl::Status MultiBlockFitOptions::Validate() const {
+  if (order < 2 || order > kMaxOrder) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
+  }
+  if (max_controls_per_direction < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_controls_per_direction = ", max_controls_per_direction, " is negative"));
+  }
+  if (max_iterations < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_iterations = ", max_iterations, " is negative"));
+  }
+  SG_RETURN_IF_ERROR(tolerances.Validate());
+  if (check_quality) SG_RETURN_IF_ERROR(quality.Validate());
+  SG_RETURN_IF_ERROR(fairing.Validate());
+  return absl::OkStatus();
+}
+
+absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const MultiBlockFitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SG_RETURN_IF_ERROR(options.Validate());
+  if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  const int nb = static_cast<int>(grid.blocks.size());
+  MultiBlockFit result;
+  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid, options.connectivity));
+  SG_ASSIGN_OR_RETURN(result.kinds,
+                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
+  std::vector<std::vector<double>> tolerances(nb);
+  std::vector<std::array<std::vector<double>, 3>> params(nb);
+  std::vector<std::array<std::vector<int>, 3>> features(nb);
+  for (int b = 0; b < nb; ++b) {
+    tolerances[b] = PointTolerances(result.kinds, b, options.tolerances);
+    params[b] = ParametrizeBlock(grid.blocks[b], options.parametrization);
+    for (int d = 0; d < 3; ++d)
+      features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
+  }
+  const Connectivity none;
+  const Connectivity& shared = options.watertight ? result.connectivity : none;
+  SG_ASSIGN_OR_RETURN(SegmentModel model,
+                      SegmentModel::Build(grid, params, shared, features, options.order,
+                                          options.max_controls_per_direction));
+  EngineOptions engine;
+  engine.edge_tolerance = options.tolerances.edge;
+  engine.max_iterations = options.max_iterations;
+  engine.remove_unneeded_knots = options.remove_unneeded_knots;
+  engine.fairing = options.fairing;
+  engine.cancel = options.cancel;
+  CellQualityOptions quality = options.quality;
+  quality.cancel = options.cancel;
+  if (options.check_quality) {
+    engine.quality = [&](int b, const FittedBlock& fitted) {
+      return CheckCellQuality(fitted, grid.blocks[b], quality);
+    };
+  }
+  SG_ASSIGN_OR_RETURN(EngineResult run, RunAdaptiveFit(grid, model, tolerances, engine));
+  result.blocks = std::move(run.blocks);
+  result.unfaired = std::move(run.unfaired);
+  if (options.watertight) {
+    CopySharedControls(model, shared, result.blocks);
+    if (!result.unfaired.empty()) CopySharedControls(model, shared, result.unfaired);
+  }
+  result.iterations = run.iterations;
+  result.knots_inserted = run.knots_inserted;
+  result.knots_removed = run.knots_removed;
+  result.quality_rounds = run.quality_rounds;
+  result.fairing_weight = run.fairing_weight;
+  result.met = true;
+  // Reports against the original (untightened) tolerances.
+  for (int b = 0; b < nb; ++b) {
+    FittedBlock& fitted = result.blocks[b];
+    const std::vector<double> tol = PointTolerances(result.kinds, b, options.tolerances);
+    std::array<std::vector<double>, 3> p;
+    for (int d = 0; d < 3; ++d) p[d] = fitted.distribution.params(d);
+    SG_ASSIGN_OR_RETURN(fitted.summary.deviation,
+                        MeasureDeviation(fitted.spline, p, grid.blocks[b], options.cancel, tol));
+    BlockFitReport report;
+    SG_ASSIGN_OR_RETURN(report.max_deviation,
+                        DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
+    if (options.check_quality) {
+      SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
+      result.quality_met = result.quality_met && report.quality.ok();
+    }
+    const Deviation& dev = fitted.summary.deviation;
+    report.tolerance_met = dev.max_ratio <= 1.0;
+    if (!report.tolerance_met) {
+      const Extents& at = dev.max_ratio_at;
+      const uint8_t kind = result.kinds.point_kinds[b][grid.blocks[b].Index(at[0], at[1], at[2])];
+      report.unmet_reason = absl::StrCat("block ", b, " ", KindNames(kind), " point (", at[0], ", ",
+                                         at[1], ", ", at[2], ") deviates ", dev.max_ratio,
+                                         " times its tolerance of ", options.tolerances.For(kind));
+      if (result.met) result.unmet_reason = report.unmet_reason;
+      result.met = false;
+    }
+    result.num_points += grid.blocks[b].num_points();
+    result.num_control_points += fitted.spline.num_control_points();
+    fitted.summary.num_points = grid.blocks[b].num_points();
+    fitted.summary.num_control_points = fitted.spline.num_control_points();
+    fitted.summary.compression_ratio =
+        static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
+    result.reports.push_back(std::move(report));
+  }
+  if (options.watertight) {
+    result.max_gap = MeasureGaps(result.connectivity, result.blocks, options.quality.max_level);
+  }
+  result.wall_curvature = WallCurvatureMetrics(result.blocks, result.kinds, kCurvatureLevel);
+  if (!result.unfaired.empty()) {
+    result.unfaired_wall_curvature =
+        WallCurvatureMetrics(result.unfaired, result.kinds, kCurvatureLevel);
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (FittedBlock& fitted : result.blocks) fitted.summary.seconds = result.seconds / nb;
+  return result;
+}
+
+}  // namespace splinegrid
