@@ -35,8 +35,8 @@ absl::Status ValidateExtents(const Extents& extents, const std::string& what, in
   const int64_t plane = int64_t{extents[0]} * extents[1];
   if (plane > max_points || extents[2] > max_points / plane) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": ", extents[0], " x ", extents[1], " x ",
-                                                   extents[2],
-                                                   " points exceeds the limit of ", max_points));
+                                                   extents[2], " points exceeds the limit of ",
+                                                   max_points));
   }
   return absl::OkStatus();
 }
