@@ -208,4 +208,44 @@ std::array<std::vector<double>, 3> ParametrizeBlock(const StructuredBlock& block
           ParametersFromIncrements(avg[2])};
 }
 
+std::vector<double> ParametrizeLines(const StructuredBlock& block, int d,
+                                     const std::vector<Extents>& lines,
+                                     Parametrization parametrization) {
+  const int m = block.extent(d);
+  LineAverage avg;
+  avg.sum.assign(m - 1, 0.0);
+  std::vector<double> inc(m > 1 ? m - 1 : 0);
+  const int s = block.spatial_dim();
+  for (Extents at : lines) {
+    double length = 0.0;
+    for (int t = 0; t + 1 < m; ++t) {
+      at[d] = t;
+      const double* a = block.Point(at[0], at[1], at[2]);
+      const double* b = a + s * (d == 0   ? 1
+                                 : d == 1 ? int64_t{block.extent(0)}
+                                          : int64_t{block.extent(0)} * block.extent(1));
+      double d2 = 0.0;
+      for (int c = 0; c < s; ++c) d2 += (b[c] - a[c]) * (b[c] - a[c]);
+      switch (parametrization) {
+        case Parametrization::kUniform:
+          inc[t] = 1.0;
+          break;
+        case Parametrization::kChordLength:
+          inc[t] = Increment<Parametrization::kChordLength>(d2);
+          break;
+        case Parametrization::kCentripetal:
+          inc[t] = Increment<Parametrization::kCentripetal>(d2);
+          break;
+      }
+      length += inc[t];
+    }
+    const double inv = InverseLength(length);
+    if (inv == 0.0) continue;
+    for (int t = 0; t + 1 < m; ++t) avg.sum[t] += inc[t] * inv;
+    ++avg.lines;
+  }
+  if (avg.lines == 0) return ParametrizeBlock(block, parametrization)[d];
+  return ParametersFromIncrements(avg);
+}
+
 }  // namespace splinegrid

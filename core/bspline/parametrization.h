@@ -34,6 +34,13 @@ std::string_view ParametrizationName(Parametrization p);
 std::array<std::vector<double>, 3> ParametrizeBlock(const StructuredBlock& block,
                                                     Parametrization parametrization);
 
+// Parameters of direction d of `block` averaged over some of its grid lines only: the lines
+// along d through the grid indices `lines` (each entry's index in direction d is ignored).
+// Collapsed lines take no part; with none left, the average over all lines. Cost O(lines m_d).
+std::vector<double> ParametrizeLines(const StructuredBlock& block, int d,
+                                     const std::vector<Extents>& lines,
+                                     Parametrization parametrization);
+
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_BSPLINE_PARAMETRIZATION_H_

@@ -36,8 +36,13 @@ constexpr double kLocalEdgeTolerance = 0.5;
 class Engine {
  public:
   Engine(const MultiBlockGrid& grid, SegmentModel& model,
-         std::vector<std::vector<double>>& tolerances, const EngineOptions& options)
-      : grid_(grid), model_(model), tolerances_(tolerances), options_(options) {
+         std::vector<std::vector<double>>& tolerances,
+         std::vector<std::vector<double>>& edge_tolerances, const EngineOptions& options)
+      : grid_(grid),
+        model_(model),
+        tolerances_(tolerances),
+        edge_tolerances_(edge_tolerances),
+        options_(options) {
     const int nb = static_cast<int>(grid.blocks.size());
     fits_.resize(nb);
     devs_.resize(nb);
@@ -56,8 +61,7 @@ class Engine {
     if (options.fairing.mode == FairingMode::kWeight) lambda_ = options.fairing.weight;
     edge_tolerances_.resize(nb);
     for (int b = 0; b < nb; ++b) {
-      edge_tolerances_[b].assign(grid.blocks[b].num_points(),
-                                 std::max(options.edge_tolerance, 0.0));
+      if (edge_tolerances_[b].empty()) edge_tolerances_[b].assign(grid.blocks[b].num_points(), 0.0);
     }
   }
 
@@ -417,7 +421,7 @@ class Engine {
   const MultiBlockGrid& grid_;
   SegmentModel& model_;
   std::vector<std::vector<double>>& tolerances_;
-  std::vector<std::vector<double>> edge_tolerances_;  // per block, per point; 0: off
+  std::vector<std::vector<double>>& edge_tolerances_;  // per block, per point; 0: off
   const EngineOptions& options_;
   std::vector<int> all_;
   std::vector<TensorSpline> fits_;
@@ -431,8 +435,9 @@ class Engine {
 
 absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentModel& model,
                                             std::vector<std::vector<double>>& tolerances,
+                                            std::vector<std::vector<double>>& edge_tolerances,
                                             const EngineOptions& options) {
-  Engine engine(grid, model, tolerances, options);
+  Engine engine(grid, model, tolerances, edge_tolerances, options);
   return engine.Run();
 }
 

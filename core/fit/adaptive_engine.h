@@ -33,8 +33,6 @@
 namespace splinegrid {
 
 struct EngineOptions {
-  // Relative accuracy of every grid edge vector (AssessErrors in refinement.h); 0: off.
-  double edge_tolerance = 0.0;
   // Refinement rounds before giving up.
   int max_iterations = 60;
   // Try to drop every knot once the tolerances hold.
@@ -49,7 +47,7 @@ struct EngineOptions {
 
 struct EngineResult {
   // summary.deviation: distances to the data; max_ratio/max_ratio_at are the largest ratio of
-  // AssessErrors (point tolerances and edge tolerance).
+  // AssessErrors (point and edge tolerances).
   std::vector<FittedBlock> blocks;
   // Per block, when options.quality is set.
   std::vector<CellQuality> quality;
@@ -67,10 +65,13 @@ struct EngineResult {
   std::vector<FittedBlock> unfaired;
 };
 
-// Runs the loop on `grid` with `model` (whose class knots it changes) and per-block, per-point
-// `tolerances` (which quality rounds tighten). Errors: CANCELLED; fit errors of the kernel.
+// Runs the loop on `grid` with `model` (whose class knots it changes), per-block, per-point
+// `tolerances` and relative `edge_tolerances` (AssessErrors in refinement.h; an empty vector
+// for a block: no edge criterion), both of which quality rounds tighten. Errors: CANCELLED;
+// fit errors of the kernel.
 absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentModel& model,
                                             std::vector<std::vector<double>>& tolerances,
+                                            std::vector<std::vector<double>>& edge_tolerances,
                                             const EngineOptions& options);
 
 }  // namespace splinegrid

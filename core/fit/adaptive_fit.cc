@@ -53,7 +53,8 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
   engine.max_iterations = options.max_iterations;
   engine.remove_unneeded_knots = options.remove_unneeded_knots;
   engine.cancel = options.cancel;
-  SG_ASSIGN_OR_RETURN(EngineResult run, RunAdaptiveFit(grid, model, tolerances, engine));
+  std::vector<std::vector<double>> no_edges(1);
+  SG_ASSIGN_OR_RETURN(EngineResult run, RunAdaptiveFit(grid, model, tolerances, no_edges, engine));
 
   ToleranceFitResult result;
   result.fitted = std::move(run.blocks[0]);

@@ -1,14 +1,17 @@
 #include "core/fit/grid_fit.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
-#include "core/fit/adaptive_fit.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
 namespace {
+
+// Refinement level of the wall curvature report (three samples between grid points).
+constexpr int kCurvatureLevel = 2;
 
 // The status with "block b: " in front of its message.
 absl::Status InBlock(int b, const absl::Status& status) {
@@ -21,6 +24,7 @@ FitOptions BlockOptions(const GridFitOptions& options, const StructuredBlock& bl
   FitOptions fit_options;
   fit_options.order = options.order;
   fit_options.parametrization = options.parametrization;
+  if (options.fairing.mode == FairingMode::kWeight) fit_options.fairing = options.fairing.weight;
   for (const auto& [index, counts] : options.block_control_counts) {
     if (index == b) {
       fit_options.control_counts = counts;
@@ -34,7 +38,66 @@ FitOptions BlockOptions(const GridFitOptions& options, const StructuredBlock& bl
   return fit_options;
 }
 
+// Control-count mode: every block on its own.
+absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options,
+                       const CancelCheck& cancel, GridFit& result) {
+  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
+    FitOptions fit_options = BlockOptions(options, grid.blocks[b], b);
+    fit_options.cancel = cancel;
+    absl::StatusOr<FittedBlock> fit = FitBlock(grid.blocks[b], fit_options);
+    if (!fit.ok()) return InBlock(b, fit.status());
+    result.blocks.push_back(BlockFit{*std::move(fit)});
+  }
+  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid));
+  SG_ASSIGN_OR_RETURN(result.kinds,
+                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
+  return absl::OkStatus();
+}
+
+// Tolerance mode: the watertight multi-block fit.
+absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& options,
+                             const CancelCheck& cancel, GridFit& result) {
+  MultiBlockFitOptions mb;
+  mb.order = options.order;
+  mb.parametrization = options.parametrization;
+  mb.tolerances = options.Tolerances();
+  mb.face_kinds = options.face_kinds;
+  mb.max_controls_per_direction = options.max_controls_per_direction;
+  mb.check_quality = options.check_quality;
+  mb.fairing = options.fairing;
+  mb.cancel = cancel;
+  SG_ASSIGN_OR_RETURN(MultiBlockFit fit, FitMultiBlock(grid, mb));
+  for (size_t b = 0; b < fit.blocks.size(); ++b) {
+    BlockFit block{std::move(fit.blocks[b])};
+    block.tolerance_met = fit.reports[b].tolerance_met;
+    block.unmet_reason = std::move(fit.reports[b].unmet_reason);
+    block.deviation_by_kind = fit.reports[b].max_deviation;
+    block.quality = std::move(fit.reports[b].quality);
+    result.blocks.push_back(std::move(block));
+  }
+  result.report.max_gap = fit.max_gap;
+  result.report.wall_curvature = fit.wall_curvature;
+  result.connectivity = std::move(fit.connectivity);
+  result.kinds = std::move(fit.kinds);
+  result.report.tolerance_met = fit.met;
+  result.report.unmet_reason = std::move(fit.unmet_reason);
+  result.report.fairing_weight = fit.fairing_weight;
+  result.report.unfaired_wall_curvature = fit.unfaired_wall_curvature;
+  result.report.iterations = fit.iterations;
+  result.report.knots_inserted = fit.knots_inserted;
+  result.report.knots_removed = fit.knots_removed;
+  result.report.quality_rounds = fit.quality_rounds;
+  return absl::OkStatus();
+}
+
 }  // namespace
+
+BoundaryTolerances GridFitOptions::Tolerances() const {
+  if (boundary_tolerances) return *boundary_tolerances;
+  BoundaryTolerances t;
+  if (tolerance) t.wall = t.interface = t.outer = t.interior = *tolerance;
+  return t;
+}
 
 absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
   if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
@@ -42,11 +105,24 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
   }
-  if (tolerance) {
-    if (!(*tolerance > 0.0) || !std::isfinite(*tolerance)) {
+  SG_RETURN_IF_ERROR(fairing.Validate());
+  const int num_blocks = static_cast<int>(grid.blocks.size());
+  for (const FaceKindOverride& o : face_kinds) {
+    if (o.face.block < 0 || o.face.block >= num_blocks) {
+      return absl::InvalidArgumentError(absl::StrCat("face_kinds: block ", o.face.block,
+                                                     " is outside [0, ", num_blocks - 1, "]"));
+    }
+  }
+  if (tolerance_mode()) {
+    if (tolerance && boundary_tolerances) {
+      return absl::InvalidArgumentError(
+          "tolerance and boundary_tolerances cannot both be given; use one");
+    }
+    if (tolerance && (!(*tolerance > 0.0) || !std::isfinite(*tolerance))) {
       return absl::InvalidArgumentError(
           absl::StrCat("tolerance = ", *tolerance, "; must be positive and finite"));
     }
+    if (boundary_tolerances) SG_RETURN_IF_ERROR(boundary_tolerances->Validate());
     if (max_controls_per_direction < 0) {
       return absl::InvalidArgumentError(absl::StrCat(
           "max_controls_per_direction = ", max_controls_per_direction, " is negative"));
@@ -56,7 +132,10 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
     }
     return absl::OkStatus();
   }
-  const int num_blocks = static_cast<int>(grid.blocks.size());
+  if (fairing.mode == FairingMode::kToTolerance) {
+    return absl::InvalidArgumentError(
+        "fairing to tolerance needs a tolerance; with control counts give a fairing weight");
+  }
   for (const auto& [block, counts] : block_control_counts) {
     if (block < 0 || block >= num_blocks) {
       return absl::InvalidArgumentError(absl::StrCat("block_control_counts: block ", block,
@@ -83,34 +162,43 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
   const auto start = std::chrono::steady_clock::now();
   SG_RETURN_IF_ERROR(options.Validate(grid));
   GridFit result;
-  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
-    const StructuredBlock& block = grid.blocks[b];
-    BlockFit block_fit;
-    if (options.tolerance) {
-      ToleranceFitOptions tol_options;
-      tol_options.order = options.order;
-      tol_options.parametrization = options.parametrization;
-      tol_options.max_controls_per_direction = options.max_controls_per_direction;
-      tol_options.cancel = cancel;
-      const double tolerance[] = {*options.tolerance};
-      absl::StatusOr<ToleranceFitResult> fit = FitToTolerance(block, tolerance, tol_options);
-      if (!fit.ok()) return InBlock(b, fit.status());
-      block_fit.fitted = std::move(fit->fitted);
-      block_fit.tolerance_met = fit->met;
-      block_fit.unmet_reason = std::move(fit->unmet_reason);
-    } else {
-      FitOptions fit_options = BlockOptions(options, block, b);
-      fit_options.cancel = cancel;
-      absl::StatusOr<FittedBlock> fit = FitBlock(block, fit_options);
-      if (!fit.ok()) return InBlock(b, fit.status());
-      block_fit.fitted = *std::move(fit);
-    }
-    result.num_points += block_fit.fitted.summary.num_points;
-    result.num_control_points += block_fit.fitted.summary.num_control_points;
-    result.max_deviation = std::max(result.max_deviation, block_fit.fitted.summary.deviation.max);
-    result.blocks.push_back(std::move(block_fit));
+  if (options.tolerance_mode()) {
+    SG_RETURN_IF_ERROR(FitToTolerances(grid, options, cancel, result));
+  } else {
+    SG_RETURN_IF_ERROR(FitBlocks(grid, options, cancel, result));
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The report (FitMultiBlock makes its own): deviations by kind, cell quality, gaps, walls.
+  const bool report = !options.tolerance_mode();
+  const bool quality = report;
+  CellQualityOptions quality_options;
+  quality_options.cancel = cancel;
+  std::vector<FittedBlock> fitted;
+  for (size_t b = 0; b < result.blocks.size(); ++b) {
+    BlockFit& block = result.blocks[b];
+    if (report) {
+      SG_ASSIGN_OR_RETURN(block.deviation_by_kind, DeviationByKind(block.fitted, grid.blocks[b],
+                                                                   result.kinds.point_kinds[b]));
+    }
+    if (quality) {
+      absl::StatusOr<CellQuality> q =
+          CheckCellQuality(block.fitted, grid.blocks[b], quality_options);
+      if (!q.ok()) return InBlock(static_cast<int>(b), q.status());
+      block.quality = *std::move(q);
+    }
+    result.report.quality_met = result.report.quality_met && block.quality.ok();
+    result.report.num_points += block.fitted.summary.num_points;
+    result.report.num_control_points += block.fitted.summary.num_control_points;
+    result.report.max_deviation =
+        std::max(result.report.max_deviation, block.fitted.summary.deviation.max);
+    if (report) fitted.push_back(block.fitted);
+  }
+  if (report) {
+    result.report.max_gap = MaxBoundaryGap(result.connectivity, fitted, quality_options.max_level);
+    result.report.wall_curvature = WallCurvatureMetrics(fitted, result.kinds, kCurvatureLevel);
+  }
+  result.report.num_matches = static_cast<int>(result.connectivity.matches.size());
+  result.report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -1,5 +1,13 @@
-// Fitting a whole multi-block grid: every block with the same options (control counts, with
-// per-block overrides, or a tolerance).
+// Fitting a whole multi-block grid, with a report: what the service's FitGrid runs.
+//
+// Two modes:
+//  - control counts (per direction, with per-block overrides): a least-squares fit of every
+//    block on its own (tensor_fit.h), optionally faired with a fixed weight;
+//  - tolerances: a watertight multi-block fit to tolerances by boundary kind (multiblock_fit.h),
+//    from one tolerance for every point or from per-kind tolerances, optionally faired.
+// Either way the result reports, per block, the deviation per boundary kind and the cell
+// quality at refinement levels 0..2 (grid_quality.h), and for the grid the connectivity, the
+// gaps between matched boundaries and the curvature along the walls (wall_curvature.h).
 #ifndef SPLINEGRID_CORE_FIT_GRID_FIT_H_
 #define SPLINEGRID_CORE_FIT_GRID_FIT_H_
 
@@ -8,7 +16,13 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/fit/fairing.h"
+#include "core/fit/grid_quality.h"
+#include "core/fit/multiblock_fit.h"
 #include "core/fit/tensor_fit.h"
+#include "core/fit/wall_curvature.h"
+#include "core/grid/boundary_kinds.h"
+#include "core/grid/connectivity.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -19,37 +33,73 @@ struct GridFitOptions {
   // Spline order (degree + 1).
   int order = 4;
   Parametrization parametrization = Parametrization::kChordLength;
-  // With a tolerance: adaptive knots until every point is within it (in the grid's length
-  // unit); without: control counts.
+  // Tolerance mode: one tolerance for every point (in the grid's length unit), or tolerances
+  // by boundary kind. At most one of the two; with neither, control counts.
   std::optional<double> tolerance;
+  std::optional<BoundaryTolerances> boundary_tolerances;
   // Control points per direction for every block; 0 = as many as points.
   Extents control_counts = {0, 0, 0};
   // Per-block overrides of control_counts: (block index, counts).
   std::vector<std::pair<int, Extents>> block_control_counts;
-  // With a tolerance: the most control points per direction (0: the point count).
+  // Tolerance mode: the most control points per direction (0: the point count).
   int max_controls_per_direction = 0;
+  // kWeight in either mode; kToTolerance needs the tolerance mode.
+  FairingOptions fairing;
+  // Explicit kinds of faces (else from the connectivity and the geometry).
+  std::vector<FaceKindOverride> face_kinds;
+  // Tolerance mode: refine locally where cells fold or change size (the quality is reported in
+  // either mode).
+  bool check_quality = true;
+
+  bool tolerance_mode() const { return tolerance.has_value() || boundary_tolerances.has_value(); }
+  // The per-kind tolerances of the tolerance mode (one tolerance: every kind, inside too).
+  BoundaryTolerances Tolerances() const;
 
   // OK if the options suit `grid`; INVALID_ARGUMENT naming the field and value otherwise.
   absl::Status Validate(const MultiBlockGrid& grid) const;
 };
 
-// A block's fit and, for tolerance fits, whether the tolerance was met.
+// A block's fit and what the report says about it.
 struct BlockFit {
   FittedBlock fitted;
-  bool tolerance_met = true;
+  bool tolerance_met = true;  // tolerance mode: every point within its tolerance
   std::string unmet_reason;
+  KindDeviation deviation_by_kind;
+  CellQuality quality;  // levels 0..2
+};
+
+// What a fit achieved, for the whole grid.
+struct GridFitReport {
+  int64_t num_points = 0;
+  int64_t num_control_points = 0;
+  double max_deviation = 0.0;
+  bool tolerance_met = true;  // tolerance mode: every block's
+  std::string unmet_reason;   // the first block's reason
+  bool quality_met = true;    // no folded or resized cell in any block
+  int num_matches = 0;        // of the connectivity
+  // Largest distance between coinciding points of matched boundaries at levels 0..2 (0 when
+  // watertight: the tolerance mode).
+  double max_gap = 0.0;
+  double fairing_weight = 0.0;
+  CurvatureMetrics wall_curvature;           // at refinement level 2
+  CurvatureMetrics unfaired_wall_curvature;  // faired to tolerance: the same knots unfaired
+  int iterations = 0;
+  int knots_inserted = 0;
+  int knots_removed = 0;
+  int quality_rounds = 0;
+  double seconds = 0.0;
 };
 
 struct GridFit {
   std::vector<BlockFit> blocks;
-  int64_t num_points = 0;
-  int64_t num_control_points = 0;
-  double max_deviation = 0.0;
-  double seconds = 0.0;
+  Connectivity connectivity;
+  BoundaryKinds kinds;
+  GridFitReport report;
 };
 
 // Fits every block of `grid`. Errors: INVALID_ARGUMENT (options, non-finite points; the message
-// names the block), FAILED_PRECONDITION (data leave control points undetermined), CANCELLED.
+// names the block), FAILED_PRECONDITION (data leave control points undetermined, blocks that
+// touch inconsistently), CANCELLED.
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
                                 const CancelCheck& cancel = {});
 

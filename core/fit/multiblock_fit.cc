@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
@@ -77,7 +78,46 @@ double CopySharedControls(const SegmentModel& model, const Connectivity& connect
   return largest;
 }
 
-// Distances between the spline and the data at every point, and the largest per kind.
+// The grid lines along direction d of `block` (by their index with 0 in direction d) that hold
+// at least three wall points: the lines whose shape the wall tolerance binds.
+std::vector<Extents> LinesWithWall(const StructuredBlock& block, const std::vector<uint8_t>& kinds,
+                                   int d) {
+  std::vector<Extents> lines;
+  const int m = block.extent(d);
+  if (m < 3) return lines;
+  const auto wall = static_cast<uint8_t>(BoundaryKind::kWall);
+  const int e1 = d == 0 ? 1 : 0;
+  const int e2 = d == 2 ? 1 : 2;
+  for (int y = 0; y < block.extent(e2); ++y) {
+    for (int x = 0; x < block.extent(e1); ++x) {
+      Extents at{};
+      at[e1] = x;
+      at[e2] = y;
+      int count = 0;
+      for (int t = 0; t < m && count < 3; ++t) {
+        at[d] = t;
+        count += (kinds[block.Index(at[0], at[1], at[2])] & wall) ? 1 : 0;
+      }
+      at[d] = 0;
+      if (count >= 3) lines.push_back(at);
+    }
+  }
+  return lines;
+}
+
+std::string KindNames(uint8_t mask) {
+  if (mask == 0) return "interior";
+  std::string names;
+  for (BoundaryKind k : {BoundaryKind::kWall, BoundaryKind::kInterface, BoundaryKind::kOuter}) {
+    if (mask & static_cast<uint8_t>(k)) {
+      absl::StrAppend(&names, names.empty() ? "" : "/", std::string(BoundaryKindName(k)));
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
 absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
                                               const StructuredBlock& block,
                                               const std::vector<uint8_t>& kinds) {
@@ -103,10 +143,8 @@ absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
   return dev;
 }
 
-// Largest distance between the two sides of every match, evaluated at levels 0..2 (points of
-// the coarse side only for hanging nodes).
-double MeasureGaps(const Connectivity& connectivity, const std::vector<FittedBlock>& blocks,
-                   int max_level) {
+double MaxBoundaryGap(const Connectivity& connectivity, const std::vector<FittedBlock>& blocks,
+                      int max_level) {
   double gap = 0.0;
   for (const BoundaryMatch& m : connectivity.matches) {
     const FittedBlock& fa = blocks[m.a.face.block];
@@ -153,19 +191,6 @@ double MeasureGaps(const Connectivity& connectivity, const std::vector<FittedBlo
   return gap;
 }
 
-std::string KindNames(uint8_t mask) {
-  if (mask == 0) return "interior";
-  std::string names;
-  for (BoundaryKind k : {BoundaryKind::kWall, BoundaryKind::kInterface, BoundaryKind::kOuter}) {
-    if (mask & static_cast<uint8_t>(k)) {
-      absl::StrAppend(&names, names.empty() ? "" : "/", std::string(BoundaryKindName(k)));
-    }
-  }
-  return names;
-}
-
-}  // namespace
-
 absl::Status MultiBlockFitOptions::Validate() const {
   if (order < 2 || order > kMaxOrder) {
     return absl::InvalidArgumentError(
@@ -180,29 +205,48 @@ absl::Status MultiBlockFitOptions::Validate() const {
         absl::StrCat("max_iterations = ", max_iterations, " is negative"));
   }
   SG_RETURN_IF_ERROR(tolerances.Validate());
-  if (check_quality) SG_RETURN_IF_ERROR(quality.Validate());
+  SG_RETURN_IF_ERROR(quality.Validate());
   SG_RETURN_IF_ERROR(fairing.Validate());
   return absl::OkStatus();
 }
 
-absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
-                                            const MultiBlockFitOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  SG_RETURN_IF_ERROR(options.Validate());
-  if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+namespace {
+
+// Parameters of every block: averaged over all grid lines of each direction, or (walls) over
+// the lines that lie on walls where a direction has any. Sets *any_wall if some direction
+// differs.
+std::vector<std::array<std::vector<double>, 3>> BlockParameters(const MultiBlockGrid& grid,
+                                                                const BoundaryKinds& kinds,
+                                                                Parametrization parametrization,
+                                                                bool walls, bool* any_wall) {
+  std::vector<std::array<std::vector<double>, 3>> params;
+  for (size_t b = 0; b < grid.blocks.size(); ++b) {
+    params.push_back(ParametrizeBlock(grid.blocks[b], parametrization));
+    if (!walls) continue;
+    for (int d = 0; d < 3; ++d) {
+      const std::vector<Extents> lines = LinesWithWall(grid.blocks[b], kinds.point_kinds[b], d);
+      const int64_t all = grid.blocks[b].num_points() / grid.blocks[b].extent(d);
+      if (lines.empty() || static_cast<int64_t>(lines.size()) == all) continue;
+      params.back()[d] = ParametrizeLines(grid.blocks[b], d, lines, parametrization);
+      *any_wall = true;
+    }
+  }
+  return params;
+}
+
+// The fit with the given parameters; `result` holds the connectivity and kinds already.
+absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+                               const std::vector<std::array<std::vector<double>, 3>>& params,
+                               MultiBlockFit& result) {
   const int nb = static_cast<int>(grid.blocks.size());
-  MultiBlockFit result;
-  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid, options.connectivity));
-  SG_ASSIGN_OR_RETURN(result.kinds,
-                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
-  std::vector<std::vector<double>> tolerances(nb);
-  std::vector<std::array<std::vector<double>, 3>> params(nb);
+  std::vector<std::vector<double>> tolerances(nb), edge_tolerances(nb);
   std::vector<std::array<std::vector<int>, 3>> features(nb);
   for (int b = 0; b < nb; ++b) {
     tolerances[b] = PointTolerances(result.kinds, b, options.tolerances);
-    params[b] = ParametrizeBlock(grid.blocks[b], options.parametrization);
-    for (int d = 0; d < 3; ++d)
+    edge_tolerances[b] = PointEdgeTolerances(result.kinds, b, options.tolerances);
+    for (int d = 0; d < 3; ++d) {
       features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
+    }
   }
   const Connectivity none;
   const Connectivity& shared = options.watertight ? result.connectivity : none;
@@ -210,7 +254,6 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
                       SegmentModel::Build(grid, params, shared, features, options.order,
                                           options.max_controls_per_direction));
   EngineOptions engine;
-  engine.edge_tolerance = options.tolerances.edge;
   engine.max_iterations = options.max_iterations;
   engine.remove_unneeded_knots = options.remove_unneeded_knots;
   engine.fairing = options.fairing;
@@ -222,7 +265,8 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
       return CheckCellQuality(fitted, grid.blocks[b], quality);
     };
   }
-  SG_ASSIGN_OR_RETURN(EngineResult run, RunAdaptiveFit(grid, model, tolerances, engine));
+  SG_ASSIGN_OR_RETURN(EngineResult run,
+                      RunAdaptiveFit(grid, model, tolerances, edge_tolerances, engine));
   result.blocks = std::move(run.blocks);
   result.unfaired = std::move(run.unfaired);
   if (options.watertight) {
@@ -235,6 +279,10 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
   result.quality_rounds = run.quality_rounds;
   result.fairing_weight = run.fairing_weight;
   result.met = true;
+  result.quality_met = true;
+  result.reports.clear();
+  result.num_points = result.num_control_points = 0;
+  result.unmet_reason.clear();
   // Reports against the original (untightened) tolerances.
   for (int b = 0; b < nb; ++b) {
     FittedBlock& fitted = result.blocks[b];
@@ -246,10 +294,8 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
     BlockFitReport report;
     SG_ASSIGN_OR_RETURN(report.max_deviation,
                         DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
-    if (options.check_quality) {
-      SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
-      result.quality_met = result.quality_met && report.quality.ok();
-    }
+    SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
+    result.quality_met = result.quality_met && report.quality.ok();
     const Deviation& dev = fitted.summary.deviation;
     report.tolerance_met = dev.max_ratio <= 1.0;
     if (!report.tolerance_met) {
@@ -269,15 +315,60 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
         static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
     result.reports.push_back(std::move(report));
   }
-  if (options.watertight) {
-    result.max_gap = MeasureGaps(result.connectivity, result.blocks, options.quality.max_level);
-  }
+  result.max_gap = options.watertight ? MaxBoundaryGap(result.connectivity, result.blocks,
+                                                       options.quality.max_level)
+                                      : 0.0;
   result.wall_curvature = WallCurvatureMetrics(result.blocks, result.kinds, kCurvatureLevel);
+  result.unfaired_wall_curvature = {};
   if (!result.unfaired.empty()) {
     result.unfaired_wall_curvature =
         WallCurvatureMetrics(result.unfaired, result.kinds, kCurvatureLevel);
   }
+  return absl::OkStatus();
+}
+
+// Whether fit a is better than b: tolerances met, then fewer bad cells, fewer folded
+// sub-cells, then a smoother wall (smaller sum of squared curvature differences).
+bool Better(const MultiBlockFit& a, const MultiBlockFit& b) {
+  auto key = [](const MultiBlockFit& f) {
+    int64_t bad = 0, folded = 0;
+    for (const BlockFitReport& r : f.reports) {
+      bad += r.quality.num_bad_cells;
+      folded += r.quality.folded;
+    }
+    return std::make_tuple(!f.met, bad, folded, f.wall_curvature.sum_squared_differences);
+  };
+  return key(a) < key(b);
+}
+
+}  // namespace
+
+absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const MultiBlockFitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SG_RETURN_IF_ERROR(options.Validate());
+  if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  MultiBlockFit result;
+  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid, options.connectivity));
+  SG_ASSIGN_OR_RETURN(result.kinds,
+                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
+  bool any_wall = false;
+  const bool walls_first = options.wall_parameters != WallParametrization::kAverage;
+  SG_RETURN_IF_ERROR(FitWithParameters(
+      grid, options,
+      BlockParameters(grid, result.kinds, options.parametrization, walls_first, &any_wall),
+      result));
+  if (options.wall_parameters == WallParametrization::kAuto && any_wall) {
+    MultiBlockFit averaged;
+    averaged.connectivity = result.connectivity;
+    averaged.kinds = result.kinds;
+    SG_RETURN_IF_ERROR(FitWithParameters(
+        grid, options,
+        BlockParameters(grid, result.kinds, options.parametrization, false, &any_wall), averaged));
+    if (Better(averaged, result)) result = std::move(averaged);
+  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const int nb = static_cast<int>(grid.blocks.size());
   for (FittedBlock& fitted : result.blocks) fitted.summary.seconds = result.seconds / nb;
   return result;
 }

@@ -24,12 +24,12 @@ DirectionView ViewOf(const StructuredBlock& block, int d) {
   return v;
 }
 
-// The relative tolerance of an edge between points with edge tolerances a and b: the tighter
-// one that is switched on (> 0), or 0 (off).
+// The relative tolerance of an edge between points with edge tolerances a and b: the looser
+// one, or 0 (off) if either is off. So an edge gets a tight value only if both its ends have
+// it: along a wall, or inside a cell whose corners were all tightened.
 double EdgeLimit(double a, double b) {
-  if (a <= 0.0) return b;
-  if (b <= 0.0) return a;
-  return std::min(a, b);
+  if (a <= 0.0 || b <= 0.0) return 0.0;
+  return std::max(a, b);
 }
 
 }  // namespace

@@ -19,8 +19,8 @@ namespace splinegrid {
 // allowed (1 = at the limit):
 //  - at every point p: |F(p) - X(p)| / tolerance[p];
 //  - on every grid edge (p, q) with |X(q) - X(p)| > 0: the error of the edge vector,
-//    |(F(q) - F(p)) - (X(q) - X(p))| / (e |X(q) - X(p)|), e the tighter of the two points'
-//    edge tolerances that are on (> 0). This keeps the grid's spacing and shape where no
+//    |(F(q) - F(p)) - (X(q) - X(p))| / (e |X(q) - X(p)|), e the looser of the two points'
+//    edge tolerances (none if either is 0). This keeps the grid's spacing and shape where no
 //    absolute tolerance binds (inside a block) without asking for absolute accuracy: an error
 //    shared by neighbouring points costs nothing.
 // `fitted` has the layout of block.coords(). `tolerance` and `edge_tolerance` have one value

@@ -22,6 +22,9 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+// One bit per face of a block: i=0, i=max, j=0, j=max, k=0, k=max.
+uint8_t FaceBit(const Face& face) { return uint8_t{1} << (2 * face.normal + face.upper); }
+
 // Calls fn(x) for every point x of `face`.
 template <typename Fn>
 void ForEachFacePoint(const StructuredBlock& block, const Face& face, Fn fn) {
@@ -90,11 +93,14 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
   BoundaryKinds kinds;
   kinds.point_kinds.resize(num_blocks);
   kinds.face_kinds.resize(num_blocks);
-  // Matched points first: they are interface whatever their face is.
-  std::vector<std::vector<bool>> matched(num_blocks);
+  // Matched points first: they are interface whatever their face is. `matched` holds, per
+  // point, a bit per face (FaceBit) on which a match covers it: a point at the end of a match
+  // (a corner, an edge of a volume face) also lies on the neighbouring face, whose kind it
+  // still carries.
+  std::vector<std::vector<uint8_t>> matched(num_blocks);
   for (int b = 0; b < num_blocks; ++b) {
     kinds.point_kinds[b].assign(grid.blocks[b].num_points(), 0);
-    matched[b].assign(grid.blocks[b].num_points(), false);
+    matched[b].assign(grid.blocks[b].num_points(), 0);
   }
   auto mark = [&](const FaceRange& r) {
     const StructuredBlock& block = grid.blocks[r.face.block];
@@ -102,7 +108,7 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
       for (int j = r.begin[1]; j <= r.end[1]; ++j) {
         for (int i = r.begin[0]; i <= r.end[0]; ++i) {
           const int64_t p = block.Index(i, j, k);
-          matched[r.face.block][p] = true;
+          matched[r.face.block][p] |= FaceBit(r.face);
           kinds.point_kinds[r.face.block][p] |= static_cast<uint8_t>(BoundaryKind::kInterface);
         }
       }
@@ -126,7 +132,9 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
       kinds.face_kinds[b].push_back(kind);
       ForEachFacePoint(block, face, [&](const Extents& x) {
         const int64_t p = block.Index(x[0], x[1], x[2]);
-        if (!matched[b][p]) kinds.point_kinds[b][p] |= static_cast<uint8_t>(kind);
+        if (!(matched[b][p] & FaceBit(face))) {
+          kinds.point_kinds[b][p] |= static_cast<uint8_t>(kind);
+        }
       });
     }
   }
@@ -167,6 +175,11 @@ std::vector<double> PointTolerances(const BoundaryKinds& kinds, int b,
   std::vector<double> tol(kinds.point_kinds[b].size());
   for (size_t p = 0; p < tol.size(); ++p) tol[p] = tolerances.For(kinds.point_kinds[b][p]);
   return tol;
+}
+
+std::vector<double> PointEdgeTolerances(const BoundaryKinds& kinds, int b,
+                                        const BoundaryTolerances& tolerances) {
+  return std::vector<double>(kinds.point_kinds[b].size(), tolerances.edge);
 }
 
 }  // namespace splinegrid

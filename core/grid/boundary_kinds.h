@@ -82,6 +82,10 @@ struct BoundaryTolerances {
 std::vector<double> PointTolerances(const BoundaryKinds& kinds, int b,
                                     const BoundaryTolerances& tolerances);
 
+// Per-point edge tolerances of block b (`edge` everywhere; refinement tightens them locally).
+std::vector<double> PointEdgeTolerances(const BoundaryKinds& kinds, int b,
+                                        const BoundaryTolerances& tolerances);
+
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_GRID_BOUNDARY_KINDS_H_
