@@ -119,6 +119,35 @@ absl::StatusOr<v1::FitGridResponse> Client::Fit(const std::string& name, const v
   return response;
 }
 
+absl::StatusOr<v1::FitGridResponse> Client::Fair(const std::string& name, int64_t revision,
+                                                 const v1::Fairing* fairing) {
+  auto context = NewContext();
+  v1::FairGridRequest request;
+  request.set_name(GridName(name));
+  request.set_revision(revision);
+  if (fairing != nullptr) *request.mutable_fairing() = *fairing;
+  v1::FitGridResponse response;
+  const grpc::Status status = stub_->FairGrid(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
+absl::StatusOr<v1::GetWallCurvatureResponse> Client::WallCurvature(const std::string& name,
+                                                                   int64_t revision,
+                                                                   int refinement_level,
+                                                                   const std::vector<int>& blocks) {
+  auto context = NewContext();
+  v1::GetWallCurvatureRequest request;
+  request.set_name(GridName(name));
+  request.set_revision(revision);
+  request.set_refinement_level(refinement_level);
+  for (int b : blocks) request.add_blocks(b);
+  v1::GetWallCurvatureResponse response;
+  const grpc::Status status = stub_->GetWallCurvature(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
 absl::StatusOr<v1::Grid> Client::Get(const std::string& name, int64_t revision, v1::GridView view,
                                      const std::vector<int>& blocks) {
   auto context = NewContext();

@@ -54,6 +54,13 @@ class Client {
                                         const std::string& display_name,
                                         const ProgressFn& progress = {});
   absl::StatusOr<v1::FitGridResponse> Fit(const std::string& name, const v1::FitSpec& spec);
+  // A faired refit of `revision` (0: latest); fairing null: the server's default (to tolerance).
+  absl::StatusOr<v1::FitGridResponse> Fair(const std::string& name, int64_t revision,
+                                           const v1::Fairing* fairing = nullptr);
+  // Curvature samples along the walls of `revision` at `refinement_level`.
+  absl::StatusOr<v1::GetWallCurvatureResponse> WallCurvature(const std::string& name,
+                                                             int64_t revision, int refinement_level,
+                                                             const std::vector<int>& blocks = {});
   absl::StatusOr<v1::Grid> Get(const std::string& name, int64_t revision = 0,
                                v1::GridView view = v1::GRID_VIEW_BASIC,
                                const std::vector<int>& blocks = {});

@@ -18,20 +18,13 @@ v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
   switch (origin) {
     case RevisionOrigin::kFit:
       return v1::REVISION_ORIGIN_FIT;
+    case RevisionOrigin::kFair:
+      return v1::REVISION_ORIGIN_FAIR;
   }
   return v1::REVISION_ORIGIN_UNSPECIFIED;
 }
 
 }  // namespace
-
-void EncodeBlockFit(const BlockFit& block, const GridFitOptions& options,
-                    v1::BlockFitSummary* out) {
-  EncodeFitSummary(block.fitted.summary, out);
-  if (options.tolerance) {
-    out->set_tolerance_met(block.tolerance_met);
-    out->set_unmet_reason(block.unmet_reason);
-  }
-}
 
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
                         const std::vector<int>& blocks, v1::Grid* out) {
@@ -48,6 +41,11 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   src->set_num_points(points);
   src->set_format(grid.source->format);
+  const std::vector<BoundaryMatch>& matches = grid.source->connectivity.matches;
+  src->set_num_matches(static_cast<int>(matches.size()));
+  if (view == v1::GRID_VIEW_FULL) {
+    for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
+  }
   for (const auto& r : grid.revisions) {
     v1::RevisionInfo* info = out->add_revisions();
     info->set_revision(r->number);
@@ -81,6 +79,8 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   r->set_compression_ratio(static_cast<double>(points) /
                            std::max<int64_t>(rev.num_control_points(), 1));
   r->set_max_deviation(rev.max_deviation());
+  EncodeFitReport(rev.report, rev.blocks, r->mutable_report());
+  r->set_parent_revision(rev.parent);
   const bool full = view == v1::GRID_VIEW_FULL;
   auto wanted = [&](int b) {
     return blocks.empty() || std::find(blocks.begin(), blocks.end(), b) != blocks.end();
@@ -100,7 +100,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   for (int b = 0; b < num_blocks; ++b) {
     v1::SplineBlock* block = r->add_blocks();
     EncodeSplineBlock(rev.blocks[b].fitted, b, full && wanted(b), block);
-    EncodeBlockFit(rev.blocks[b], rev.fit_options, block->mutable_fit());
+    EncodeBlockFit(rev.blocks[b], rev.fit_options.tolerance_mode(), block->mutable_fit());
   }
   const int64_t bytes = static_cast<int64_t>(out->ByteSizeLong());
   if (bytes > kMaxMessageBytes) {

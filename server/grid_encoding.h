@@ -19,9 +19,6 @@ inline constexpr int64_t kMaxMessageBytes = (int64_t{4} << 20) - (64 << 10);
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
                         const std::vector<int>& blocks, v1::Grid* out);
 
-// A block's fit summary including the tolerance outcome.
-void EncodeBlockFit(const BlockFit& block, const GridFitOptions& options, v1::BlockFitSummary* out);
-
 }  // namespace splinegrid::server
 
 #endif  // SPLINEGRID_SERVER_GRID_ENCODING_H_

@@ -39,6 +39,18 @@ int64_t FittedBlockBytes(const FittedBlock& block) {
   return bytes + static_cast<int64_t>(sizeof(FittedBlock));
 }
 
+int64_t RevisionBytes(const GridFit& fit) {
+  int64_t bytes = 0;
+  for (const BlockFit& block : fit.blocks) {
+    bytes += FittedBlockBytes(block.fitted) + static_cast<int64_t>(sizeof(BlockFit)) +
+             static_cast<int64_t>(block.quality.bad_cells.size() * sizeof(Extents));
+  }
+  for (const std::vector<uint8_t>& kinds : fit.kinds.point_kinds) {
+    bytes += static_cast<int64_t>(kinds.size());
+  }
+  return bytes;
+}
+
 absl::Status GridStore::Create(std::shared_ptr<const StoredGrid> grid) {
   std::lock_guard<std::mutex> lock(mu_);
   const auto [it, inserted] = grids_.emplace(grid->id, grid);

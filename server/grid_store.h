@@ -21,7 +21,10 @@
 
 namespace splinegrid::server {
 
-enum class RevisionOrigin { kFit };
+enum class RevisionOrigin {
+  kFit,   // FitGrid
+  kFair,  // FairGrid: a faired refit of a parent revision's spec
+};
 
 // An immutable state of a grid's spline mapping.
 struct GridRevision {
@@ -29,7 +32,10 @@ struct GridRevision {
   absl::Time create_time;
   RevisionOrigin origin = RevisionOrigin::kFit;
   GridFitOptions fit_options;  // provenance
+  int64_t parent = 0;          // kFair: the revision it was faired from
   std::vector<BlockFit> blocks;
+  BoundaryKinds kinds;  // the boundary kinds the fit used (walls for curvature)
+  GridFitReport report;
   MemoryReservation memory;  // the bytes this revision holds in the budget
 
   int64_t num_control_points() const;
@@ -39,7 +45,8 @@ struct GridRevision {
 // The points a grid was imported from, with the budget they hold.
 struct SourcePoints {
   MultiBlockGrid grid;
-  std::string format;  // how it arrived, e.g. "plot3d ascii 2d single-block"
+  Connectivity connectivity;  // found at import
+  std::string format;         // how it arrived, e.g. "plot3d ascii 2d single-block"
   MemoryReservation memory;
 };
 
@@ -57,6 +64,9 @@ struct StoredGrid {
 
 // Bytes a block's spline, point distribution and summary take in memory.
 int64_t FittedBlockBytes(const FittedBlock& block);
+
+// Bytes a revision made of `fit` takes: its blocks and boundary kinds.
+int64_t RevisionBytes(const GridFit& fit);
 
 class GridStore {
  public:

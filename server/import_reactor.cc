@@ -194,6 +194,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     }
     upload_ = MemoryReservation();
     SG_ASSIGN_OR_RETURN(source->memory, state_->budget.Reserve(bytes, "the imported grid"));
+    SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
     auto grid = std::make_shared<StoredGrid>();
     grid->display_name = header_.display_name();
     grid->create_time = absl::Now();

@@ -99,47 +99,6 @@ grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerConte
   return reactor;
 }
 
-grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext* context,
-                                                     const v1::FitGridRequest* request,
-                                                     v1::FitGridResponse* response) {
-  CallLog log("FitGrid", request->name(), state_->options.log_calls);
-  CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
-    SG_ASSIGN_OR_RETURN(GridFitOptions options, ParseFitSpec(request->spec()));
-    const MultiBlockGrid& source = grid->source->grid;
-    SG_RETURN_IF_ERROR(options.Validate(source));
-    // Working memory of a fit: about the intermediate nets plus the parametrisation, bounded
-    // by the source size.
-    SG_ASSIGN_OR_RETURN(MemoryReservation work,
-                        state_->budget.Reserve(grid->source->memory.bytes(), "the fit"));
-    SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source, options, cancel));
-    GridRevision revision;
-    revision.create_time = absl::Now();
-    revision.origin = RevisionOrigin::kFit;
-    revision.fit_options = options;
-    int64_t bytes = 0;
-    for (const BlockFit& block : fit.blocks) bytes += FittedBlockBytes(block.fitted);
-    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(bytes, "the fitted revision"));
-    revision.blocks = std::move(fit.blocks);
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
-                        state_->store.AddRevision(id, std::move(revision)));
-    const GridRevision& published = *stored->revisions.back();
-    response->set_revision(published.number);
-    for (const BlockFit& block : published.blocks) {
-      EncodeBlockFit(block, published.fit_options, response->add_blocks());
-    }
-    response->set_num_points(fit.num_points);
-    response->set_num_control_points(fit.num_control_points);
-    response->set_compression_ratio(static_cast<double>(fit.num_points) /
-                                    std::max<int64_t>(fit.num_control_points, 1));
-    response->set_max_deviation(fit.max_deviation);
-    response->set_seconds(fit.seconds);
-    return absl::OkStatus();
-  });
-}
-
 grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext* context,
                                                      const v1::GetGridRequest* request,
                                                      v1::Grid* response) {

@@ -55,6 +55,12 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* FitGrid(grpc::CallbackServerContext* context,
                                     const v1::FitGridRequest* request,
                                     v1::FitGridResponse* response) override;
+  grpc::ServerUnaryReactor* FairGrid(grpc::CallbackServerContext* context,
+                                     const v1::FairGridRequest* request,
+                                     v1::FitGridResponse* response) override;
+  grpc::ServerUnaryReactor* GetWallCurvature(grpc::CallbackServerContext* context,
+                                             const v1::GetWallCurvatureRequest* request,
+                                             v1::GetWallCurvatureResponse* response) override;
   grpc::ServerUnaryReactor* GetGrid(grpc::CallbackServerContext* context,
                                     const v1::GetGridRequest* request, v1::Grid* response) override;
   grpc::ServerUnaryReactor* ListGrids(grpc::CallbackServerContext* context,
@@ -77,6 +83,12 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   // Runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       const std::function<absl::Status()>& work);
+
+  // Fits `grid`'s source with `options`, stores the result as a new revision (origin, parent)
+  // and fills `response`.
+  absl::Status FitAndStore(const StoredGrid& grid, const GridFitOptions& options,
+                           RevisionOrigin origin, int64_t parent, const CancelCheck& cancel,
+                           v1::FitGridResponse* response);
 
   ServiceState* state_;
 };

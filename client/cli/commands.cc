@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "absl/flags/flag.h"
 #include "absl/strings/numbers.h"
@@ -75,17 +76,48 @@ absl::Status Serve(const Args& args) {
   return server::RunServerUntilSignal(options);
 }
 
-absl::Status Fit(const Args& args) {
-  if (args.size() != 1)
-    return Usage("usage: splinegrid fit FILE [--name N] [--tol T | --ctl a,b,c]");
-  const std::string& path = args[0];
+namespace {
+
+// --fair: "" (none), "tol" (to tolerance) or a weight.
+absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag() {
+  const std::string text = absl::GetFlag(FLAGS_fair);
+  if (text.empty()) return std::nullopt;
+  v1::Fairing fairing;
+  if (text == "tol") {
+    fairing.set_mode(v1::FAIRING_MODE_TO_TOLERANCE);
+    return fairing;
+  }
+  double weight;
+  if (!absl::SimpleAtod(text, &weight) || !(weight > 0.0)) {
+    return Usage(absl::StrCat("--fair = '", text, "': give 'tol' or a positive weight"));
+  }
+  fairing.set_mode(v1::FAIRING_MODE_WEIGHT);
+  fairing.set_weight(weight);
+  return fairing;
+}
+
+// The FitSpec of the fit flags.
+absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   const double tol = absl::GetFlag(FLAGS_tol);
   const std::string ctl = absl::GetFlag(FLAGS_ctl);
-  if (tol != 0.0 && !ctl.empty()) return Usage("give --tol or --ctl, not both");
+  const bool kinds = absl::GetFlag(FLAGS_kinds) || absl::GetFlag(FLAGS_wall) != 0.0 ||
+                     absl::GetFlag(FLAGS_interface) != 0.0 || absl::GetFlag(FLAGS_outer) != 0.0 ||
+                     absl::GetFlag(FLAGS_interior) != 0.0 || absl::GetFlag(FLAGS_edge) >= 0.0;
+  if ((tol != 0.0) + !ctl.empty() + kinds > 1) {
+    return Usage("give one of --tol, --ctl and the tolerances by kind (--kinds, --wall, ...)");
+  }
   v1::FitSpec spec;
   spec.set_order(absl::GetFlag(FLAGS_order));
   if (tol != 0.0) {
     spec.set_tolerance(tol);
+    spec.set_max_controls_per_direction(absl::GetFlag(FLAGS_max_ctl));
+  } else if (kinds) {
+    v1::BoundaryTolerances* t = spec.mutable_boundary_tolerances();
+    t->set_wall(absl::GetFlag(FLAGS_wall));
+    t->set_interface(absl::GetFlag(FLAGS_interface));
+    t->set_outer(absl::GetFlag(FLAGS_outer));
+    t->set_interior(absl::GetFlag(FLAGS_interior));
+    if (absl::GetFlag(FLAGS_edge) >= 0.0) t->set_edge(absl::GetFlag(FLAGS_edge));
     spec.set_max_controls_per_direction(absl::GetFlag(FLAGS_max_ctl));
   } else if (!ctl.empty()) {
     SG_ASSIGN_OR_RETURN(const Extents counts, ParseTriple(ctl, "--ctl"));
@@ -93,6 +125,21 @@ absl::Status Fit(const Args& args) {
     spec.mutable_control_counts()->set_j(counts[1]);
     spec.mutable_control_counts()->set_k(counts[2]);
   }
+  SG_ASSIGN_OR_RETURN(const std::optional<v1::Fairing> fairing, ParseFairFlag());
+  if (fairing) *spec.mutable_fairing() = *fairing;
+  return spec;
+}
+
+}  // namespace
+
+absl::Status Fit(const Args& args) {
+  if (args.size() != 1) {
+    return Usage(
+        "usage: splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] "
+        "[--fair tol|LAMBDA]");
+  }
+  const std::string& path = args[0];
+  SG_ASSIGN_OR_RETURN(const v1::FitSpec spec, SpecFromFlags());
   SG_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
   const std::string id =
       absl::GetFlag(FLAGS_name).empty() ? IdFromPath(path) : absl::GetFlag(FLAGS_name);
@@ -242,6 +289,42 @@ absl::Status Eval(const Args& args) {
   Print(absl::StrCat("wrote ", out, ": ", result.blocks.size(), " block(s), ", points,
                      " points (revision ", result.revision, ")\n"),
         summary);
+  return absl::OkStatus();
+}
+
+absl::Status Fair(const Args& args) {
+  if (args.size() != 1)
+    return Usage("usage: splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]");
+  SG_ASSIGN_OR_RETURN(const std::optional<v1::Fairing> fairing, ParseFairFlag());
+  SG_ASSIGN_OR_RETURN(
+      const v1::FitGridResponse fit,
+      Connect()->Fair(args[0], absl::GetFlag(FLAGS_revision), fairing ? &*fairing : nullptr));
+  Print(FormatFit(client::GridName(args[0]), fit), fit);
+  return absl::OkStatus();
+}
+
+absl::Status Curvature(const Args& args) {
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (args.size() != 1) {
+    return Usage(
+        "usage: splinegrid curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]");
+  }
+  std::vector<int> blocks;
+  if (!absl::GetFlag(FLAGS_block).empty()) {
+    for (absl::string_view part : absl::StrSplit(absl::GetFlag(FLAGS_block), ',')) {
+      int b;
+      if (!absl::SimpleAtoi(part, &b)) {
+        return Usage(absl::StrCat("--block: '", part, "' is not an integer"));
+      }
+      blocks.push_back(b);
+    }
+  }
+  const int level = absl::GetFlag(FLAGS_level) < 0 ? 2 : absl::GetFlag(FLAGS_level);
+  SG_ASSIGN_OR_RETURN(
+      const v1::GetWallCurvatureResponse curvature,
+      Connect()->WallCurvature(args[0], absl::GetFlag(FLAGS_revision), level, blocks));
+  if (!out.empty()) SG_RETURN_IF_ERROR(WriteFileAtomically(out, CurvatureCsv(curvature)));
+  Print(FormatCurvature(client::GridName(args[0]), curvature, out), curvature.metrics());
   return absl::OkStatus();
 }
 

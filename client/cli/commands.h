@@ -18,6 +18,8 @@ absl::Status Fit(const Args& args);
 absl::Status Get(const Args& args);
 absl::Status List(const Args& args);
 absl::Status Eval(const Args& args);
+absl::Status Fair(const Args& args);
+absl::Status Curvature(const Args& args);
 absl::Status Remove(const Args& args);
 absl::Status Health(const Args& args);
 

@@ -11,16 +11,27 @@ ABSL_FLAG(double, tol, 0.0, "fit: largest allowed deviation, in the grid's lengt
 ABSL_FLAG(std::string, ctl, "", "fit: control points per direction, e.g. 24,16 or 24,16,8");
 ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
 ABSL_FLAG(bool, planar, true, "fit: store the 2D view of grids held as two planes (CFL3D style)");
-ABSL_FLAG(int, max_ctl, 0, "fit --tol: most control points per direction (0: no cap)");
+ABSL_FLAG(int, max_ctl, 0, "fit --tol/--kinds: most control points per direction (0: no cap)");
+ABSL_FLAG(bool, kinds, false,
+          "fit: tolerances by boundary kind (defaults 0.15e-3 wall, 2e-3 interface, 8e-3 outer)");
+ABSL_FLAG(double, wall, 0.0, "fit: wall tolerance (implies --kinds; 0: default)");
+ABSL_FLAG(double, interface, 0.0, "fit: block interface tolerance (implies --kinds; 0: default)");
+ABSL_FLAG(double, outer, 0.0, "fit: outer boundary tolerance (implies --kinds; 0: default)");
+ABSL_FLAG(double, interior, 0.0, "fit: tolerance inside blocks (implies --kinds; 0: none)");
+ABSL_FLAG(double, edge, -1.0,
+          "fit: relative accuracy of grid edges inside blocks (implies --kinds; <0: default 0.5)");
+ABSL_FLAG(std::string, fair, "",
+          "fit/fair: fairing: 'tol' (largest weight within the tolerances) or a weight lambda");
 
-ABSL_FLAG(int64_t, revision, 0, "get/eval: revision (0: latest)");
+ABSL_FLAG(int64_t, revision, 0, "get/eval/fair/curvature: revision (0: latest)");
 ABSL_FLAG(bool, full, false, "get: include knots, control points and distributions");
 
-ABSL_FLAG(int, level, -1, "eval: refinement level (0 = original points)");
+ABSL_FLAG(int, level, -1, "eval/curvature: refinement level (0 = original points)");
 ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
-ABSL_FLAG(std::string, block, "", "eval: blocks to evaluate, e.g. 0 or 0,3 (default: all)");
+ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
-ABSL_FLAG(std::string, o, "", "eval: output file (.vts, .vtm, .x binary or .xyz text Plot3D)");
+ABSL_FLAG(std::string, o, "",
+          "eval: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv");
 ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
 

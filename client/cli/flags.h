@@ -19,6 +19,13 @@ ABSL_DECLARE_FLAG(std::string, ctl);
 ABSL_DECLARE_FLAG(int, order);
 ABSL_DECLARE_FLAG(bool, planar);
 ABSL_DECLARE_FLAG(int, max_ctl);
+ABSL_DECLARE_FLAG(bool, kinds);
+ABSL_DECLARE_FLAG(double, wall);
+ABSL_DECLARE_FLAG(double, interface);
+ABSL_DECLARE_FLAG(double, outer);
+ABSL_DECLARE_FLAG(double, interior);
+ABSL_DECLARE_FLAG(double, edge);
+ABSL_DECLARE_FLAG(std::string, fair);
 // get
 ABSL_DECLARE_FLAG(int64_t, revision);
 ABSL_DECLARE_FLAG(bool, full);

@@ -1,7 +1,9 @@
 // splinegrid: the command-line tool of the splinegrid service.
 //
 //   splinegrid serve [--address host:port] [--threads N] [--memory_budget_mb M]
-//   splinegrid fit FILE [--name N] [--tol T | --ctl a,b,c]
+//   splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] [--fair F]
+//   splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]
+//   splinegrid curvature NAME [--revision R] [--level L] [-o OUT.csv]
 //   splinegrid get NAME [--full]      splinegrid list      splinegrid rm NAME
 //   splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}
 //   splinegrid health
@@ -20,7 +22,10 @@ namespace {
 constexpr char kUsage[] =
     "splinegrid: structured grids as B-spline mappings.\n"
     "  splinegrid serve [--address localhost:50051] [--threads N] [--memory_budget_mb M]\n"
-    "  splinegrid fit FILE [--name N] [--tol T | --ctl a,b,c]\n"
+    "  splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] |\n"
+    "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
+    "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]\n"
+    "  splinegrid curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]\n"
     "  splinegrid get NAME [--full] | list | rm NAME | health\n"
     "  splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}\n"
     "Client commands use --server host:port (default localhost:50051) and --json.";
@@ -39,6 +44,7 @@ int main(int argc, char** argv) {
       {"serve", splinegrid::cli::Serve},  {"fit", splinegrid::cli::Fit},
       {"get", splinegrid::cli::Get},      {"list", splinegrid::cli::List},
       {"eval", splinegrid::cli::Eval},    {"rm", splinegrid::cli::Remove},
+      {"fair", splinegrid::cli::Fair},    {"curvature", splinegrid::cli::Curvature},
       {"health", splinegrid::cli::Health}};
   const auto command = commands.find(positional[1]);
   if (command == commands.end()) {

@@ -23,26 +23,104 @@ std::string FormatExtents(const v1::Extents& e) {
   return absl::StrCat(e.i(), "x", e.j(), "x", e.k());
 }
 
+namespace {
+
+// "0.000145" or "-" for an absent optional deviation.
+template <typename T>
+std::string Optional(bool has, T value) {
+  return has ? absl::StrFormat("%.3g", value) : std::string("-");
+}
+
+std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c) {
+  return absl::StrFormat(
+      "  %s: %d lines, %d samples, %d curvature extrema, sum of squared differences %.4g, "
+      "max |curvature| %.4g\n",
+      label, c.lines(), c.samples(), c.extrema(), c.sum_squared_differences(),
+      c.max_abs_curvature());
+}
+
+}  // namespace
+
+std::string FormatReport(const v1::FitReport& r) {
+  std::string out;
+  absl::StrAppend(&out,
+                  absl::StrFormat("  tolerances: %s%s\n", r.tolerance_met() ? "met" : "NOT MET",
+                                  r.unmet_reason().empty() ? "" : ": " + r.unmet_reason()));
+  absl::StrAppend(&out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original "
+                                        "cells folded or resized beyond 2x; worst Jacobian ratio "
+                                        "%.3g, largest size ratio %.3g\n",
+                                        r.folded_cells(), r.bad_cells(), r.min_jacobian_ratio(),
+                                        r.max_size_ratio()));
+  absl::StrAppend(&out, absl::StrFormat("  connectivity: %d matches, largest gap %.3g\n",
+                                        r.num_matches(), r.max_gap()));
+  if (r.iterations() > 0 || r.knots_inserted() > 0) {
+    absl::StrAppend(&out, absl::StrFormat("  knots: %d inserted in %d rounds (%d quality rounds), "
+                                          "%d removed\n",
+                                          r.knots_inserted(), r.iterations(), r.quality_rounds(),
+                                          r.knots_removed()));
+  }
+  if (r.fairing_weight() > 0.0) {
+    absl::StrAppend(&out, absl::StrFormat("  fairing weight %.3g\n", r.fairing_weight()));
+  }
+  if (r.has_unfaired_wall_curvature()) {
+    absl::StrAppend(&out, FormatCurvatureLine("walls unfaired", r.unfaired_wall_curvature()));
+  }
+  if (r.wall_curvature().lines() > 0) {
+    absl::StrAppend(&out, FormatCurvatureLine("walls", r.wall_curvature()));
+  }
+  return out;
+}
+
 std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   std::string out = absl::StrFormat(
       "%s revision %d: %d points -> %d control points (%.1fx), max deviation %.3g, %.1f ms\n", name,
       fit.revision(), fit.num_points(), fit.num_control_points(), fit.compression_ratio(),
       fit.max_deviation(), 1e3 * fit.seconds());
-  absl::StrAppend(&out, absl::StrFormat("%6s %12s %10s %8s %11s %11s %16s %8s\n", "block", "points",
-                                        "controls", "ratio", "max dev", "rms dev", "max at", "ms"));
+  absl::StrAppend(&out, FormatReport(fit.report()));
+  absl::StrAppend(
+      &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %8s %8s %6s\n", "block",
+                            "points", "controls", "ratio", "max dev", "wall", "interface", "outer",
+                            "interior", "min jac", "max size", "bad"));
   for (int b = 0; b < fit.blocks_size(); ++b) {
     const v1::BlockFitSummary& s = fit.blocks(b);
+    const v1::DeviationByKind& k = s.deviation_by_kind();
+    const v1::CellQualityReport& q = s.quality();
     absl::StrAppend(
-        &out,
-        absl::StrFormat("%6d %12d %10d %8.1f %11.3g %11.3g %16s %8.1f%s\n", b, s.num_points(),
-                        s.num_control_points(), s.compression_ratio(), s.max_deviation(),
-                        s.rms_deviation(),
-                        absl::StrCat("(", s.max_deviation_at().i(), ",", s.max_deviation_at().j(),
-                                     ",", s.max_deviation_at().k(), ")"),
-                        1e3 * s.seconds(),
-                        s.has_tolerance_met() && !s.tolerance_met()
-                            ? absl::StrCat("  TOLERANCE NOT MET: ", s.unmet_reason())
-                            : ""));
+        &out, absl::StrFormat(
+                  "%6d %10d %9d %7.1f %10.3g %10s %10s %10s %10s %8.3g %8.3g %6d%s\n", b,
+                  s.num_points(), s.num_control_points(), s.compression_ratio(), s.max_deviation(),
+                  Optional(k.has_wall(), k.wall()), Optional(k.has_interface(), k.interface()),
+                  Optional(k.has_outer(), k.outer()), Optional(k.has_interior(), k.interior()),
+                  q.min_ratio(), q.max_ratio(), q.num_bad_cells(),
+                  s.has_tolerance_met() && !s.tolerance_met()
+                      ? absl::StrCat("  TOLERANCE NOT MET: ", s.unmet_reason())
+                      : ""));
+  }
+  return out;
+}
+
+std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureResponse& curvature,
+                            const std::string& csv_path) {
+  std::string out = absl::StrFormat("%s revision %d wall curvature\n", name, curvature.revision());
+  absl::StrAppend(&out, FormatCurvatureLine("walls", curvature.metrics()));
+  if (!csv_path.empty()) absl::StrAppend(&out, "  samples written to ", csv_path, "\n");
+  return out;
+}
+
+std::string CurvatureCsv(const v1::GetWallCurvatureResponse& curvature) {
+  std::string out =
+      "block,direction,start_i,start_j,start_k,line,sample,arc_length,x,y,z,curvature\n";
+  const int dim = curvature.spatial_dim();
+  for (int l = 0; l < curvature.lines_size(); ++l) {
+    const v1::WallCurvatureLine& line = curvature.lines(l);
+    for (int q = 0; q < line.curvature_size(); ++q) {
+      const double z = dim == 3 ? line.points(3 * q + 2) : 0.0;
+      absl::StrAppend(
+          &out, absl::StrFormat("%d,%d,%d,%d,%d,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                                line.block(), line.direction(), line.start().i(), line.start().j(),
+                                line.start().k(), l, q, line.arc_length(q), line.points(dim * q),
+                                line.points(dim * q + 1), z, line.curvature(q)));
+    }
   }
   return out;
 }

@@ -21,6 +21,17 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit);
 // One grid: source, revisions, blocks.
 std::string FormatGrid(const v1::Grid& grid);
 
+// The fit report's grid-wide lines (tolerances, quality, connectivity, fairing, curvature).
+std::string FormatReport(const v1::FitReport& report);
+
+// Wall curvature metrics, and where the samples were written (if anywhere).
+std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureResponse& curvature,
+                            const std::string& csv_path);
+
+// One CSV row per sample: block,direction,start_i,start_j,start_k,line,sample,arc_length,x,y,z,
+// curvature (z = 0 in 2D).
+std::string CurvatureCsv(const v1::GetWallCurvatureResponse& curvature);
+
 // A progress callback that redraws "label 12.3 / 45.6 MiB (27%)" on stderr when it is a
 // terminal (and prints nothing otherwise); Done() ends the line.
 class ProgressLine {

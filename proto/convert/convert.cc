@@ -1,6 +1,8 @@
 #include "proto/convert/convert.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
@@ -50,6 +52,23 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
     case v1::FitSpec::kTolerance:
       options.tolerance = spec.tolerance();
       break;
+    case v1::FitSpec::kBoundaryTolerances: {
+      const v1::BoundaryTolerances& given = spec.boundary_tolerances();
+      BoundaryTolerances t;
+      auto take = [](double value, double& field) {
+        if (value != 0.0) field = value;
+      };
+      take(given.wall(), t.wall);
+      take(given.interface(), t.interface);
+      take(given.outer(), t.outer);
+      take(given.interior(), t.interior);
+      if (given.has_edge()) t.edge = given.edge();
+      if (absl::Status s = t.Validate(); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("spec.boundary_tolerances: ", s.message()));
+      }
+      options.boundary_tolerances = t;
+      break;
+    }
     case v1::FitSpec::kControlCounts: {
       const Extents counts = ParseExtents(spec.control_counts());
       for (int d = 0; d < 3; ++d) {
@@ -68,7 +87,92 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
     options.block_control_counts.emplace_back(entry.block(), ParseExtents(entry.control_counts()));
   }
   options.max_controls_per_direction = spec.max_controls_per_direction();
+  SG_ASSIGN_OR_RETURN(options.fairing, ParseFairing(spec.fairing(), "spec.fairing"));
+  for (int q = 0; q < spec.face_kinds_size(); ++q) {
+    const v1::FaceKind& entry = spec.face_kinds(q);
+    const std::string field = absl::StrCat("spec.face_kinds[", q, "]");
+    SG_ASSIGN_OR_RETURN(const Face face, ParseBlockFace(entry.block(), entry.face(), field));
+    FaceKindOverride kind{face};
+    switch (entry.kind()) {
+      case v1::BOUNDARY_KIND_WALL:
+        kind.kind = BoundaryKind::kWall;
+        break;
+      case v1::BOUNDARY_KIND_INTERFACE:
+        kind.kind = BoundaryKind::kInterface;
+        break;
+      case v1::BOUNDARY_KIND_OUTER:
+        kind.kind = BoundaryKind::kOuter;
+        break;
+      default:
+        return absl::InvalidArgumentError(absl::StrCat(
+            field, ".kind = ", static_cast<int>(entry.kind()), " is not WALL, INTERFACE or OUTER"));
+    }
+    options.face_kinds.push_back(kind);
+  }
+  options.check_quality = !spec.skip_quality_refinement();
   return options;
+}
+
+v1::BlockFace EncodeBlockFace(int normal, bool upper) {
+  return static_cast<v1::BlockFace>(1 + 2 * normal + (upper ? 1 : 0));
+}
+
+absl::StatusOr<Face> ParseBlockFace(int block, v1::BlockFace face, const std::string& field) {
+  const int value = static_cast<int>(face);
+  if (value < v1::BLOCK_FACE_I_MIN || value > v1::BLOCK_FACE_K_MAX) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".face = ", value, " is not one of I_MIN .. K_MAX"));
+  }
+  if (block < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ".block = ", block, " is negative"));
+  }
+  return Face{block, (value - 1) / 2, (value - 1) % 2 == 1};
+}
+
+absl::StatusOr<FairingOptions> ParseFairing(const v1::Fairing& fairing, const std::string& field) {
+  FairingOptions options;
+  const double weight = fairing.weight();
+  if (!(weight >= 0.0) || !std::isfinite(weight)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".weight = ", weight, " is not a finite number >= 0"));
+  }
+  switch (fairing.mode()) {
+    case v1::FAIRING_MODE_UNSPECIFIED:
+    case v1::FAIRING_MODE_OFF:
+      options.mode = FairingMode::kOff;
+      break;
+    case v1::FAIRING_MODE_WEIGHT:
+      if (weight == 0.0) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ".weight = 0; mode WEIGHT needs a positive lambda"));
+      }
+      options.mode = FairingMode::kWeight;
+      options.weight = weight;
+      break;
+    case v1::FAIRING_MODE_TO_TOLERANCE:
+      options.mode = FairingMode::kToTolerance;
+      if (weight > 0.0) options.weight = weight;
+      break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".mode = ", static_cast<int>(fairing.mode()), " is not a known value"));
+  }
+  return options;
+}
+
+void EncodeFairing(const FairingOptions& fairing, v1::Fairing* out) {
+  switch (fairing.mode) {
+    case FairingMode::kOff:
+      out->set_mode(v1::FAIRING_MODE_OFF);
+      return;
+    case FairingMode::kWeight:
+      out->set_mode(v1::FAIRING_MODE_WEIGHT);
+      break;
+    case FairingMode::kToTolerance:
+      out->set_mode(v1::FAIRING_MODE_TO_TOLERANCE);
+      break;
+  }
+  out->set_weight(fairing.weight);
 }
 
 void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
@@ -76,9 +180,27 @@ void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
   out->set_parametrization(EncodeParametrization(options.parametrization));
   if (options.tolerance) {
     out->set_tolerance(*options.tolerance);
+  } else if (options.boundary_tolerances) {
+    const BoundaryTolerances& t = *options.boundary_tolerances;
+    v1::BoundaryTolerances* given = out->mutable_boundary_tolerances();
+    given->set_wall(t.wall);
+    given->set_interface(t.interface);
+    given->set_outer(t.outer);
+    given->set_interior(std::isfinite(t.interior) ? t.interior : 0.0);
+    given->set_edge(t.edge);
   } else {
     EncodeExtents(options.control_counts, out->mutable_control_counts());
   }
+  EncodeFairing(options.fairing, out->mutable_fairing());
+  for (const FaceKindOverride& o : options.face_kinds) {
+    v1::FaceKind* entry = out->add_face_kinds();
+    entry->set_block(o.face.block);
+    entry->set_face(EncodeBlockFace(o.face.normal, o.face.upper));
+    entry->set_kind(o.kind == BoundaryKind::kWall        ? v1::BOUNDARY_KIND_WALL
+                    : o.kind == BoundaryKind::kInterface ? v1::BOUNDARY_KIND_INTERFACE
+                                                         : v1::BOUNDARY_KIND_OUTER);
+  }
+  out->set_skip_quality_refinement(!options.check_quality);
   for (const auto& [block, counts] : options.block_control_counts) {
     v1::BlockControlCounts* entry = out->add_block_control_counts();
     entry->set_block(block);
@@ -97,6 +219,93 @@ void EncodeFitSummary(const FitSummary& summary, v1::BlockFitSummary* out) {
   out->set_seconds(summary.seconds);
 }
 
+void EncodeBlockFit(const BlockFit& block, bool tolerance_mode, v1::BlockFitSummary* out) {
+  EncodeFitSummary(block.fitted.summary, out);
+  if (tolerance_mode) {
+    out->set_tolerance_met(block.tolerance_met);
+    out->set_unmet_reason(block.unmet_reason);
+  }
+  const KindDeviation& d = block.deviation_by_kind;
+  v1::DeviationByKind* dev = out->mutable_deviation_by_kind();
+  if (d.wall >= 0.0) dev->set_wall(d.wall);
+  if (d.interface >= 0.0) dev->set_interface(d.interface);
+  if (d.outer >= 0.0) dev->set_outer(d.outer);
+  if (d.interior >= 0.0) dev->set_interior(d.interior);
+  const CellQuality& q = block.quality;
+  v1::CellQualityReport* quality = out->mutable_quality();
+  quality->set_cells_checked(q.cells_checked);
+  quality->set_cells_skipped(q.cells_skipped);
+  quality->set_folded(q.folded);
+  quality->set_out_of_size(q.out_of_size);
+  if (q.cells_checked > 0) {
+    quality->set_min_ratio(q.min_ratio);
+    quality->set_max_ratio(q.max_ratio);
+    EncodeExtents(q.worst_cell, quality->mutable_worst_cell());
+    quality->set_worst_level(q.worst_level);
+    quality->set_max_level(CellQualityOptions().max_level);
+  }
+  quality->set_num_bad_cells(q.num_bad_cells);
+}
+
+void EncodeCurvature(const CurvatureMetrics& metrics, v1::CurvatureReport* out) {
+  out->set_lines(metrics.lines);
+  out->set_samples(metrics.samples);
+  out->set_extrema(metrics.extrema);
+  out->set_sum_squared_differences(metrics.sum_squared_differences);
+  out->set_max_abs_curvature(metrics.max_abs_curvature);
+}
+
+void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& blocks,
+                     v1::FitReport* out) {
+  out->set_tolerance_met(report.tolerance_met);
+  out->set_unmet_reason(report.unmet_reason);
+  out->set_quality_met(report.quality_met);
+  out->set_num_matches(report.num_matches);
+  out->set_max_gap(report.max_gap);
+  out->set_fairing_weight(report.fairing_weight);
+  EncodeCurvature(report.wall_curvature, out->mutable_wall_curvature());
+  if (report.unfaired_wall_curvature.lines > 0) {
+    EncodeCurvature(report.unfaired_wall_curvature, out->mutable_unfaired_wall_curvature());
+  }
+  out->set_iterations(report.iterations);
+  out->set_knots_inserted(report.knots_inserted);
+  out->set_knots_removed(report.knots_removed);
+  out->set_quality_rounds(report.quality_rounds);
+  double min_ratio = std::numeric_limits<double>::infinity(), size_ratio = 0.0;
+  int64_t folded = 0, bad = 0;
+  for (const BlockFit& b : blocks) {
+    folded += b.quality.folded;
+    bad += b.quality.num_bad_cells;
+    if (b.quality.cells_checked == 0) continue;
+    min_ratio = std::min(min_ratio, b.quality.min_ratio);
+    size_ratio = std::max(size_ratio, b.quality.max_ratio);
+    if (b.quality.min_ratio > 0.0) size_ratio = std::max(size_ratio, 1.0 / b.quality.min_ratio);
+  }
+  out->set_folded_cells(folded);
+  out->set_bad_cells(bad);
+  if (std::isfinite(min_ratio)) {
+    out->set_min_jacobian_ratio(min_ratio);
+    out->set_max_size_ratio(size_ratio);
+  }
+}
+
+void EncodeBoundaryMatch(const BoundaryMatch& match, v1::BoundaryMatch* out) {
+  auto range = [](const FaceRange& r, v1::FaceRange* o) {
+    o->set_block(r.face.block);
+    o->set_face(EncodeBlockFace(r.face.normal, r.face.upper));
+    EncodeExtents(r.begin, o->mutable_begin());
+    EncodeExtents(r.end, o->mutable_end());
+  };
+  range(match.a, out->mutable_a());
+  range(match.b, out->mutable_b());
+  for (int d = 0; d < 3; ++d) {
+    out->add_b_direction(match.b_direction[d]);
+    out->add_reversed(match.reversed[d]);
+  }
+  out->set_step(match.step);
+  out->set_description(match.Describe());
+}
+
 void EncodeSplineBlock(const FittedBlock& block, int index, bool full, v1::SplineBlock* out) {
   out->set_index(index);
   out->set_spatial_dim(block.spline.spatial_dim());
@@ -109,6 +318,8 @@ void EncodeSplineBlock(const FittedBlock& block, int index, bool full, v1::Splin
       direction->mutable_knots()->Assign(knots.knots().begin(), knots.knots().end());
       const std::vector<double>& params = block.distribution.params(d);
       direction->mutable_parameters()->Assign(params.begin(), params.end());
+      const std::vector<int>& breaks = block.distribution.breaks(d);
+      direction->mutable_breaks()->Assign(breaks.begin(), breaks.end());
     }
   }
   if (full) {
@@ -125,8 +336,10 @@ absl::StatusOr<FittedBlock> ParseSplineBlock(const v1::SplineBlock& block) {
   }
   std::array<KnotVector, 3> knots;
   std::array<std::vector<double>, 3> params;
+  std::array<std::vector<int>, 3> breaks;
   for (int d = 0; d < 3; ++d) {
     const v1::SplineDirection& direction = block.directions(d);
+    breaks[d].assign(direction.breaks().begin(), direction.breaks().end());
     absl::StatusOr<KnotVector> kv =
         KnotVector::Create(direction.order(), {direction.knots().begin(), direction.knots().end()});
     if (!kv.ok()) {
@@ -140,7 +353,8 @@ absl::StatusOr<FittedBlock> ParseSplineBlock(const v1::SplineBlock& block) {
       TensorSpline spline,
       TensorSpline::Create(std::move(knots), block.spatial_dim(),
                            {block.control_points().begin(), block.control_points().end()}));
-  SG_ASSIGN_OR_RETURN(PointDistribution distribution, PointDistribution::Create(std::move(params)));
+  SG_ASSIGN_OR_RETURN(PointDistribution distribution,
+                      PointDistribution::Create(std::move(params), std::move(breaks)));
   FittedBlock fitted{std::move(spline), std::move(distribution), {}};
   const v1::BlockFitSummary& fit = block.fit();
   fitted.summary.num_points = fit.num_points();

@@ -5,6 +5,9 @@
 #ifndef SPLINEGRID_PROTO_CONVERT_CONVERT_H_
 #define SPLINEGRID_PROTO_CONVERT_CONVERT_H_
 
+#include <string>
+#include <vector>
+
 #include "absl/status/statusor.h"
 #include "core/fit/grid_fit.h"
 #include "core/fit/tensor_fit.h"
@@ -25,6 +28,26 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec);
 void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out);
 
 void EncodeFitSummary(const FitSummary& summary, v1::BlockFitSummary* out);
+
+// The per-block report: summary, tolerance outcome (tolerance mode), deviation by kind and
+// cell quality.
+void EncodeBlockFit(const BlockFit& block, bool tolerance_mode, v1::BlockFitSummary* out);
+
+// The grid-wide report (min Jacobian and max size ratio over `blocks`).
+void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& blocks,
+                     v1::FitReport* out);
+
+void EncodeCurvature(const CurvatureMetrics& metrics, v1::CurvatureReport* out);
+
+void EncodeBoundaryMatch(const BoundaryMatch& match, v1::BoundaryMatch* out);
+
+v1::BlockFace EncodeBlockFace(int normal, bool upper);
+// Face `face` of block `block`, or INVALID_ARGUMENT naming `field`.
+absl::StatusOr<Face> ParseBlockFace(int block, v1::BlockFace face, const std::string& field);
+
+// Fairing (mode and weight), validated; `field` names it in errors.
+absl::StatusOr<FairingOptions> ParseFairing(const v1::Fairing& fairing, const std::string& field);
+void EncodeFairing(const FairingOptions& fairing, v1::Fairing* out);
 
 // A fitted block as a SplineBlock: always order, control counts and the fit summary; with
 // `full` also knots, control points and the point distribution.

@@ -19,6 +19,7 @@ from splinegrid.client import (
     EvaluatedGrid,
     EvaluatedPoints,
     SplinegridError,
+    WallCurvatureLine,
     grid_name,
 )
 
@@ -29,5 +30,6 @@ __all__ = [
     "EvaluatedGrid",
     "EvaluatedPoints",
     "SplinegridError",
+    "WallCurvatureLine",
     "grid_name",
 ]

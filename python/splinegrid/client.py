@@ -56,6 +56,7 @@ __all__ = [
     "EvaluatedGrid",
     "EvaluatedPoints",
     "SplinegridError",
+    "WallCurvatureLine",
     "grid_name",
 ]
 
@@ -133,6 +134,16 @@ class EvaluatedPoints:
     du: Optional[np.ndarray] = None
     dv: Optional[np.ndarray] = None
     dw: Optional[np.ndarray] = None
+
+
+class WallCurvatureLine(NamedTuple):
+    """Curvature samples along one wall grid line (points start + t e_direction of a block)."""
+    block: int
+    direction: int           # 0 i, 1 j, 2 k
+    start: tuple[int, int, int]
+    arc_length: np.ndarray   # (n,)
+    points: np.ndarray       # (n, spatial_dim)
+    curvature: np.ndarray    # (n,), signed in 2-D (positive turning left)
 
 
 def grid_name(name_or_id: str) -> str:
@@ -260,29 +271,81 @@ class Client:
 
     def fit(self, name: str, control_counts: Optional[Triple] = None,
             tolerance: Optional[float] = None, order: int = 4,
-            max_controls: int = 0) -> service_pb2.FitGridResponse:
+            max_controls: int = 0,
+            boundary_tolerances: Optional[dict[str, float]] = None,
+            fairing: Union[None, str, float] = None) -> service_pb2.FitGridResponse:
         """Fits the grid's source points; the result is stored as a new revision.
 
-        Give either ``control_counts`` ``(a, b)`` or ``(a, b, c)`` (control points per
-        direction i, j, k for every block; 0 or a missing entry: as many as points) or a
-        ``tolerance`` (largest deviation, in the grid's length unit; knots are added until it
-        is met or ``max_controls`` per direction, 0 = no cap, is reached). Neither: interpolate.
+        Give one of ``control_counts`` ``(a, b)`` or ``(a, b, c)`` (control points per
+        direction i, j, k for every block; 0 or a missing entry: as many as points), a
+        ``tolerance`` (largest deviation of every point, in the grid's length unit) or
+        ``boundary_tolerances``, a dict with any of ``wall``, ``interface``, ``outer``,
+        ``interior`` and ``edge`` (missing: the paper's 0.15e-3, 2e-3, 8e-3, no interior
+        tolerance, edge 0.5; ``{}`` takes all defaults). With tolerances, knots are added until
+        they are met or ``max_controls`` per direction (0 = no cap) is reached, and the fit is
+        watertight across blocks. Neither: interpolate.
+
+        ``fairing``: ``"tol"`` (the largest fairing weight within the tolerances) or a weight.
 
         Returns the FitGridResponse proto: ``revision``, ``num_points``,
-        ``num_control_points``, ``compression_ratio``, ``max_deviation``, ``seconds`` and
-        ``blocks``, one BlockFitSummary per block (points, control points, ratio, max/RMS
-        deviation and where, and with a tolerance ``tolerance_met``/``unmet_reason``).
+        ``num_control_points``, ``compression_ratio``, ``max_deviation``, ``seconds``,
+        ``blocks`` (one BlockFitSummary per block: deviation overall and per boundary kind,
+        cell quality, tolerance outcome) and ``report`` (FitReport: tolerances met, cell
+        validity at refinement levels 0-2, connectivity and gaps, fairing weight, wall
+        curvature before and after fairing).
         """
-        if control_counts is not None and tolerance is not None:
-            raise ValueError("give control_counts or tolerance, not both")
+        given = [control_counts is not None, tolerance is not None,
+                 boundary_tolerances is not None]
+        if sum(given) > 1:
+            raise ValueError("give one of control_counts, tolerance and boundary_tolerances")
         spec = grid_pb2.FitSpec(order=order, max_controls_per_direction=max_controls)
         if tolerance is not None:
             spec.tolerance = tolerance
+        elif boundary_tolerances is not None:
+            unknown = set(boundary_tolerances) - {"wall", "interface", "outer", "interior", "edge"}
+            if unknown:
+                raise ValueError(f"boundary_tolerances: unknown kinds {sorted(unknown)}")
+            spec.boundary_tolerances.SetInParent()
+            for kind, value in boundary_tolerances.items():
+                setattr(spec.boundary_tolerances, kind, float(value))
         elif control_counts is not None:
             spec.control_counts.CopyFrom(_extents(control_counts, "control_counts", fill=0))
+        if fairing is not None:
+            spec.fairing.CopyFrom(_fairing(fairing))
         request = service_pb2.FitGridRequest(name=grid_name(name), spec=spec)
         with _translated_errors():
             return self.stub.FitGrid(request, timeout=self.timeout)
+
+    def fair(self, name: str, revision: int = 0,
+             fairing: Union[None, str, float] = None) -> service_pb2.FitGridResponse:
+        """Refits revision ``revision`` (0: latest) with fairing and stores a new revision.
+
+        ``fairing``: ``"tol"``, a weight, or None (the server's default: to tolerance for a
+        revision fitted to tolerances). Returns the FitGridResponse of the new revision; its
+        report compares the wall curvature with and without fairing.
+        """
+        request = service_pb2.FairGridRequest(name=grid_name(name), revision=revision)
+        if fairing is not None:
+            request.fairing.CopyFrom(_fairing(fairing))
+        with _translated_errors():
+            return self.stub.FairGrid(request, timeout=self.timeout)
+
+    def wall_curvature(self, name: str, revision: int = 0, level: int = 2,
+                       blocks: Blocks = None) -> list[WallCurvatureLine]:
+        """Curvature along every wall grid line of revision ``revision`` (0: latest), sampled at
+        refinement level ``level`` (2**level - 1 samples between grid points)."""
+        request = service_pb2.GetWallCurvatureRequest(
+            name=grid_name(name), revision=revision, refinement_level=level,
+            blocks=_block_list(blocks))
+        with _translated_errors():
+            response = self.stub.GetWallCurvature(request, timeout=self.timeout)
+        dim = response.spatial_dim
+        return [WallCurvatureLine(
+            block=line.block, direction=line.direction,
+            start=(line.start.i, line.start.j, line.start.k),
+            arc_length=np.asarray(line.arc_length, dtype=np.float64),
+            points=np.asarray(line.points, dtype=np.float64).reshape(-1, dim),
+            curvature=np.asarray(line.curvature, dtype=np.float64)) for line in response.lines]
 
     def get(self, name: str, revision: int = 0, full: bool = False,
             blocks: Iterable[int] = ()) -> grid_pb2.Grid:
@@ -451,6 +514,14 @@ def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
         raise ValueError(f"{what} = {values}; give 1 to 3 integers (i, j, k)")
     i, j, k = values + [fill] * (3 - len(values))
     return grid_pb2.Extents(i=i, j=j, k=k)
+
+
+def _fairing(fairing: Union[str, float]) -> grid_pb2.Fairing:
+    if fairing == "tol":
+        return grid_pb2.Fairing(mode=grid_pb2.FAIRING_MODE_TO_TOLERANCE)
+    if isinstance(fairing, str) or not float(fairing) > 0.0:
+        raise ValueError(f"fairing = {fairing!r}: give 'tol' or a positive weight")
+    return grid_pb2.Fairing(mode=grid_pb2.FAIRING_MODE_WEIGHT, weight=float(fairing))
 
 
 def _block_list(blocks: Blocks) -> list[int]:

@@ -1,0 +1,93 @@
+// FitGrid and FairGrid: fit a grid's source points and store the result as a new revision.
+#include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
+#include "server/service.h"
+
+namespace splinegrid::server {
+
+absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFitOptions& options,
+                                            RevisionOrigin origin, int64_t parent,
+                                            const CancelCheck& cancel,
+                                            v1::FitGridResponse* response) {
+  const MultiBlockGrid& source = grid.source->grid;
+  SG_RETURN_IF_ERROR(options.Validate(source));
+  // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
+  // evaluations of the deviation and quality checks, bounded by a few times the source size.
+  SG_ASSIGN_OR_RETURN(MemoryReservation work,
+                      state_->budget.Reserve(2 * grid.source->memory.bytes(), "the fit"));
+  SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source, options, cancel));
+  GridRevision revision;
+  revision.create_time = absl::Now();
+  revision.origin = origin;
+  revision.parent = parent;
+  revision.fit_options = options;
+  SG_ASSIGN_OR_RETURN(revision.memory,
+                      state_->budget.Reserve(RevisionBytes(fit), "the fitted revision"));
+  revision.blocks = std::move(fit.blocks);
+  revision.kinds = std::move(fit.kinds);
+  revision.report = fit.report;
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
+                      state_->store.AddRevision(grid.id, std::move(revision)));
+  const GridRevision& published = *stored->revisions.back();
+  response->set_revision(published.number);
+  for (const BlockFit& block : published.blocks) {
+    EncodeBlockFit(block, options.tolerance_mode(), response->add_blocks());
+  }
+  const GridFitReport& report = published.report;
+  response->set_num_points(report.num_points);
+  response->set_num_control_points(report.num_control_points);
+  response->set_compression_ratio(static_cast<double>(report.num_points) /
+                                  std::max<int64_t>(report.num_control_points, 1));
+  response->set_max_deviation(report.max_deviation);
+  response->set_seconds(report.seconds);
+  EncodeFitReport(report, published.blocks, response->mutable_report());
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext* context,
+                                                     const v1::FitGridRequest* request,
+                                                     v1::FitGridResponse* response) {
+  CallLog log("FitGrid", request->name(), state_->options.log_calls);
+  CancelCheck cancel = CallCancelCheck(context);
+  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const GridFitOptions options, ParseFitSpec(request->spec()));
+    return FitAndStore(*grid, options, RevisionOrigin::kFit, 0, cancel, response);
+  });
+}
+
+grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContext* context,
+                                                      const v1::FairGridRequest* request,
+                                                      v1::FitGridResponse* response) {
+  CallLog log("FairGrid", request->name(), state_->options.log_calls);
+  CancelCheck cancel = CallCancelCheck(context);
+  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    if (request->revision() < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("revision = ", request->revision(), " is negative"));
+    }
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
+                        grid->FindRevision(request->revision()));
+    GridFitOptions options = parent->fit_options;
+    if (request->has_fairing()) {
+      SG_ASSIGN_OR_RETURN(options.fairing, ParseFairing(request->fairing(), "fairing"));
+    } else if (options.tolerance_mode()) {
+      options.fairing = FairingOptions{FairingMode::kToTolerance};
+    } else {
+      return absl::InvalidArgumentError(
+          absl::StrCat("fairing is unset and revision ", parent->number,
+                       " was fitted with control counts: give a fairing weight (mode WEIGHT)"));
+    }
+    if (options.fairing.mode == FairingMode::kOff) {
+      return absl::InvalidArgumentError(
+          "fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
+    }
+    return FitAndStore(*grid, options, RevisionOrigin::kFair, parent->number, cancel, response);
+  });
+}
+
+}  // namespace splinegrid::server
