@@ -48,6 +48,9 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options
     if (!fit.ok()) return InBlock(b, fit.status());
     result.blocks.push_back(BlockFit{*std::move(fit)});
   }
+  if (options.fairing.mode == FairingMode::kWeight) {
+    result.report.fairing_weight = options.fairing.weight;
+  }
   SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid));
   SG_ASSIGN_OR_RETURN(result.kinds,
                       ClassifyBoundaries(grid, result.connectivity, options.face_kinds));

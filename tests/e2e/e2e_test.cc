@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/file_util.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -178,6 +180,40 @@ TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
                    "/python/examples/fit_and_refine.py --server=127.0.0.1:", port_));
   ASSERT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out, HasSubstr("(1, 257, 897, 2)"));  // level 2 of the 225 x 65 grid
+}
+
+TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
+  const Result fit =
+      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=coarse --kinds"));
+  ASSERT_EQ(fit.exit_code, 0) << fit.out;
+  EXPECT_THAT(fit.out, HasSubstr("tolerances: met"));
+  EXPECT_THAT(fit.out, HasSubstr("connectivity: 1 matches"));
+  const Result fair = Cli("fair coarse");
+  ASSERT_EQ(fair.exit_code, 0) << fair.out;
+  EXPECT_THAT(fair.out, HasSubstr("revision 2"));
+  EXPECT_THAT(fair.out, HasSubstr("walls unfaired"));
+  const std::string csv = (dir_ / "wall.csv").string();
+  const Result curvature = Cli(absl::StrCat("curvature coarse --revision=1 -o ", csv));
+  ASSERT_EQ(curvature.exit_code, 0) << curvature.out;
+  const std::string text = ReadFileToString(csv).value();
+  EXPECT_EQ(text.rfind("block,direction,start_i,start_j,start_k,line,sample,arc_length", 0), 0u);
+  // One wall line of the 113 x 33 C-grid: its airfoil points at refinement level 2, a header.
+  const int64_t rows = std::count(text.begin(), text.end(), '\n');
+  EXPECT_GT(rows, 4 * 60);
+  EXPECT_NE(Cli("curvature coarse --level=9").exit_code, 0);
+}
+
+TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
+  const std::string png = (dir_ / "curvature.png").string();
+  const Result python = RunCommand(
+      absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
+                   "/python/examples/fair_and_plot.py --server=127.0.0.1:", port_,
+                   " --grid=", SharedData("grids/n0012_113-33.p2dfmt"), " --png=", png));
+  ASSERT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("fairing weight"));
+  const std::string image = ReadFileToString(png).value();
+  ASSERT_GT(image.size(), 1000u);
+  EXPECT_EQ(image.substr(1, 3), "PNG");
 }
 
 TEST_F(EndToEndTest, SigtermDrainsAndExitsZeroWithOneLogLinePerCall) {

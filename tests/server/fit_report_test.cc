@@ -1,0 +1,189 @@
+// Fits to tolerances by boundary kind, their report, FairGrid and GetWallCurvature through the
+// service, and the errors of those requests.
+#include <cmath>
+
+#include "gmock/gmock.h"
+#include "tests/server/service_fixture.h"
+
+namespace splinegrid::testing {
+namespace {
+
+MATCHER_P2(StatusIs, code, fragment, "") {
+  const absl::Status status = arg;
+  *result_listener << "status " << status;
+  return status.code() == code && status.message().find(fragment) != std::string::npos;
+}
+
+class FitReportTest : public ServiceTest {
+ protected:
+  void SetUp() override {
+    ServiceTest::SetUp();
+    ImportShared("grids/n0012_113-33.p2dfmt", "naca");
+  }
+  // The paper's tolerances (the spec's defaults).
+  v1::FitGridResponse FitByKind() {
+    v1::FitSpec spec;
+    spec.mutable_boundary_tolerances();
+    absl::StatusOr<v1::FitGridResponse> fit = client_->Fit("naca", spec);
+    EXPECT_TRUE(fit.ok()) << fit.status();
+    return fit.ok() ? *fit : v1::FitGridResponse();
+  }
+};
+
+TEST_F(FitReportTest, FitByBoundaryKindMeetsEachKindsToleranceAndReportsIt) {
+  const v1::FitGridResponse fit = FitByKind();
+  const v1::FitReport& report = fit.report();
+  EXPECT_TRUE(report.tolerance_met()) << report.unmet_reason();
+  // The C-grid's wake cut is a match of the block with itself; fitted once, it is watertight.
+  EXPECT_GE(report.num_matches(), 1);
+  EXPECT_LT(report.max_gap(), 1e-12);
+  EXPECT_EQ(report.folded_cells(), 0);
+  EXPECT_GT(report.min_jacobian_ratio(), 0.0);
+  EXPECT_EQ(report.wall_curvature().lines(), 1);  // the airfoil
+  EXPECT_GT(report.wall_curvature().samples(), 4 * 50);
+  ASSERT_EQ(fit.blocks_size(), 1);
+  const v1::DeviationByKind& by_kind = fit.blocks(0).deviation_by_kind();
+  ASSERT_TRUE(by_kind.has_wall() && by_kind.has_interface() && by_kind.has_outer());
+  EXPECT_LE(by_kind.wall(), 0.15e-3);
+  EXPECT_LE(by_kind.interface(), 2e-3);
+  EXPECT_LE(by_kind.outer(), 8e-3);
+  EXPECT_GT(fit.blocks(0).quality().cells_checked(), 32 * 112 * (1 + 4 + 16) / 2);
+  EXPECT_GT(fit.compression_ratio(), 1.5);
+
+  // The stored revision carries the same report; the FULL view lists the connectivity.
+  const v1::Grid grid = client_->Get("naca", 0, v1::GRID_VIEW_FULL).value();
+  EXPECT_EQ(grid.revision().report().SerializeAsString(), report.SerializeAsString());
+  EXPECT_EQ(grid.source().num_matches(), report.num_matches());
+  ASSERT_EQ(grid.source().connectivity_size(), report.num_matches());
+  const v1::BoundaryMatch& cut = grid.source().connectivity(0);
+  EXPECT_EQ(cut.a().block(), 0);
+  EXPECT_EQ(cut.b().block(), 0);
+  EXPECT_EQ(cut.a().face(), v1::BLOCK_FACE_J_MIN);
+  EXPECT_THAT(cut.description(), ::testing::HasSubstr("reversed"));
+  // The basic view counts the matches without listing them.
+  const v1::Grid basic = client_->Get("naca").value();
+  EXPECT_EQ(basic.source().num_matches(), report.num_matches());
+  EXPECT_EQ(basic.source().connectivity_size(), 0);
+}
+
+TEST_F(FitReportTest, FairGridAddsAFairedRevisionWithinTheSameTolerances) {
+  const v1::FitGridResponse fit = FitByKind();
+  const v1::FitGridResponse faired = client_->Fair("naca", fit.revision()).value();
+  EXPECT_EQ(faired.revision(), fit.revision() + 1);
+  EXPECT_TRUE(faired.report().tolerance_met()) << faired.report().unmet_reason();
+  EXPECT_LT(faired.report().max_gap(), 1e-12);
+  // To tolerance: the same knots unfaired are reported for comparison.
+  ASSERT_TRUE(faired.report().has_unfaired_wall_curvature());
+  EXPECT_EQ(faired.report().unfaired_wall_curvature().samples(),
+            faired.report().wall_curvature().samples());
+  const v1::DeviationByKind& by_kind = faired.blocks(0).deviation_by_kind();
+  EXPECT_LE(by_kind.wall(), 0.15e-3);
+  EXPECT_LE(by_kind.outer(), 8e-3);
+  const v1::Grid grid = client_->Get("naca").value();
+  EXPECT_EQ(grid.revision().origin(), v1::REVISION_ORIGIN_FAIR);
+  EXPECT_EQ(grid.revision().parent_revision(), fit.revision());
+  EXPECT_EQ(grid.revision().fit_spec().fairing().mode(), v1::FAIRING_MODE_TO_TOLERANCE);
+}
+
+TEST_F(FitReportTest, FairGridOfACountsRevisionNeedsAWeight) {
+  FitCounts("naca", 40, 16);
+  EXPECT_THAT(client_->Fair("naca", 0).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "give a fairing weight"));
+  v1::Fairing tolerance;
+  tolerance.set_mode(v1::FAIRING_MODE_TO_TOLERANCE);
+  EXPECT_THAT(client_->Fair("naca", 0, &tolerance).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "fairing to tolerance needs"));
+  v1::Fairing weight;
+  weight.set_mode(v1::FAIRING_MODE_WEIGHT);
+  weight.set_weight(1e-3);
+  const v1::FitGridResponse faired = client_->Fair("naca", 1, &weight).value();
+  EXPECT_DOUBLE_EQ(faired.report().fairing_weight(), 1e-3);
+  const v1::Grid grid = client_->Get("naca").value();
+  EXPECT_EQ(grid.revision().fit_spec().fairing().mode(), v1::FAIRING_MODE_WEIGHT);
+  EXPECT_DOUBLE_EQ(grid.revision().fit_spec().fairing().weight(), 1e-3);
+  // Fairing changes the control points (same counts).
+  const v1::Grid one = client_->Get("naca", 1, v1::GRID_VIEW_FULL).value();
+  const v1::Grid two = client_->Get("naca", 2, v1::GRID_VIEW_FULL).value();
+  ASSERT_EQ(one.revision().blocks(0).control_points_size(),
+            two.revision().blocks(0).control_points_size());
+  EXPECT_NE(one.revision().blocks(0).SerializeAsString(),
+            two.revision().blocks(0).SerializeAsString());
+}
+
+TEST_F(FitReportTest, WallCurvatureSamplesEveryWallLine) {
+  const v1::FitGridResponse fit = FitByKind();
+  const v1::GetWallCurvatureResponse level2 = client_->WallCurvature("naca", 0, 2).value();
+  EXPECT_EQ(level2.revision(), fit.revision());
+  EXPECT_EQ(level2.spatial_dim(), 2);
+  ASSERT_EQ(level2.lines_size(), 1);
+  const v1::WallCurvatureLine& line = level2.lines(0);
+  EXPECT_EQ(line.direction(), 0);
+  const int samples = (line.length() - 1) * 4 + 1;
+  EXPECT_EQ(line.curvature_size(), samples);
+  EXPECT_EQ(line.arc_length_size(), samples);
+  EXPECT_EQ(line.points_size(), 2 * samples);
+  // The airfoil's arc length is a bit over two chords; the leading edge radius of a NACA 0012
+  // is 0.0158 chords (|curvature| about 63 there).
+  EXPECT_NEAR(line.arc_length(samples - 1), 2.03, 0.02);
+  double largest = 0.0;
+  for (double k : line.curvature()) largest = std::max(largest, std::abs(k));
+  EXPECT_GT(largest, 40.0);
+  EXPECT_EQ(level2.metrics().SerializeAsString(),
+            fit.report().wall_curvature().SerializeAsString());
+  const v1::GetWallCurvatureResponse level0 = client_->WallCurvature("naca", 0, 0).value();
+  EXPECT_EQ(level0.lines(0).curvature_size(), line.length());
+}
+
+TEST_F(FitReportTest, BadRequestsNameTheFieldAndValue) {
+  v1::FitSpec spec;
+  spec.mutable_boundary_tolerances()->set_wall(-1.0);
+  EXPECT_THAT(client_->Fit("naca", spec).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "tolerances.wall = -1"));
+  spec.mutable_boundary_tolerances()->set_wall(0.0);
+  spec.mutable_boundary_tolerances()->set_edge(2.0);
+  EXPECT_THAT(client_->Fit("naca", spec).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "tolerances.edge = 2"));
+  v1::FitSpec fairing;
+  fairing.mutable_fairing()->set_mode(v1::FAIRING_MODE_WEIGHT);
+  EXPECT_THAT(client_->Fit("naca", fairing).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "spec.fairing.weight = 0"));
+  fairing.mutable_fairing()->set_weight(std::nan(""));
+  EXPECT_THAT(client_->Fit("naca", fairing).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "spec.fairing.weight = nan"));
+  fairing.mutable_fairing()->set_mode(v1::FAIRING_MODE_TO_TOLERANCE);
+  fairing.mutable_fairing()->set_weight(0.0);
+  EXPECT_THAT(client_->Fit("naca", fairing).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "fairing to tolerance needs"));
+  v1::FitSpec kinds;
+  kinds.mutable_boundary_tolerances();
+  v1::FaceKind* face = kinds.add_face_kinds();
+  face->set_block(0);
+  face->set_face(static_cast<v1::BlockFace>(9));
+  face->set_kind(v1::BOUNDARY_KIND_WALL);
+  EXPECT_THAT(client_->Fit("naca", kinds).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "spec.face_kinds[0].face = 9"));
+  face->set_face(v1::BLOCK_FACE_I_MIN);
+  face->set_block(3);
+  EXPECT_THAT(client_->Fit("naca", kinds).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "face_kinds: block 3"));
+
+  // Not fitted yet; then bad levels and blocks.
+  EXPECT_THAT(client_->WallCurvature("naca", 0, 2).status(),
+              StatusIs(absl::StatusCode::kFailedPrecondition, "no revision yet"));
+  EXPECT_THAT(client_->Fair("naca", 0).status(),
+              StatusIs(absl::StatusCode::kFailedPrecondition, "no revision yet"));
+  FitCounts("naca", 30, 12);
+  EXPECT_THAT(client_->WallCurvature("naca", 0, 5).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "refinement_level = 5"));
+  EXPECT_THAT(client_->WallCurvature("naca", 0, 2, {1}).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "blocks: 1"));
+  EXPECT_THAT(client_->WallCurvature("naca", 7, 2).status(),
+              StatusIs(absl::StatusCode::kNotFound, "no revision 7"));
+  v1::Fairing off;
+  off.set_mode(v1::FAIRING_MODE_OFF);
+  EXPECT_THAT(client_->Fair("naca", 0, &off).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "fairing.mode = OFF"));
+}
+
+}  // namespace
+}  // namespace splinegrid::testing
