@@ -185,5 +185,25 @@ TEST_F(FitReportTest, BadRequestsNameTheFieldAndValue) {
               StatusIs(absl::StatusCode::kInvalidArgument, "fairing.mode = OFF"));
 }
 
+// A fit whose deadline passes stops at the next poll of the refinement loop: DEADLINE_EXCEEDED,
+// no revision, the work's memory back, the server still answering.
+TEST_F(FitReportTest, ALongFitHonoursItsDeadline) {
+  ImportShared("grids/rae2822_257x97.fmt", "rae");
+  const int64_t idle = server_->state().budget.used();
+  v1::FitGridRequest request;
+  request.set_name("grids/rae");
+  request.mutable_spec()->mutable_boundary_tolerances();  // about a second of work
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(50));
+  v1::FitGridResponse response;
+  const auto start = std::chrono::steady_clock::now();
+  const grpc::Status status = client_->stub().FitGrid(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_TRUE(WaitForBudget(idle));
+  EXPECT_LT(std::chrono::steady_clock::now() - start,
+            std::chrono::milliseconds(1000));  // the whole fit takes ~1.5 s
+  EXPECT_EQ(client_->Get("rae").value().latest_revision(), 0);
+}
+
 }  // namespace
 }  // namespace splinegrid::testing
