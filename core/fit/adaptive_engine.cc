@@ -253,9 +253,14 @@ class Engine {
     bool any_room = false;
     for (int c = 0; c < model_.num_classes(); ++c) {
       SegmentModel::Class& cls = model_.mutable_class(c);
+      // A class knot adds a control to every member: a direction holding several segments of
+      // the class (the two wake segments of a C-grid) gains several per knot.
+      std::map<std::pair<int, int>, int> per_direction;
+      for (const auto& mem : cls.members) ++per_direction[{mem.block, mem.dir}];
       int room = std::numeric_limits<int>::max();
-      for (const auto& mem : cls.members) {
-        room = std::min(room, model_.cap(mem.block, mem.dir) - model_.Controls(mem.block, mem.dir));
+      for (const auto& [key, count] : per_direction) {
+        const auto [b, d] = key;
+        room = std::min(room, (model_.cap(b, d) - model_.Controls(b, d)) / count);
       }
       if (room <= 0) continue;
       any_room = true;

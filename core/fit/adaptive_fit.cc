@@ -14,7 +14,6 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
                                                   std::span<const double> tolerance,
                                                   const ToleranceFitOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const Extents& m = block.extents();
   if (options.order < 2 || options.order > kMaxOrder) {
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", options.order, " is outside [2, ", kMaxOrder, "]"));

@@ -46,7 +46,9 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options
     fit_options.cancel = cancel;
     absl::StatusOr<FittedBlock> fit = FitBlock(grid.blocks[b], fit_options);
     if (!fit.ok()) return InBlock(b, fit.status());
-    result.blocks.push_back(BlockFit{*std::move(fit)});
+    BlockFit block;
+    block.fitted = *std::move(fit);
+    result.blocks.push_back(std::move(block));
   }
   if (options.fairing.mode == FairingMode::kWeight) {
     result.report.fairing_weight = options.fairing.weight;
@@ -71,7 +73,8 @@ absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& o
   mb.cancel = cancel;
   SG_ASSIGN_OR_RETURN(MultiBlockFit fit, FitMultiBlock(grid, mb));
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
-    BlockFit block{std::move(fit.blocks[b])};
+    BlockFit block;
+    block.fitted = std::move(fit.blocks[b]);
     block.tolerance_met = fit.reports[b].tolerance_met;
     block.unmet_reason = std::move(fit.reports[b].unmet_reason);
     block.deviation_by_kind = fit.reports[b].max_deviation;

@@ -88,7 +88,9 @@ class EndToEndTest : public ::testing::Test {
   }
 
   void TearDown() override {
-    if (server_ > 0 && !stopped_) EXPECT_EQ(Stop(), 0) << ReadLog();
+    if (server_ > 0 && !stopped_) {
+      EXPECT_EQ(Stop(), 0) << ReadLog();
+    }
     std::filesystem::remove_all(dir_);
   }
 

@@ -185,6 +185,22 @@ TEST_F(FitReportTest, BadRequestsNameTheFieldAndValue) {
               StatusIs(absl::StatusCode::kInvalidArgument, "fairing.mode = OFF"));
 }
 
+// A tolerance below what the control cap allows is reported, naming the boundary point that
+// misses it; the revision is still stored (it is the best fit within the cap).
+TEST_F(FitReportTest, AnImpossibleToleranceIsReportedNotLooped) {
+  v1::FitSpec spec;
+  spec.mutable_boundary_tolerances()->set_wall(1e-12);
+  spec.set_max_controls_per_direction(20);
+  const v1::FitGridResponse fit = client_->Fit("naca", spec).value();
+  EXPECT_FALSE(fit.report().tolerance_met());
+  EXPECT_THAT(fit.report().unmet_reason(), ::testing::HasSubstr("wall point ("));
+  EXPECT_THAT(fit.report().unmet_reason(), ::testing::HasSubstr("tolerance of 1e-12"));
+  ASSERT_EQ(fit.blocks_size(), 1);
+  EXPECT_FALSE(fit.blocks(0).tolerance_met());
+  const v1::Grid grid = client_->Get("naca").value();
+  EXPECT_LE(grid.revision().blocks(0).directions(0).num_controls(), 20);
+}
+
 // A fit whose deadline passes stops at the next poll of the refinement loop: DEADLINE_EXCEEDED,
 // no revision, the work's memory back, the server still answering.
 TEST_F(FitReportTest, ALongFitHonoursItsDeadline) {
