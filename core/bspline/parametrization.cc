@@ -3,6 +3,7 @@
 #include <cmath>
 #include <memory>
 
+#include "absl/strings/str_cat.h"
 #include "core/util/check.h"
 
 namespace splinegrid {
@@ -17,6 +18,17 @@ std::string_view ParametrizationName(Parametrization p) {
       return "centripetal";
   }
   return "unknown";
+}
+
+absl::Status ValidateParametrization(Parametrization p) {
+  switch (p) {
+    case Parametrization::kUniform:
+    case Parametrization::kChordLength:
+    case Parametrization::kCentripetal:
+      return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("parametrization = ", static_cast<int>(p), " is not a known value"));
 }
 
 namespace {

@@ -26,6 +26,9 @@ enum class Parametrization {
 // "uniform", "chord_length" or "centripetal".
 std::string_view ParametrizationName(Parametrization p);
 
+// OK for the three values above; INVALID_ARGUMENT naming the value otherwise (a cast integer).
+absl::Status ValidateParametrization(Parametrization p);
+
 // Parameters of the three grid directions (i, j, k) of `block`, each averaged over all grid
 // lines of that direction. Always strictly increasing from 0 to 1: increments that vanish on
 // every line (repeated points) get a small share of a uniform increment, so the parameters stay

@@ -18,6 +18,8 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", options.order, " is outside [2, ", kMaxOrder, "]"));
   }
+  SG_RETURN_IF_ERROR(ValidateParametrization(options.parametrization));
+  SG_RETURN_IF_ERROR(options.features.Validate());
   if (options.max_controls_per_direction < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_controls_per_direction = ", options.max_controls_per_direction, " is negative"));

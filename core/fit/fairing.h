@@ -5,8 +5,8 @@
 // the jump
 //   J_q(P) = s^(k-1)(t_q+) - s^(k-1)(t_q-) = sum_j (N_j^(k-1)(t_q+) - N_j^(k-1)(t_q-)) P_j
 // involves the k + 1 controls P_{q-k} .. P_q. For cubics (k = 4) it is the jump of the third
-// derivative; on uniform knots of width h, h^3 J_q = -P_{q-4} + 4 P_{q-3} - 6 P_{q-2} + 4 P_{q-1}
-// - P_q, a fourth difference of neighbouring control points. A spline whose jumps vanish is a
+// derivative; on uniform knots of width h, h^3 J_q = P_{q-4} - 4 P_{q-3} + 6 P_{q-2} - 4 P_{q-1}
+// + P_q, a fourth difference of neighbouring control points. A spline whose jumps vanish is a
 // single polynomial, so penalising them pulls the fit towards the smoothest shape the data
 // allow. The fit minimises
 //   sum_r |s(u_r) - x_r|^2 + lambda sum_q m_q (h_q^(k-1) J_q)^2,

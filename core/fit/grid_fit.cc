@@ -112,6 +112,7 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
         absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
   }
   SG_RETURN_IF_ERROR(fairing.Validate());
+  SG_RETURN_IF_ERROR(ValidateParametrization(parametrization));
   const int num_blocks = static_cast<int>(grid.blocks.size());
   for (const FaceKindOverride& o : face_kinds) {
     if (o.face.block < 0 || o.face.block >= num_blocks) {

@@ -204,7 +204,10 @@ absl::Status MultiBlockFitOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("max_iterations = ", max_iterations, " is negative"));
   }
+  SG_RETURN_IF_ERROR(ValidateParametrization(parametrization));
   SG_RETURN_IF_ERROR(tolerances.Validate());
+  SG_RETURN_IF_ERROR(connectivity.Validate());
+  SG_RETURN_IF_ERROR(features.Validate());
   SG_RETURN_IF_ERROR(quality.Validate());
   SG_RETURN_IF_ERROR(fairing.Validate());
   return absl::OkStatus();

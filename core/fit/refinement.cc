@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "absl/strings/str_cat.h"
 #include "core/bspline/basis.h"
 #include "core/bspline/contraction.h"
 #include "core/util/status_macros.h"
@@ -33,6 +34,22 @@ double EdgeLimit(double a, double b) {
 }
 
 }  // namespace
+
+absl::Status FeatureOptions::Validate() const {
+  const std::pair<const char*, double> angles[] = {{"angle_degrees", angle_degrees},
+                                                   {"spike_degrees", spike_degrees}};
+  for (const auto& [name, value] : angles) {
+    if (!(value >= 0.0 && value <= 180.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("features.", name, " = ", value, " is outside [0, 180]"));
+    }
+  }
+  if (!(spike_ratio >= 1.0) || !std::isfinite(spike_ratio)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("features.spike_ratio = ", spike_ratio, " is not a finite number >= 1"));
+  }
+  return absl::OkStatus();
+}
 
 ErrorAssessment AssessErrors(const StructuredBlock& block, const double* fitted,
                              std::span<const double> tolerance,

@@ -57,6 +57,9 @@ struct FeatureOptions {
   double angle_degrees = 30.0;
   double spike_degrees = 4.0;
   double spike_ratio = 4.0;
+
+  // INVALID_ARGUMENT naming the field unless the angles are in [0, 180] and spike_ratio >= 1.
+  absl::Status Validate() const;
 };
 std::vector<int> DetectFeatures(const StructuredBlock& block, int d, const FeatureOptions& options);
 

@@ -84,24 +84,11 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
       if (q > 0 && q < model.directions_[l.bb][l.db].m - 1) required[l.bb][l.db].insert(q);
     }
   }
-  // Features that keep at least `order` points per segment next to the required splits and to
-  // each other.
   for (int b = 0; b < nb; ++b) {
-    for (int d = 0; d < 3; ++d) {
-      const Direction& dir = model.directions_[b][d];
-      splits[b][d] = required[b][d];
-      if (dir.m == 1) continue;
-      for (int f : features[b][d]) {
-        bool fits = f >= dir.order - 1 && f <= dir.m - dir.order;
-        for (int s : splits[b][d]) fits &= std::abs(f - s) >= dir.order - 1;
-        // Each split costs order - 1 controls; features must stay within the cap.
-        const int controls =
-            dir.order + static_cast<int>(splits[b][d].size() + 1) * (dir.order - 1);
-        if (fits && controls <= dir.cap) splits[b][d].insert(f);
-      }
-    }
+    for (int d = 0; d < 3; ++d) splits[b][d] = required[b][d];
   }
-  // Propagate splits through the matches until every matched range is cut the same way.
+  // Propagate the required splits through the matches until every matched range is cut the
+  // same way.
   for (bool changed = true; changed;) {
     changed = false;
     for (const RangeLink& l : links) {
@@ -126,6 +113,56 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
         }
         if (splits[l.ba][l.da].insert(r).second) changed = true;
         if (required[l.bb][l.db].count(q)) required[l.ba][l.da].insert(r);
+      }
+    }
+  }
+  // Features, each together with its images through the matches (its orbit) or not at all:
+  // every image must keep order - 1 intervals to the ends of its direction, to the splits
+  // already there and to the orbit's other points, must not fall between two points of a
+  // coarse side (a kink on a hanging node is kept smooth) and must stay within its direction's
+  // cap. A feature judged on its own direction only could cut the coarse side of a hanging-node
+  // match too short (fine index 4 is coarse index 2).
+  for (int b = 0; b < nb; ++b) {
+    for (int d = 0; d < 3; ++d) {
+      if (model.directions_[b][d].m == 1) continue;
+      for (int f : features[b][d]) {
+        std::vector<std::array<int, 3>> orbit = {{b, d, f}};  // (block, direction, index)
+        bool ok = true;
+        for (size_t i = 0; ok && i < orbit.size(); ++i) {
+          const auto [ob, od, r] = orbit[i];
+          if (splits[ob][od].count(r)) continue;  // already cut, with all its images
+          const Direction& dir = model.directions_[ob][od];
+          bool fits = r >= dir.order - 1 && r <= dir.m - dir.order;
+          for (int s : splits[ob][od]) fits &= std::abs(r - s) >= dir.order - 1;
+          int cuts = static_cast<int>(splits[ob][od].size()) + 1;
+          for (size_t o = 0; o < i; ++o) {
+            if (orbit[o][0] != ob || orbit[o][1] != od || splits[ob][od].count(orbit[o][2])) {
+              continue;
+            }
+            fits &= std::abs(r - orbit[o][2]) >= dir.order - 1;
+            ++cuts;
+          }
+          // Each split costs order - 1 controls.
+          ok = fits && dir.order + cuts * (dir.order - 1) <= dir.cap;
+          auto add = [&](int ib, int id, int ir) {
+            const std::array<int, 3> image = {ib, id, ir};
+            if (std::find(orbit.begin(), orbit.end(), image) == orbit.end()) orbit.push_back(image);
+          };
+          for (const RangeLink& l : links) {
+            if (!ok) break;
+            if (l.ba == ob && l.da == od && r > l.a0 && r < l.a1) add(l.bb, l.db, l.MapAB(r));
+            if (l.bb == ob && l.db == od && r > std::min(l.b0, l.b1) && r < std::max(l.b0, l.b1)) {
+              const int q = l.MapBA(r);
+              if (q < 0) {
+                ok = false;  // between two coarse points: keep the kink smooth
+              } else {
+                add(l.ba, l.da, q);
+              }
+            }
+          }
+        }
+        if (!ok) continue;
+        for (const auto& [ob, od, r] : orbit) splits[ob][od].insert(r);
       }
     }
   }

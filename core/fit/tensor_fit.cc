@@ -45,6 +45,7 @@ absl::Status FitOptions::Validate(const Extents& points) const {
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
   }
+  SG_RETURN_IF_ERROR(ValidateParametrization(parametrization));
   if (!(fairing >= 0.0) || !std::isfinite(fairing)) {
     return absl::InvalidArgumentError(
         absl::StrCat("fairing = ", fairing, " is not a finite number >= 0"));

@@ -225,8 +225,11 @@ class MatchGrower {
               nhi[o] = hi[o];
             }
           }
-          if (RowCoincides(match, xa, xb, nlo, nhi)) {
-            (side < 0 ? lo[d] : hi[d]) += side;
+          Extents glo = lo, ghi = hi;  // the grown range
+          (side < 0 ? glo[d] : ghi[d]) += side;
+          if (RowCoincides(match, xa, xb, nlo, nhi) && !OverlapsItsImage(match, xa, xb, glo, ghi)) {
+            lo = glo;
+            hi = ghi;
             grew = true;
           }
         }
@@ -275,6 +278,24 @@ class MatchGrower {
       return index_.Coincide(a, na, b, nb);
     }
     return false;
+  }
+
+  // Whether range [lo, hi] of a self-match on one face (a C-grid's wake cut) overlaps its own
+  // image by more than one layer of points. The two sides of a wake cut may share the point
+  // where the wall line folds back (the trailing edge of a zero-thickness body) but no more:
+  // grown past it, the range would cover the whole line, mapped onto itself.
+  static bool OverlapsItsImage(const BoundaryMatch& m, const Extents& xa, const Extents& xb,
+                               const Extents& lo, const Extents& hi) {
+    if (!(m.a.face == m.b.face)) return false;
+    const Extents ylo = Map(m, xa, xb, lo), yhi = Map(m, xa, xb, hi);
+    for (int d = 0; d < 3; ++d) {
+      if (m.b_direction[d] < 0) continue;
+      const int e = m.b_direction[d];  // a tangential direction of the face, as is d
+      const int shared =
+          std::min(hi[e], std::max(ylo[e], yhi[e])) - std::max(lo[e], std::min(ylo[e], yhi[e]));
+      if (shared <= 0) return false;  // at most one layer in common along e
+    }
+    return true;
   }
 
   bool RowCoincides(const BoundaryMatch& m, const Extents& xa, const Extents& xb, const Extents& lo,
@@ -383,8 +404,26 @@ std::vector<Face> BlockFaces(const StructuredBlock& block, int b) {
   return faces;
 }
 
+absl::Status ConnectivityOptions::Validate() const {
+  if (!std::isfinite(absolute_tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("connectivity.absolute_tolerance = ", absolute_tolerance, " is not finite"));
+  }
+  if (!(relative_tolerance > 0.0) || !std::isfinite(relative_tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("connectivity.relative_tolerance = ", relative_tolerance,
+                     " is not a positive finite number"));
+  }
+  if (min_points < 2) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("connectivity.min_points = ", min_points, " is below 2"));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
                                               const ConnectivityOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
   Connectivity connectivity;
   if (grid.blocks.empty()) return connectivity;
   const int s = grid.blocks.front().spatial_dim();

@@ -63,6 +63,10 @@ struct ConnectivityOptions {
   double relative_tolerance = 1e-3;
   // Matches of fewer points are ignored (a shared corner point alone is not a match).
   int min_points = 2;
+
+  // INVALID_ARGUMENT naming the field: tolerances must be finite, relative_tolerance > 0 and
+  // min_points >= 2.
+  absl::Status Validate() const;
 };
 
 struct Connectivity {
@@ -70,8 +74,8 @@ struct Connectivity {
 };
 
 // Finds all matches between the boundaries of `grid`'s blocks. Cost about O(boundary points)
-// (hashed), plus O(matched points) to grow the matches. Errors: INVALID_ARGUMENT for blocks of
-// different spatial dimensions or non-finite coordinates (naming the block and point).
+// (hashed), plus O(matched points) to grow the matches. Errors: INVALID_ARGUMENT for bad options,
+// blocks of different spatial dimensions or non-finite coordinates (naming the block and point).
 absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
                                               const ConnectivityOptions& options = {});
 
