@@ -1,0 +1,442 @@
+// FitAirfoil (airfoil_fit.h): options and outline validation, feature points, knot placement
+// (insertion, then removal), fairing to tolerance and the assembly of the result. The fits
+// themselves are ProfileFitter's (profile_fitter.h), the curvature measures those of
+// profile_curvature.h, and the outline's simplicity check FindPolylineCrossing's (polyline.h).
+#include "core/fit/airfoil_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/fit/profile_curvature.h"
+#include "core/fit/profile_fitter.h"
+#include "core/grid/polyline.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// Fewest points of an outline (as io/airfoil.h reads).
+constexpr int kMinPoints = 5;
+// Consecutive points closer than this fraction of the outline's bounding-box diagonal repeat.
+constexpr double kRepeatRelTol = 1e-12;
+// Knot placement screens every candidate knot vector with kScreenCorrections rounds (the
+// parameters are warm-started from the previous fit) and converges only candidates that miss
+// the target by less than the factor kScreenMargin.
+constexpr int kScreenCorrections = 3;
+constexpr double kScreenMargin = 1.5;
+// Removal passes over the knots (each pass tries every knot once).
+constexpr int kRemovalPasses = 3;
+// Fairing search: lambda = weight 10^-e for e = 0 .. kFairingDecades, then bisections of the
+// last decade on a log scale (a factor 10^(1/16) = 1.15), as the adaptive engine does.
+constexpr int kFairingDecades = 14;
+constexpr int kFairingBisections = 4;
+// A feature point turns by at least this multiple of its neighbours' turning (OutlineFeatures).
+constexpr double kKinkRatio = 2.0;
+// A fit whose curvature exceeds this multiple of the reference's largest has a cusp or a tiny
+// loop that the distances cannot see (parameter correction can bunch parameters until the
+// speed |C'| nearly vanishes); it is not accepted.
+constexpr double kCurvatureGuard = 2.0;
+
+// |J_q| of `curve` at its simple interior knots, in knot order: the scaled jumps of the third
+// derivative (fairing.h, ScaledDerivativeJumps) of both coordinates.
+std::vector<double> JumpMagnitudes(const Curve& curve) {
+  const size_t n = curve.control.size() / 2;
+  std::vector<double> x(n), y(n);
+  for (size_t j = 0; j < n; ++j) x[j] = curve.control[2 * j], y[j] = curve.control[2 * j + 1];
+  const std::vector<double> jx = ScaledDerivativeJumps(curve.knots, x);
+  const std::vector<double> jy = ScaledDerivativeJumps(curve.knots, y);
+  std::vector<double> jump(jx.size());
+  for (size_t q = 0; q < jx.size(); ++q) jump[q] = std::hypot(jx[q], jy[q]);
+  return jump;
+}
+
+// Row factors that cap every jump row of `curve`'s knots at the median jump: the row of a knot
+// whose unfaired jump |J_q| exceeds the median M is scaled by M / |J_q|. The nose needs jumps a
+// hundred times the others; with equal weights its rows would bind the tolerance long before
+// the surfaces are faired.
+std::vector<double> MedianCappedScales(const Curve& curve) {
+  const std::vector<double> jump = JumpMagnitudes(curve);
+  if (jump.empty()) return {};
+  std::vector<double> sorted = jump;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::vector<double> scale(jump.size(), 1.0);
+  for (size_t q = 0; q < jump.size(); ++q) {
+    if (jump[q] > median) scale[q] = median / jump[q];
+  }
+  return scale;
+}
+
+// File comment, step 5: the largest lambda <= weight whose fit is within `tolerance` and
+// `accept`ed, or `unfaired` (lambda 0) when none is. Trials are screened (kScreenCorrections).
+absl::StatusOr<Fitted> FairToTolerance(ProfileFitter& fitter, const std::vector<double>& interior,
+                                       const Fitted& unfaired, double weight, double tolerance,
+                                       const std::function<bool(const Fitted&)>& accept) {
+  Penalty penalty{0.0, MedianCappedScales(unfaired.curve)};
+  std::optional<Fitted> good;
+  double bad = 0.0;
+  auto try_lambda = [&](double lambda) -> absl::StatusOr<bool> {
+    penalty.lambda = lambda;
+    absl::StatusOr<Fitted> fit =
+        FitAndMeasure(fitter, interior, penalty, unfaired.params, kScreenCorrections);
+    if (fit.ok() && fit->max() <= kScreenMargin * tolerance) {
+      fit = FitAndMeasure(fitter, interior, penalty, fit->params);
+    }
+    if (fit.status().code() == absl::StatusCode::kCancelled) return fit.status();
+    if (!fit.ok() || !(fit->max() <= tolerance) || !accept(*fit)) return false;
+    good = *std::move(fit);
+    return true;
+  };
+  for (int e = 0; e <= kFairingDecades; ++e) {
+    const double lambda = weight * std::pow(10.0, -e);
+    SG_ASSIGN_OR_RETURN(const bool ok, try_lambda(lambda));
+    if (ok) break;
+    bad = lambda;
+  }
+  if (!good) return unfaired;
+  for (int step = 0; bad > 0.0 && step < kFairingBisections; ++step) {
+    const double mid = std::sqrt(good->lambda * bad);
+    SG_ASSIGN_OR_RETURN(const bool ok, try_lambda(mid));
+    if (!ok) bad = mid;
+  }
+  return *std::move(good);
+}
+
+// Checks the outline: a curve block of >= kMinPoints finite 2D points, none repeating its
+// predecessor.
+absl::Status ValidateOutline(const StructuredBlock& points) {
+  const Extents& e = points.extents();
+  if (e[1] != 1 || e[2] != 1) {
+    return absl::InvalidArgumentError(absl::StrCat("points extents = (", e[0], ", ", e[1], ", ",
+                                                   e[2], "): an outline is n x 1 x 1"));
+  }
+  if (points.spatial_dim() != 2) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points spatial_dim = ", points.spatial_dim(), ": an outline is planar (2)"));
+  }
+  if (e[0] < kMinPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points: ", e[0], " points, an outline needs at least ", kMinPoints));
+  }
+  SG_RETURN_IF_ERROR(ValidateFinite(points, "points"));
+  const std::span<const double> xy = points.coords();
+  double x0 = xy[0], x1 = xy[0], y0 = xy[1], y1 = xy[1];
+  for (int i = 0; i < e[0]; ++i) {
+    x0 = std::min(x0, xy[2 * i]), x1 = std::max(x1, xy[2 * i]);
+    y0 = std::min(y0, xy[2 * i + 1]), y1 = std::max(y1, xy[2 * i + 1]);
+  }
+  const double repeat = kRepeatRelTol * std::hypot(x1 - x0, y1 - y0);
+  for (int i = 1; i < e[0]; ++i) {
+    if (std::hypot(xy[2 * i] - xy[2 * i - 2], xy[2 * i + 1] - xy[2 * i - 1]) <= repeat) {
+      return absl::InvalidArgumentError(absl::StrCat("points: point ", i, " at (", xy[2 * i], ", ",
+                                                     xy[2 * i + 1], ") repeats point ", i - 1));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// Feature points: those of DetectFeatures that are kinks, turning by at least kKinkRatio times
+// as much as both neighbours (a tangent discontinuity stands out; a tight but smooth bend
+// sampled coarsely, like a nose, turns by about as much at the neighbours), never the leading
+// edge, and only where both neighbouring segments keep order - 2 data points strictly inside
+// (what the order - 2 free controls of a segment without interior knots need).
+std::vector<int> OutlineFeatures(const StructuredBlock& points, const FeatureOptions& options,
+                                 int leading_edge, int order) {
+  const int m = static_cast<int>(points.num_points());
+  auto turning = [&](int r) {
+    if (r <= 0 || r >= m - 1) return 0.0;
+    const double *a = points.Point(r - 1, 0, 0), *b = points.Point(r, 0, 0),
+                 *c = points.Point(r + 1, 0, 0);
+    const double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - b[0], vy = c[1] - b[1];
+    return std::abs(std::atan2(ux * vy - uy * vx, ux * vx + uy * vy));
+  };
+  std::vector<int> kept;
+  for (int r : DetectFeatures(points, 0, options)) {
+    const int previous = kept.empty() ? 0 : kept.back();
+    if (r == leading_edge || r - previous < order - 1 || m - 1 - r < order - 1 ||
+        turning(r) < kKinkRatio * std::max(turning(r - 1), turning(r + 1))) {
+      continue;
+    }
+    kept.push_back(r);
+  }
+  return kept;
+}
+
+// Interior knots of the reference: the anchors' knots and a knot at every second data point
+// of each segment (at least two data points per span).
+std::vector<double> ReferenceKnots(const std::vector<int>& anchors,
+                                   const std::vector<double>& params, int order) {
+  std::vector<double> interior;
+  for (size_t a = 0; a + 1 < anchors.size(); ++a) {
+    if (a > 0) interior.insert(interior.end(), order - 1, params[anchors[a]]);
+    for (int r = anchors[a] + 2; r + 1 < anchors[a + 1]; r += 2) interior.push_back(params[r]);
+  }
+  return interior;
+}
+
+// What knot placement (steps 3 and 4) found.
+struct Placement {
+  std::vector<double> interior;
+  Fitted fitted;
+  int inserted = 0;
+  int removed = 0;
+  std::string stop;  // why the target was not met; empty when it was
+};
+
+// Steps 3 and 4 from the knots `interior` and parameters `params`: insertion until every
+// distance is within `target` and the curve has no cusp (`cusp` gives the parameter of one),
+// at most `cap` controls; then removal. Knot vectors are screened (kScreenCorrections).
+absl::StatusOr<Placement> PlaceKnots(
+    ProfileFitter& fitter, std::vector<double> interior, const std::vector<double>& params,
+    double target, int cap, bool remove,
+    const std::function<std::optional<double>(const Fitted&)>& cusp) {
+  const int m = static_cast<int>(params.size());
+  auto screen = [&](const std::vector<double>& knots,
+                    const std::vector<double>& start) -> absl::StatusOr<Fitted> {
+    SG_ASSIGN_OR_RETURN(Fitted fit, FitAndMeasure(fitter, knots, {}, start, kScreenCorrections));
+    if (fit.max() <= target || fit.max() > kScreenMargin * target) return fit;
+    return FitAndMeasure(fitter, knots, {}, fit.params);
+  };
+  Placement out;
+  out.interior = std::move(interior);
+  SG_ASSIGN_OR_RETURN(out.fitted, screen(out.interior, params));
+  for (;;) {
+    std::vector<double> ratio(m);
+    for (int i = 0; i < m; ++i) ratio[i] = out.fitted.distances[i] / target;
+    if (out.fitted.max() <= target) {
+      const std::optional<double> at = cusp(out.fitted);
+      if (!at) break;
+      // Split the span of the cusp: mark the data points around it as twice out.
+      const auto it = std::lower_bound(out.fitted.params.begin(), out.fitted.params.end(), *at);
+      const int r = static_cast<int>(it - out.fitted.params.begin());
+      for (int i = std::max(r - 1, 0); i <= std::min(r, m - 1); ++i) ratio[i] = 2.0;
+    }
+    const int n = fitter.NumControls(out.interior);
+    if (n >= cap) {
+      out.stop = absl::StrCat("the control-point cap ", cap, " is reached");
+      break;
+    }
+    const std::vector<double>& at = out.fitted.params;
+    if (SplitSpans(at, ratio, 1.0, 1, out.interior,
+                   [&] { return fitter.WellPosed(out.interior, at); }) == 0) {
+      out.stop = "no knot span with data left to split";
+      break;
+    }
+    ++out.inserted;
+    SG_ASSIGN_OR_RETURN(out.fitted, screen(out.interior, out.fitted.params));
+  }
+  for (int pass = 0; remove && out.stop.empty() && pass < kRemovalPasses; ++pass) {
+    // Candidates: the simple knots, smallest third-derivative jump |J_q| first.
+    const std::vector<double> jump = JumpMagnitudes(out.fitted.curve);
+    std::vector<std::pair<double, double>> candidates;  // (|J_q|, knot)
+    for (size_t q = 0, i = 0; i < out.interior.size(); ++i) {
+      if (std::count(out.interior.begin(), out.interior.end(), out.interior[i]) > 1) continue;
+      candidates.push_back({jump[q++], out.interior[i]});
+    }
+    std::sort(candidates.begin(), candidates.end());
+    int removed = 0;
+    for (const auto& [jump, knot] : candidates) {
+      std::vector<double> trial = out.interior;
+      trial.erase(std::find(trial.begin(), trial.end(), knot));
+      if (!fitter.WellPosed(trial, out.fitted.params)) continue;
+      absl::StatusOr<Fitted> fit = screen(trial, out.fitted.params);
+      if (fit.status().code() == absl::StatusCode::kCancelled) return fit.status();
+      if (!fit.ok() || !(fit->max() <= target) || cusp(*fit)) continue;
+      out.interior = std::move(trial);
+      out.fitted = *std::move(fit);
+      ++removed;
+    }
+    out.removed += removed;
+    if (removed == 0) break;
+  }
+  return out;
+}
+
+}  // namespace
+
+int64_t ProfileCurvature::spurious() const {
+  return std::accumulate(spurious_extrema.begin(), spurious_extrema.end(), int64_t{0});
+}
+
+absl::Status AirfoilFitOptions::Validate() const {
+  auto bad = [](const char* field, auto value, const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(field, " = ", value, ": ", why));
+  };
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
+    return bad("tolerance", tolerance, "must be a positive finite length");
+  }
+  if (order < 3 || order > kMaxOrder) {
+    return bad("order", order, absl::StrCat("must be in [3, ", kMaxOrder, "]"));
+  }
+  if (max_control_points != 0 && max_control_points < order) {
+    return bad("max_control_points", max_control_points, "must be 0 (no cap) or >= order");
+  }
+  if (max_parameter_corrections < 0) {
+    return bad("max_parameter_corrections", max_parameter_corrections, "must be >= 0");
+  }
+  SG_RETURN_IF_ERROR(fairing.Validate());
+  if (!(fairing_headroom > 0.0 && fairing_headroom <= 1.0)) {
+    return bad("fairing_headroom", fairing_headroom, "must be in (0, 1]");
+  }
+  if (curvature_level < 0 || curvature_level > 6) {
+    return bad("curvature_level", curvature_level, "must be in [0, 6]");
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
+                                      const AirfoilFitOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(ValidateOutline(points));
+  const int m = static_cast<int>(points.num_points());
+  const int k = options.order;
+  const double tolerance = options.tolerance;
+  const int level = options.curvature_level;
+  const std::vector<double> data(points.coords().begin(), points.coords().end());
+  AirfoilFit result;
+
+  // Trailing edge: ends within the tolerance are one point, their midpoint. Leading edge: the
+  // point farthest from the trailing-edge midpoint.
+  std::vector<double> fit_data = data;
+  const double gap = std::hypot(data[0] - data[2 * m - 2], data[1] - data[2 * m - 1]);
+  result.sharp_trailing_edge = gap <= tolerance;
+  if (result.sharp_trailing_edge) {
+    for (int c = 0; c < 2; ++c) {
+      fit_data[c] = fit_data[2 * m - 2 + c] = 0.5 * (data[c] + data[2 * m - 2 + c]);
+    }
+  }
+  if (const std::optional<PolylineCrossing> crossing =
+          FindPolylineCrossing(fit_data, result.sharp_trailing_edge)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "points: the outline crosses itself: segment ", crossing->first, "-", crossing->first + 1,
+        " meets segment ", crossing->second, "-", crossing->second + 1,
+        " (points must go once around the profile, in Selig order)"));
+  }
+  const double te_x = 0.5 * (fit_data[0] + fit_data[2 * m - 2]);
+  const double te_y = 0.5 * (fit_data[1] + fit_data[2 * m - 1]);
+  double farthest = -1.0;
+  for (int i = 0; i < m; ++i) {
+    const double d = std::hypot(data[2 * i] - te_x, data[2 * i + 1] - te_y);
+    if (d > farthest) farthest = d, result.leading_edge = i;
+  }
+  result.features = OutlineFeatures(points, options.features, result.leading_edge, k);
+  const int min_controls = k + static_cast<int>(result.features.size()) * (k - 1);
+  const int cap = options.max_control_points == 0 ? m : std::min(options.max_control_points, m);
+  if (cap < min_controls) {
+    const std::string need = absl::StrCat("order ", k, " and ", result.features.size(),
+                                          " feature points need at least ", min_controls);
+    return absl::InvalidArgumentError(
+        cap < m ? absl::StrCat("max_control_points = ", cap, ": ", need)
+                : absl::StrCat("points: ", m, " points are too few, ", need, " controls"));
+  }
+
+  StructuredBlock work = points;
+  std::copy(fit_data.begin(), fit_data.end(), work.coords().begin());
+  const std::vector<double> params = ParametrizeBlock(work, options.parametrization)[0];
+  ProfileFitter fitter(fit_data, data, k, result.features, options.max_parameter_corrections,
+                       options.cancel);
+  const std::vector<int>& anchors = fitter.anchors();
+  std::vector<double> interior;
+  for (int r : result.features) interior.insert(interior.end(), k - 1, params[r]);
+
+  // The reference (file comment): the fairest curve within the tolerance, and its largest
+  // curvature, which bounds every accepted fit's (kCurvatureGuard). Too few points for its knots
+  // (high orders on tiny outlines): no reference, every extremum counts as spurious.
+  double curvature_limit = std::numeric_limits<double>::infinity();
+  const std::vector<double> dense_knots = ReferenceKnots(anchors, params, k);
+  if (fitter.NumControls(dense_knots) <= m && fitter.WellPosed(dense_knots, params)) {
+    SG_ASSIGN_OR_RETURN(const Fitted dense, FitAndMeasure(fitter, dense_knots, {}, params));
+    SG_ASSIGN_OR_RETURN(const Fitted reference,
+                        FairToTolerance(fitter, dense_knots, dense, options.fairing.weight,
+                                        tolerance, [](const Fitted&) { return true; }));
+    result.reference_curvature = MeasureCurvature(reference, anchors, result.leading_edge, level);
+    CountSpurious(result.reference_curvature, result.reference_curvature);
+    curvature_limit = kCurvatureGuard * result.reference_curvature.total.max_abs_curvature;
+  }
+  auto cusp = [&](const Fitted& fit) -> std::optional<double> {
+    const auto [kappa, u] = CurvaturePeak(fit, anchors, level);
+    if (kappa > curvature_limit) return u;
+    return std::nullopt;
+  };
+
+  // Steps 3 and 4, then the unfaired fit converged.
+  const bool fair_to_tolerance = options.fairing.mode == FairingMode::kToTolerance;
+  const double target = tolerance * (fair_to_tolerance ? options.fairing_headroom : 1.0);
+  SG_ASSIGN_OR_RETURN(Placement placed, PlaceKnots(fitter, std::move(interior), params, target, cap,
+                                                   options.remove_knots, cusp));
+  result.knots_inserted = placed.inserted;
+  result.knots_removed = placed.removed;
+  interior = std::move(placed.interior);
+  Fitted fitted = std::move(placed.fitted);
+  {
+    SG_ASSIGN_OR_RETURN(Fitted converged, FitAndMeasure(fitter, interior, {}, fitted.params));
+    if (!placed.stop.empty() || (converged.max() <= target && !cusp(converged))) {
+      fitted = std::move(converged);
+    }
+  }
+
+  // Step 5: fairing. A faired curve must also be no less fair than the unfaired one by the
+  // measures reported: squared curvature differences and spurious extrema.
+  result.unfaired_curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
+  CountSpurious(result.reference_curvature, result.unfaired_curvature);
+  if (fair_to_tolerance && placed.stop.empty()) {
+    const ProfileCurvature& before = result.unfaired_curvature;
+    auto fairer = [&](const Fitted& fit) {
+      ProfileCurvature c = MeasureCurvature(fit, anchors, result.leading_edge, level);
+      CountSpurious(result.reference_curvature, c);
+      return c.total.max_abs_curvature <= curvature_limit &&
+             c.total.sum_squared_differences <= before.total.sum_squared_differences &&
+             c.spurious() <= before.spurious();
+    };
+    SG_ASSIGN_OR_RETURN(fitted, FairToTolerance(fitter, interior, fitted, options.fairing.weight,
+                                                tolerance, fairer));
+  } else if (options.fairing.mode == FairingMode::kWeight) {
+    SG_ASSIGN_OR_RETURN(
+        fitted,
+        FitAndMeasure(fitter, interior, {options.fairing.weight, MedianCappedScales(fitted.curve)},
+                      fitted.params));
+  }
+  result.curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
+  CountSpurious(result.reference_curvature, result.curvature);
+
+  SG_ASSIGN_OR_RETURN(result.curve,
+                      TensorSpline::Create({fitted.curve.knots, KnotVector(), KnotVector()}, 2,
+                                           fitted.curve.control));
+  result.num_control_points = fitted.curve.knots.num_controls();
+  result.fairing_weight = fitted.lambda;
+  result.params = std::move(fitted.feet);
+  result.distances = std::move(fitted.distances);
+  result.worst_point =
+      static_cast<int>(std::max_element(result.distances.begin(), result.distances.end()) -
+                       result.distances.begin());
+  result.max_deviation = result.distances[result.worst_point];
+  result.fits = fitter.fits();
+  const double peak = result.curvature.total.max_abs_curvature;
+  result.met = result.max_deviation <= tolerance && peak <= curvature_limit;
+  if (!result.met) {
+    const int w = result.worst_point;
+    result.unmet_reason =
+        result.max_deviation <= tolerance
+            ? absl::StrCat("the curve has a cusp: curvature ", peak, " exceeds ", kCurvatureGuard,
+                           " times the reference's ", curvature_limit / kCurvatureGuard)
+            : absl::StrCat("point ", w, " at (", data[2 * w], ", ", data[2 * w + 1], ") is ",
+                           result.max_deviation, " from the curve, over the tolerance ", tolerance);
+    absl::StrAppend(&result.unmet_reason, " with ", result.num_control_points, " control points: ",
+                    placed.stop.empty()
+                        ? absl::StrCat("the fixed fairing weight ", result.fairing_weight)
+                        : placed.stop);
+  }
+  return result;
+}
+
+}  // namespace splinegrid
