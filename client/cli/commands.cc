@@ -12,6 +12,8 @@
 #include "client/cli/flags.h"
 #include "client/cli/output.h"
 #include "client/client.h"
+#include "core/fit/airfoil_fit.h"
+#include "core/io/airfoil.h"
 #include "core/io/file_util.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
@@ -326,6 +328,33 @@ absl::Status Curvature(const Args& args) {
   if (!out.empty()) SG_RETURN_IF_ERROR(WriteFileAtomically(out, CurvatureCsv(curvature)));
   Print(FormatCurvature(client::GridName(args[0]), curvature, out), curvature.metrics());
   return absl::OkStatus();
+}
+
+absl::Status Airfoil(const Args& args) {
+  if (args.size() != 1) {
+    return Usage(
+        "usage: splinegrid airfoil FILE.dat [--tol T] [--fair tol|LAMBDA|off] [-o OUT.csv]");
+  }
+  SG_ASSIGN_OR_RETURN(const AirfoilCoordinates coordinates, ReadAirfoilFile(args[0]));
+  AirfoilFitOptions options;
+  if (absl::GetFlag(FLAGS_tol) != 0.0) options.tolerance = absl::GetFlag(FLAGS_tol);
+  const std::string fair = absl::GetFlag(FLAGS_fair);
+  if (fair == "off") {
+    options.fairing.mode = FairingMode::kOff;
+  } else if (!fair.empty() && fair != "tol") {
+    if (!absl::SimpleAtod(fair, &options.fairing.weight)) {
+      return Usage(absl::StrCat("--fair = '", fair, "': give 'tol', 'off' or a weight"));
+    }
+    options.fairing.mode = FairingMode::kWeight;
+  }
+  SG_ASSIGN_OR_RETURN(const AirfoilFit fit, FitAirfoil(coordinates.points, options));
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (!out.empty()) SG_RETURN_IF_ERROR(WriteFileAtomically(out, AirfoilCurvatureCsv(fit)));
+  std::string text = FormatAirfoilFit(coordinates.name, options.tolerance, fit);
+  if (!out.empty()) absl::StrAppend(&text, "  curvature written to ", out, "\n");
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  return fit.met ? absl::OkStatus()
+                 : absl::FailedPreconditionError(absl::StrCat("not met: ", fit.unmet_reason));
 }
 
 absl::Status Remove(const Args& args) {

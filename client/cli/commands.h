@@ -20,6 +20,8 @@ absl::Status List(const Args& args);
 absl::Status Eval(const Args& args);
 absl::Status Fair(const Args& args);
 absl::Status Curvature(const Args& args);
+// Local (no server): fits an airfoil's coordinates (core/fit/airfoil_fit.h).
+absl::Status Airfoil(const Args& args);
 absl::Status Remove(const Args& args);
 absl::Status Health(const Args& args);
 

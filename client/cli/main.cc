@@ -4,6 +4,7 @@
 //   splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] [--fair F]
 //   splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]
 //   splinegrid curvature NAME [--revision R] [--level L] [-o OUT.csv]
+//   splinegrid airfoil FILE.dat [--tol T] [--fair tol|LAMBDA|off] [-o OUT.csv]   (no server)
 //   splinegrid get NAME [--full]      splinegrid list      splinegrid rm NAME
 //   splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}
 //   splinegrid health
@@ -26,6 +27,7 @@ constexpr char kUsage[] =
     "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
     "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]\n"
     "  splinegrid curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]\n"
+    "  splinegrid airfoil FILE.dat [--tol 1e-4] [--fair tol|LAMBDA|off] [-o OUT.csv]   (local)\n"
     "  splinegrid get NAME [--full] | list | rm NAME | health\n"
     "  splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}\n"
     "Client commands use --server host:port (default localhost:50051) and --json.";
@@ -41,11 +43,11 @@ int main(int argc, char** argv) {
   }
   using Command = absl::Status (*)(const splinegrid::cli::Args&);
   const std::map<std::string, Command> commands = {
-      {"serve", splinegrid::cli::Serve},  {"fit", splinegrid::cli::Fit},
-      {"get", splinegrid::cli::Get},      {"list", splinegrid::cli::List},
-      {"eval", splinegrid::cli::Eval},    {"rm", splinegrid::cli::Remove},
-      {"fair", splinegrid::cli::Fair},    {"curvature", splinegrid::cli::Curvature},
-      {"health", splinegrid::cli::Health}};
+      {"serve", splinegrid::cli::Serve},     {"fit", splinegrid::cli::Fit},
+      {"get", splinegrid::cli::Get},         {"list", splinegrid::cli::List},
+      {"eval", splinegrid::cli::Eval},       {"rm", splinegrid::cli::Remove},
+      {"fair", splinegrid::cli::Fair},       {"curvature", splinegrid::cli::Curvature},
+      {"airfoil", splinegrid::cli::Airfoil}, {"health", splinegrid::cli::Health}};
   const auto command = commands.find(positional[1]);
   if (command == commands.end()) {
     std::fprintf(stderr, "unknown command '%s'\n%s\n", positional[1], kUsage);

@@ -6,6 +6,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/bspline/differential_geometry.h"
+#include "core/bspline/evaluation.h"
 #include "google/protobuf/util/json_util.h"
 
 namespace splinegrid::cli {
@@ -171,6 +173,34 @@ client::ProgressFn ProgressLine::callback() {
 void ProgressLine::Done() {
   if (drawn_) std::fprintf(stderr, "\n");
   drawn_ = false;
+}
+
+std::string FormatAirfoilFit(const std::string& name, double tolerance, const AirfoilFit& fit) {
+  std::string out = absl::StrFormat(
+      "%s: %d points -> %d control points, %s trailing edge, largest distance %.3g (%s %.3g)\n",
+      name, static_cast<int>(fit.params.size()), fit.num_control_points,
+      fit.sharp_trailing_edge ? "sharp" : "blunt", fit.max_deviation,
+      fit.met ? "within" : "NOT within", tolerance);
+  if (!fit.met) absl::StrAppend(&out, "  ", fit.unmet_reason, "\n");
+  absl::StrAppend(&out, absl::StrFormat("  fairing weight %.3g; curvature extrema %d unfaired, "
+                                        "%d faired, %d spurious (per piece:",
+                                        fit.fairing_weight, fit.unfaired_curvature.total.extrema,
+                                        fit.curvature.total.extrema, fit.curvature.spurious()));
+  for (int64_t e : fit.curvature.piece_extrema) absl::StrAppend(&out, " ", e);
+  absl::StrAppend(&out, ")\n");
+  return out;
+}
+
+std::string AirfoilCurvatureCsv(const AirfoilFit& fit) {
+  std::string out = "u,x,y,curvature\n";
+  const int n = 8 * static_cast<int>(std::max<size_t>(fit.params.size(), 2) - 1);
+  for (int q = 0; q <= n; ++q) {
+    const double u = static_cast<double>(q) / n;
+    const Point3 p = EvaluatePoint(fit.curve, {u, 0.0, 0.0});
+    absl::StrAppend(&out, absl::StrFormat("%.17g,%.17g,%.17g,%.17g\n", u, p[0], p[1],
+                                          CurveCurvature(fit.curve, 0, u)));
+  }
+  return out;
 }
 
 }  // namespace splinegrid::cli

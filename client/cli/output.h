@@ -5,6 +5,7 @@
 #include <string>
 
 #include "client/client.h"
+#include "core/fit/airfoil_fit.h"
 #include "google/protobuf/message.h"
 
 namespace splinegrid::cli {
@@ -31,6 +32,13 @@ std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureR
 // One CSV row per sample: block,direction,start_i,start_j,start_k,line,sample,arc_length,x,y,z,
 // curvature (z = 0 in 2D).
 std::string CurvatureCsv(const v1::GetWallCurvatureResponse& curvature);
+
+// An airfoil fit: control points, distance, trailing edge, fairing, curvature extrema.
+std::string FormatAirfoilFit(const std::string& name, double tolerance, const AirfoilFit& fit);
+
+// One CSV row per curvature sample of the fitted airfoil (8 per data interval):
+// u,x,y,curvature (signed, positive turning left).
+std::string AirfoilCurvatureCsv(const AirfoilFit& fit);
 
 // A progress callback that redraws "label 12.3 / 45.6 MiB (27%)" on stderr when it is a
 // terminal (and prints nothing otherwise); Done() ends the line.
