@@ -205,6 +205,18 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
   EXPECT_NE(Cli("curvature coarse --level=9").exit_code, 0);
 }
 
+TEST_F(EndToEndTest, CliFitsAnAirfoilLocally) {
+  const std::string csv = (dir_ / "rae.csv").string();
+  const Result fit = Cli(absl::StrCat("airfoil ", SharedData("airfoils/rae2822.dat"), " -o ", csv));
+  ASSERT_EQ(fit.exit_code, 0) << fit.out;
+  EXPECT_THAT(fit.out, HasSubstr("sharp trailing edge"));
+  EXPECT_THAT(fit.out, HasSubstr("(within 0.0001)"));
+  EXPECT_THAT(fit.out, HasSubstr("0 spurious"));
+  const std::string text = ReadFileToString(csv).value();
+  EXPECT_EQ(text.rfind("u,x,y,curvature\n", 0), 0u);
+  EXPECT_NE(Cli(absl::StrCat("airfoil ", SharedData("grids/n0012_113-33.p2dfmt"))).exit_code, 0);
+}
+
 TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
   const std::string png = (dir_ / "curvature.png").string();
   const Result python = RunCommand(
