@@ -179,7 +179,8 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
 TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
   const Result python = RunCommand(
       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
-                   "/python/examples/fit_and_refine.py --server=127.0.0.1:", port_));
+                   "/python/examples/fit_and_refine.py --server=127.0.0.1:", port_,
+                   " --grid=", SharedData("grids/n0012_225-65.p2dfmt")));
   ASSERT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out, HasSubstr("(1, 257, 897, 2)"));  // level 2 of the 225 x 65 grid
 }
