@@ -1,5 +1,5 @@
-// Eight client threads mixing import, fit, evaluate, list and delete on shared and on each
-// other's grids. Every answer must be OK or an expected race outcome (NOT_FOUND when another
+// Eight client threads mixing import, fit, fair, evaluate, wall curvature, list and delete on
+// shared and on each other's grids. Every answer must be OK or an expected race outcome (NOT_FOUND when another
 // thread deleted the grid, FAILED_PRECONDITION when it is not fitted yet); the shared grid must
 // end exactly as it began. Runs clean under ThreadSanitizer (.ci/tsan).
 #include <random>
@@ -60,6 +60,12 @@ TEST_F(ServiceTest, ConcurrentClientsMixingEveryMethod) {
       for (int x = 0; x < 3; ++x)
         points.add_parameters(std::uniform_real_distribution<>(0, 1)(rng));
       check(client_->EvaluatePoints(points).status(), "evaluate points");
+      v1::Fairing fairing;
+      fairing.set_mode(v1::FAIRING_MODE_WEIGHT);
+      fairing.set_weight(1e-4);
+      check(client_->Fair(theirs, 0, &fairing).status(), "fair");
+      check(client_->WallCurvature("shared", 0, 0, {static_cast<int>(rng() % 9)}).status(),
+            "wall curvature");
       check(client_->List().status(), "list");
       check(client_->Get(theirs, 0, v1::GRID_VIEW_FULL).status(), "get");
       if (round % 3 == 2) check(client_->Delete(theirs), "delete theirs");
