@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <span>
 #include <tuple>
@@ -88,7 +89,10 @@ class Engine {
     }
     result.met = Met();
     result.fairing_weight = lambda_;
-    result.quality_met = !options_.quality || Score(all_).ok();
+    if (options_.quality) {
+      SG_ASSIGN_OR_RETURN(const QualityScore score, Score(all_));
+      result.quality_met = score.ok();
+    }
     for (int b : all_) {
       if (devs_[b].max_ratio >= result.worst_ratio) {
         result.worst_ratio = devs_[b].max_ratio;
@@ -96,7 +100,7 @@ class Engine {
         result.worst_at = devs_[b].max_ratio_at;
       }
       result.blocks.push_back(Fitted(b));
-      if (options_.quality) result.quality.push_back(quality_[b]);
+      if (options_.quality) result.quality.push_back(*quality_[b]);
     }
     return result;
   }
@@ -109,7 +113,7 @@ class Engine {
     std::vector<std::vector<double>> edge_tolerances;
     std::vector<TensorSpline> fits;
     std::vector<Deviation> devs;
-    std::vector<CellQuality> quality;
+    std::vector<std::optional<CellQuality>> quality;
   };
   State Save() const {
     State s{{}, tolerances_, edge_tolerances_, fits_, devs_, quality_};
@@ -130,7 +134,7 @@ class Engine {
   struct BlockState {
     std::vector<TensorSpline> fits;
     std::vector<Deviation> devs;
-    std::vector<CellQuality> quality;
+    std::vector<std::optional<CellQuality>> quality;
   };
   BlockState SaveBlocks(const std::vector<int>& blocks) const {
     BlockState s;
@@ -174,11 +178,16 @@ class Engine {
   }
   bool Met() const { return WorstRatio(all_) <= 1.0; }
 
-  QualityScore Score(const std::vector<int>& blocks) const {
+  // The quality of `blocks`, checking the fits not checked yet (the check evaluates every cell
+  // at levels 0..2, so it waits until a step needs it: most trial fits fail their tolerances).
+  absl::StatusOr<QualityScore> Score(const std::vector<int>& blocks) {
     QualityScore s;
     for (int b : blocks) {
-      s.bad += quality_[b].num_bad_cells;
-      s.folded += quality_[b].folded;
+      if (!quality_[b]) {
+        SG_ASSIGN_OR_RETURN(quality_[b], options_.quality(b, Fitted(b)));
+      }
+      s.bad += quality_[b]->num_bad_cells;
+      s.folded += quality_[b]->folded;
     }
     return s;
   }
@@ -199,7 +208,7 @@ class Engine {
     return fitted;
   }
 
-  // Fits block b with the current knots and weight, measures it and (if asked) its quality.
+  // Fits block b with the current knots and weight and measures its deviation.
   absl::Status FitBlock(int b) {
     std::array<std::vector<double>, 3> params;
     std::array<KnotVector, 3> knots;
@@ -222,9 +231,7 @@ class Engine {
       devs_[b].max_ratio = a.max_ratio;
       devs_[b].max_ratio_at = a.max_at;
     }
-    if (options_.quality) {
-      SG_ASSIGN_OR_RETURN(quality_[b], options_.quality(b, Fitted(b)));
-    }
+    quality_[b].reset();
     return absl::OkStatus();
   }
 
@@ -301,7 +308,7 @@ class Engine {
   // max_quality_rounds or two rounds in a row that do not improve on it.
   absl::Status ImproveQuality(EngineResult& result) {
     State best = Save();
-    QualityScore best_score = Score(all_);
+    SG_ASSIGN_OR_RETURN(QualityScore best_score, Score(all_));
     int futile = 0;
     while (!best_score.ok() && futile < 2 && result.quality_rounds < options_.max_quality_rounds) {
       SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
@@ -309,8 +316,8 @@ class Engine {
       TightenAroundBadCells();
       SG_RETURN_IF_ERROR(FitBlocks(all_));
       SG_RETURN_IF_ERROR(Refine(result));
-      const QualityScore score = Score(all_);
       if (!Met()) break;
+      SG_ASSIGN_OR_RETURN(const QualityScore score, Score(all_));
       if (score < best_score) {
         best = Save();
         best_score = score;
@@ -329,7 +336,7 @@ class Engine {
   void TightenAroundBadCells() {
     for (int b : all_) {
       const StructuredBlock& block = grid_.blocks[b];
-      for (const Extents& cell : quality_[b].bad_cells) {
+      for (const Extents& cell : quality_[b]->bad_cells) {
         for (int dk = 0; dk <= (block.extent(2) > 1 ? 1 : 0); ++dk) {
           for (int dj = 0; dj <= (block.extent(1) > 1 ? 1 : 0); ++dj) {
             for (int di = 0; di <= (block.extent(0) > 1 ? 1 : 0); ++di) {
@@ -346,10 +353,19 @@ class Engine {
     }
   }
 
-  // Whether `blocks` meet their tolerances and are no worse in quality than `before`.
-  bool Acceptable(const std::vector<int>& blocks, const QualityScore& before) const {
+  // Whether `blocks` meet their tolerances and are no worse in quality than `before` (the
+  // quality is only checked when the tolerances hold).
+  absl::StatusOr<bool> Acceptable(const std::vector<int>& blocks, const QualityScore& before) {
     if (WorstRatio(blocks) > 1.0) return false;
-    return !options_.quality || Score(blocks) <= before;
+    if (!options_.quality) return true;
+    SG_ASSIGN_OR_RETURN(const QualityScore score, Score(blocks));
+    return score <= before;
+  }
+
+  // The quality score of `blocks`, or a zero score without a quality check.
+  absl::StatusOr<QualityScore> ScoreIfChecked(const std::vector<int>& blocks) {
+    if (!options_.quality) return QualityScore{};
+    return Score(blocks);
   }
 
   // Step 3: tries each class knot; keeps a removal when every affected block still meets its
@@ -364,14 +380,18 @@ class Engine {
       for (size_t i = 0; i < cls.knots.size();) {
         SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
         const double knot = cls.knots[i];
+        SG_ASSIGN_OR_RETURN(const QualityScore before, ScoreIfChecked(blocks));
         const BlockState saved = SaveBlocks(blocks);
-        const QualityScore before = Score(blocks);
         cls.knots.erase(cls.knots.begin() + i);
         bool keep = model_.WellPosed(c);
         if (keep) {
           const absl::Status fit = FitBlocks(blocks);
           if (fit.code() == absl::StatusCode::kCancelled) return fit;
-          keep = fit.ok() && Acceptable(blocks, before);
+          if (fit.ok()) {
+            SG_ASSIGN_OR_RETURN(keep, Acceptable(blocks, before));
+          } else {
+            keep = false;
+          }
         }
         if (keep) {
           ++removed;
@@ -389,13 +409,14 @@ class Engine {
   // downwards from the weight to 1e-14 of it, then four bisections of the last decade on a log
   // scale (a factor 10^(1/16) = 1.15).
   absl::Status FairToTolerance() {
+    SG_ASSIGN_OR_RETURN(const QualityScore before, ScoreIfChecked(all_));
     const State unfaired = Save();
-    const QualityScore before = Score(all_);
     auto acceptable_at = [&](double lambda) -> absl::StatusOr<bool> {
       lambda_ = lambda;
       const absl::Status fit = FitBlocks(all_);
       if (fit.code() == absl::StatusCode::kCancelled) return fit;
-      return fit.ok() && Acceptable(all_, before);
+      if (!fit.ok()) return false;
+      return Acceptable(all_, before);
     };
     double good = 0.0, bad = 0.0;
     for (int e = 0; e <= 14; ++e) {
@@ -431,7 +452,7 @@ class Engine {
   std::vector<int> all_;
   std::vector<TensorSpline> fits_;
   std::vector<Deviation> devs_;
-  std::vector<CellQuality> quality_;
+  std::vector<std::optional<CellQuality>> quality_;  // unset: not checked since the fit
   std::vector<double> shares_;
   double lambda_ = 0.0;
 };
