@@ -130,11 +130,22 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
         if (o.face == face) kind = o.kind;
       }
       kinds.face_kinds[b].push_back(kind);
+      // A point matched on this face still carries the face's kind where it borders an unmatched
+      // point of the face: the end of a C-grid's wake cut is also the airfoil's trailing edge.
+      auto unmatched = [&](const Extents& x) {
+        return !(matched[b][block.Index(x[0], x[1], x[2])] & FaceBit(face));
+      };
       ForEachFacePoint(block, face, [&](const Extents& x) {
-        const int64_t p = block.Index(x[0], x[1], x[2]);
-        if (!(matched[b][p] & FaceBit(face))) {
-          kinds.point_kinds[b][p] |= static_cast<uint8_t>(kind);
+        bool own = unmatched(x);
+        for (int d = 0; d < 3 && !own; ++d) {
+          if (d == face.normal) continue;
+          for (int step : {-1, 1}) {
+            Extents y = x;
+            y[d] += step;
+            if (y[d] >= 0 && y[d] < block.extent(d) && unmatched(y)) own = true;
+          }
         }
+        if (own) kinds.point_kinds[b][block.Index(x[0], x[1], x[2])] |= static_cast<uint8_t>(kind);
       });
     }
   }

@@ -8,7 +8,9 @@
 //     of a planar or volume block is a wall when the grid is clustered towards it (its first
 //     layer's median spacing is below `wall_spacing_ratio` times the median spacing of that
 //     direction in the block), otherwise an outer boundary.
-// Points on several faces (corners, edges) carry every kind that applies.
+// Points on several faces (corners, edges) carry every kind that applies, and so do the points
+// at the border of a match on a face (the end of a C-grid's wake cut is also the first point of
+// its airfoil).
 #ifndef SPLINEGRID_CORE_GRID_BOUNDARY_KINDS_H_
 #define SPLINEGRID_CORE_GRID_BOUNDARY_KINDS_H_
 

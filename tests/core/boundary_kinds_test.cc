@@ -95,7 +95,11 @@ TEST(BoundaryKindsTest, CGridWakeIsInterfaceTheBodyIsWall) {
   for (int i = 0; i < c.ni; ++i) {
     const bool wake = i <= c.wake_cells || i >= upper_wake;
     const bool end = i == 0 || i == c.ni - 1;  // also on the outflow faces i=0, i=max
-    const uint8_t expected = wake ? (end ? kInterface | kOuter : kInterface) : kWall;
+    // The trailing edge points end the wake cut and begin the airfoil: both kinds.
+    const bool trailing_edge = i == c.wake_cells || i == upper_wake;
+    const uint8_t expected = trailing_edge ? kInterface | kWall
+                             : wake        ? (end ? kInterface | kOuter : kInterface)
+                                           : kWall;
     EXPECT_EQ(KindAt(c.grid, kinds, 0, i, 0), expected) << i;
   }
 }
@@ -239,7 +243,11 @@ TEST(BoundaryKindsSharedGridTest, NacaCGrid) {
   const int ni = block.extent(0), nj = block.extent(1);
   for (int i = 1; i + 1 < ni; ++i) {
     const bool in_wake = i <= wake.a.end[0] || i >= wake.b.begin[0];
-    EXPECT_EQ(KindAt(grid, kinds, 0, i, 0), in_wake ? kInterface : kWall) << i;
+    const bool trailing_edge = i == wake.a.end[0] || i == wake.b.begin[0];
+    EXPECT_EQ(KindAt(grid, kinds, 0, i, 0), trailing_edge ? kInterface | kWall
+                                            : in_wake     ? kInterface
+                                                          : kWall)
+        << i;
     EXPECT_EQ(KindAt(grid, kinds, 0, i, nj - 1), kOuter) << i;
     EXPECT_EQ(KindAt(grid, kinds, 0, i, nj / 2), 0) << i;
   }

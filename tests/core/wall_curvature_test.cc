@@ -35,8 +35,9 @@ bool SameLine(const WallLine& a, const WallLine& b) {
 TEST(WallLinesTest, CGridWallLineStopsAtTheWakeAndAtBreaks) {
   const CGrid c = MakeCGrid();
   const BoundaryKinds kinds = ClassifyBoundaries(c.grid, FindConnectivity(c.grid).value()).value();
-  // The wall: j = 0 without the wake cut (which includes the trailing edge points).
-  const int first = c.wake_cells + 1, last = c.ni - 2 - c.wake_cells;
+  // The wall: j = 0 without the wake cut, from trailing edge to trailing edge (those points
+  // end the cut and begin the airfoil).
+  const int first = c.wake_cells, last = c.ni - 1 - c.wake_cells;
   std::vector<WallLine> lines = FindWallLines({WithDistribution(c.grid.blocks[0], {})}, kinds);
   ASSERT_EQ(lines.size(), 1u);
   EXPECT_TRUE(SameLine(lines[0], {0, 0, {first, 0, 0}, last - first + 1}));
