@@ -1,0 +1,107 @@
+#include "core/deform/deform_quality.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/fit/grid_quality.h"
+#include "core/fit/wall_curvature.h"
+#include "core/grid/sampling.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+// The angle in degrees between the partial derivatives along directions d and e at uvw.
+double LineAngle(const TensorSpline& spline, const Point3& uvw, int d, int e) {
+  const PartialDerivatives ders = EvaluateDerivatives(spline, uvw, 1);
+  const Extents du = {d == 0, d == 1, d == 2};
+  const Extents de = {e == 0, e == 1, e == 2};
+  const Point3& t = ders(du[0], du[1], du[2]);
+  const Point3& n = ders(de[0], de[1], de[2]);
+  const double tt = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+  const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(tt > 0.0 && nn > 0.0)) return 90.0;
+  const double c = std::abs(t[0] * n[0] + t[1] * n[1] + t[2] * n[2]) / (tt * nn);
+  return std::acos(std::min(c, 1.0)) * kDegrees;
+}
+
+}  // namespace
+
+absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>& reference,
+                                                  const std::vector<FittedBlock>& deformed,
+                                                  const BoundaryKinds& kinds, int level,
+                                                  const CancelCheck& cancel) {
+  if (reference.size() != deformed.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("the deformed grid has ", deformed.size(),
+                                                   " blocks, the reference ", reference.size()));
+  }
+  if (level < 0 || level > kMaxRefinementLevel) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("level = ", level, " is outside [0, ", kMaxRefinementLevel, "]"));
+  }
+  DeformationCheck check;
+  check.level = level;
+  CellQualityOptions options;
+  options.max_level = 0;
+  options.max_size_ratio = 1e300;  // only folds count here
+  options.max_reported_cells = 0;
+  options.cancel = cancel;
+  for (size_t b = 0; b < reference.size(); ++b) {
+    std::array<std::vector<double>, 3> params;
+    for (int d = 0; d < 3; ++d) {
+      const int m = reference[b].distribution.num_points(d);
+      params[d] = reference[b].distribution.Refined(d, 0, m - 1, level);
+    }
+    const StructuredBlock was = EvaluateGrid(reference[b].spline, params);
+    SG_ASSIGN_OR_RETURN(PointDistribution at_level, PointDistribution::Create(params));
+    const FittedBlock now{deformed[b].spline, std::move(at_level), {}};
+    absl::StatusOr<CellQuality> q = CheckCellQuality(now, was, options);
+    if (!q.ok()) {
+      return absl::Status(q.status().code(), absl::StrCat("block ", b, ": ", q.status().message()));
+    }
+    check.cells_checked += q->cells_checked;
+    check.folded += q->folded;
+    check.max_jacobian_ratio = std::max(check.max_jacobian_ratio, q->max_ratio);
+    if (q->cells_checked > 0 && q->min_ratio < check.min_jacobian_ratio) {
+      check.min_jacobian_ratio = q->min_ratio;
+      check.worst_block = static_cast<int>(b);
+      check.worst_cell = q->worst_cell;
+    }
+  }
+  for (const WallLine& line : FindWallLines(reference, kinds)) {
+    SG_RETURN_IF_ERROR(PollCancel(cancel));
+    const FittedBlock& ref = reference[line.block];
+    const int d = line.direction;
+    // The direction leaving the wall: the other active one of a planar block, the normal of
+    // the face the line lies on for a volume.
+    int e = -1;
+    const int dim = ref.spline.spatial_dim();
+    int active = 0;
+    for (int x = 0; x < 3; ++x) active += ref.distribution.num_points(x) > 1 ? 1 : 0;
+    if (active < dim) continue;  // a surface block: no line leaves the wall
+    for (int x = 0; x < 3 && e < 0; ++x) {
+      const int m = ref.distribution.num_points(x);
+      if (x == d || m == 1) continue;
+      if (active == 2 || line.start[x] == 0 || line.start[x] == m - 1) e = x;
+    }
+    if (e < 0) continue;
+    const std::vector<double> u =
+        ref.distribution.Refined(d, line.start[d], line.start[d] + line.length - 1, level);
+    Point3 uvw;
+    for (int x = 0; x < 3; ++x) uvw[x] = ref.distribution.params(x)[line.start[x]];
+    for (double t : u) {
+      uvw[d] = t;
+      const double before = LineAngle(ref.spline, uvw, d, e);
+      const double after = LineAngle(deformed[line.block].spline, uvw, d, e);
+      check.max_orthogonality_change_degrees =
+          std::max(check.max_orthogonality_change_degrees, std::abs(after - before));
+      ++check.wall_samples;
+    }
+  }
+  return check;
+}
+
+}  // namespace splinegrid

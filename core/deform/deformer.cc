@@ -1,0 +1,563 @@
+#include "core/deform/deformer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <unordered_map>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/grid/sampling.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+
+// The factored fits of one face range at one level: one RangeFit per tangential direction.
+struct Deformer::BoundaryFit {
+  int block = 0;
+  std::vector<int> tangential;  // 1 or 2 directions
+  std::vector<RangeFit> fits;   // per tangential direction
+  std::array<std::vector<double>, 3>
+      params;  // the samples (a single value in the normal direction)
+};
+
+namespace {
+
+Point3 ControlPoint(const TensorSpline& spline, int64_t c) {
+  const int s = spline.spatial_dim();
+  const double* p = spline.control().data() + s * c;
+  return {p[0], p[1], s == 3 ? p[2] : 0.0};
+}
+
+void SetControlPoint(TensorSpline& spline, int64_t c, const Point3& x) {
+  const int s = spline.spatial_dim();
+  double* p = spline.mutable_control().data() + s * c;
+  for (int i = 0; i < s; ++i) p[i] = x[i];
+}
+
+double Distance2(const Point3& a, const Point3& b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+         (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+// f(d) of the file comment of deformer.h.
+double Fraction(double d, double r0, double r1) {
+  if (d <= r0) return 1.0;
+  if (d >= r1) return 0.0;
+  const double t = (d - r0) / (r1 - r0);
+  return 1.0 - t * t * (3.0 - 2.0 * t);
+}
+
+// Hash of a point's exact bits, to find controls that coincide bitwise.
+struct BitsHash {
+  size_t operator()(const std::array<uint64_t, 3>& b) const {
+    return std::hash<uint64_t>()(b[0] * 0x9E3779B97F4A7C15ull ^ (b[1] + 0x7F4A7C15ull) ^
+                                 (b[2] << 1));
+  }
+};
+
+std::array<uint64_t, 3> Bits(const Point3& p) {
+  std::array<uint64_t, 3> b;
+  for (int c = 0; c < 3; ++c) std::memcpy(&b[c], &p[c], sizeof(double));
+  return b;
+}
+
+// The Greville abscissa of every control of `knots`: the mean of its k - 1 inner knots.
+std::vector<double> Greville(const KnotVector& knots) {
+  const int n = knots.num_controls(), k = knots.order();
+  std::vector<double> g(n, 0.0);
+  if (k == 1) return g;
+  for (int a = 0; a < n; ++a) {
+    double sum = 0.0;
+    for (int q = a + 1; q < a + k; ++q) sum += knots.knot(q);
+    g[a] = sum / (k - 1);
+  }
+  return g;
+}
+
+// Coons (transfinite) interpolation of the interior of a control-net displacement D from its
+// faces (control index 0 and n - 1 of each active direction), in the Greville abscissae.
+void CoonsInterior(const TensorSpline& spline, std::vector<Point3>& D) {
+  const Extents n = spline.control_extents();
+  std::array<std::vector<double>, 3> g;
+  std::vector<int> active;
+  for (int d = 0; d < 3; ++d) {
+    g[d] = Greville(spline.knots(d));
+    if (n[d] > 1) active.push_back(d);
+  }
+  auto at = [&](int a, int b, int c) -> const Point3& {
+    return D[a + int64_t{n[0]} * (b + int64_t{n[1]} * c)];
+  };
+  // The face index in direction d: 0 or n[d] - 1, and the blend weight of the upper one.
+  const int ui = n[0] - 1, uj = n[1] - 1, uk = n[2] - 1;
+  std::vector<Point3> out = D;
+  for (int c = 0; c < n[2]; ++c) {
+    for (int b = 0; b < n[1]; ++b) {
+      for (int a = 0; a < n[0]; ++a) {
+        const bool face =
+            (a == 0 || a == ui) || (b == 0 || b == uj) || (n[2] > 1 && (c == 0 || c == uk));
+        if (face) continue;
+        const double x = g[0][a], y = g[1][b], z = n[2] > 1 ? g[2][c] : 0.0;
+        Point3 p = {0, 0, 0};
+        for (int e = 0; e < 3; ++e) {
+          if (active.size() == 2) {
+            p[e] = (1 - x) * at(0, b, c)[e] + x * at(ui, b, c)[e] + (1 - y) * at(a, 0, c)[e] +
+                   y * at(a, uj, c)[e] -
+                   ((1 - x) * (1 - y) * at(0, 0, c)[e] + x * (1 - y) * at(ui, 0, c)[e] +
+                    (1 - x) * y * at(0, uj, c)[e] + x * y * at(ui, uj, c)[e]);
+          } else {
+            // U + V + W - UV - VW - WU + UVW.
+            const double U = (1 - x) * at(0, b, c)[e] + x * at(ui, b, c)[e];
+            const double V = (1 - y) * at(a, 0, c)[e] + y * at(a, uj, c)[e];
+            const double W = (1 - z) * at(a, b, 0)[e] + z * at(a, b, uk)[e];
+            const double UV = (1 - x) * (1 - y) * at(0, 0, c)[e] + x * (1 - y) * at(ui, 0, c)[e] +
+                              (1 - x) * y * at(0, uj, c)[e] + x * y * at(ui, uj, c)[e];
+            const double VW = (1 - y) * (1 - z) * at(a, 0, 0)[e] + y * (1 - z) * at(a, uj, 0)[e] +
+                              (1 - y) * z * at(a, 0, uk)[e] + y * z * at(a, uj, uk)[e];
+            const double WU = (1 - z) * (1 - x) * at(0, b, 0)[e] + z * (1 - x) * at(0, b, uk)[e] +
+                              (1 - z) * x * at(ui, b, 0)[e] + z * x * at(ui, b, uk)[e];
+            double UVW = 0.0;
+            for (int q = 0; q < 8; ++q) {
+              const int qa = q & 1, qb = (q >> 1) & 1, qc = (q >> 2) & 1;
+              UVW += (qa ? x : 1 - x) * (qb ? y : 1 - y) * (qc ? z : 1 - z) *
+                     at(qa ? ui : 0, qb ? uj : 0, qc ? uk : 0)[e];
+            }
+            p[e] = U + V + W - UV - VW - WU + UVW;
+          }
+        }
+        out[a + int64_t{n[0]} * (b + int64_t{n[1]} * c)] = p;
+      }
+    }
+  }
+  D = std::move(out);
+}
+
+}  // namespace
+
+absl::Status DeformOptions::Validate() const {
+  if (!(rigid_radius >= 0.0) || !std::isfinite(rigid_radius)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rigid_radius = ", rigid_radius, " is not a finite number >= 0"));
+  }
+  if (!(decay_radius >= 0.0) || !std::isfinite(decay_radius)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("decay_radius = ", decay_radius, " is not a finite number >= 0"));
+  }
+  if (decay_radius > 0.0 && decay_radius <= rigid_radius) {
+    return absl::InvalidArgumentError(absl::StrCat("decay_radius = ", decay_radius,
+                                                   " must exceed rigid_radius = ", rigid_radius));
+  }
+  if (smoothing_iterations < 0 || smoothing_iterations > 10000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("smoothing_iterations = ", smoothing_iterations, " is outside [0, 10000]"));
+  }
+  if (propagation != Propagation::kBlend && propagation != Propagation::kTransfinite) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("propagation = ", static_cast<int>(propagation), " is not a known value"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Deformer> Deformer::Create(std::vector<FittedBlock> reference, BoundaryKinds kinds,
+                                          const DeformOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  if (reference.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  if (kinds.point_kinds.size() != reference.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("boundary kinds for ", kinds.point_kinds.size(),
+                                                   " blocks, the grid has ", reference.size()));
+  }
+  Deformer deformer;
+  deformer.options_ = options;
+  std::vector<Extents> extents;
+  for (const FittedBlock& b : reference) {
+    extents.push_back(
+        {b.distribution.num_points(0), b.distribution.num_points(1), b.distribution.num_points(2)});
+  }
+  SG_ASSIGN_OR_RETURN(deformer.selected_, SelectedPoints(extents, kinds, options.moved));
+  deformer.roles_ = ClassifyControls(reference, kinds, deformer.selected_);
+  const int nb = static_cast<int>(reference.size());
+  for (int b = 0; b < nb; ++b) {
+    for (int64_t c = 0; c < static_cast<int64_t>(deformer.roles_[b].size()); ++c) {
+      if (deformer.roles_[b][c] == ControlRole::kMoved) {
+        deformer.moved_.push_back({b, c});
+        deformer.moved_positions_.push_back(ControlPoint(reference[b].spline, c));
+      }
+    }
+  }
+  if (deformer.moved_.empty()) {
+    return absl::FailedPreconditionError(
+        "no control point moves: the selection holds no boundary segment or face cell");
+  }
+  // The moved boundary, sampled at its grid points.
+  std::vector<Point3> samples;
+  for (int b = 0; b < nb; ++b) {
+    std::array<std::vector<double>, 3> params;
+    for (int d = 0; d < 3; ++d) params[d] = reference[b].distribution.params(d);
+    const StructuredBlock points = EvaluateGrid(reference[b].spline, params);
+    const int s = points.spatial_dim();
+    for (int64_t p = 0; p < points.num_points(); ++p) {
+      if (!deformer.selected_[b][p]) continue;
+      const double* x = points.coords().data() + s * p;
+      samples.push_back({x[0], x[1], s == 3 ? x[2] : 0.0});
+    }
+  }
+  // Distances of the free and fixed controls to it; the nearest fixed one bounds the decay.
+  std::vector<std::vector<double>> distance(nb);
+  double nearest_fixed = std::numeric_limits<double>::infinity();
+  for (int b = 0; b < nb; ++b) {
+    distance[b].assign(deformer.roles_[b].size(), 0.0);
+    for (int64_t c = 0; c < static_cast<int64_t>(distance[b].size()); ++c) {
+      if (deformer.roles_[b][c] == ControlRole::kMoved) continue;
+      const Point3 p = ControlPoint(reference[b].spline, c);
+      double best = std::numeric_limits<double>::infinity();
+      for (const Point3& q : samples) best = std::min(best, Distance2(p, q));
+      distance[b][c] = std::sqrt(best);
+      if (deformer.roles_[b][c] == ControlRole::kFixed) {
+        nearest_fixed = std::min(nearest_fixed, distance[b][c]);
+      }
+    }
+  }
+  deformer.decay_radius_ = options.decay_radius > 0.0 ? options.decay_radius : nearest_fixed;
+  if (!(deformer.decay_radius_ > options.rigid_radius)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "rigid_radius = ", options.rigid_radius, " reaches the nearest fixed boundary control, ",
+        deformer.decay_radius_, " from the moved boundary"));
+  }
+  deformer.fraction_.resize(nb);
+  for (int b = 0; b < nb; ++b) {
+    deformer.fraction_[b].assign(distance[b].size(), 0.0);
+    for (size_t c = 0; c < distance[b].size(); ++c) {
+      switch (deformer.roles_[b][c]) {
+        case ControlRole::kMoved:
+          deformer.fraction_[b][c] = 1.0;
+          break;
+        case ControlRole::kFixed:
+          break;
+        case ControlRole::kFree:
+          deformer.fraction_[b][c] =
+              Fraction(distance[b][c], options.rigid_radius, deformer.decay_radius_);
+          break;
+      }
+    }
+  }
+  // Controls that coincide bitwise (shared boundaries of a watertight grid).
+  std::unordered_map<std::array<uint64_t, 3>, std::vector<std::pair<int, int64_t>>, BitsHash>
+      groups;
+  for (int b = 0; b < nb; ++b) {
+    for (int64_t c = 0; c < reference[b].spline.num_control_points(); ++c) {
+      groups[Bits(ControlPoint(reference[b].spline, c))].push_back({b, c});
+    }
+  }
+  for (auto& [bits, members] : groups) {
+    if (members.size() > 1) {
+      std::sort(members.begin(), members.end());
+      deformer.coinciding_.push_back(std::move(members));
+    }
+  }
+  std::sort(deformer.coinciding_.begin(), deformer.coinciding_.end());
+  deformer.reference_ = std::move(reference);
+  deformer.kinds_ = std::move(kinds);
+  return deformer;
+}
+
+template <typename FreeMotion>
+void Deformer::Propagate(std::vector<FittedBlock>& blocks, const FreeMotion& free_motion) const {
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    TensorSpline& spline = blocks[b].spline;
+    for (int64_t c = 0; c < spline.num_control_points(); ++c) {
+      if (roles_[b][c] != ControlRole::kFree) continue;
+      const Point3 p = ControlPoint(reference_[b].spline, c);
+      SetControlPoint(spline, c, free_motion(p, fraction_[b][c]));
+    }
+  }
+  Finish(blocks);
+}
+
+void Deformer::Finish(std::vector<FittedBlock>& blocks) const {
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    TensorSpline& spline = blocks[b].spline;
+    const Extents n = spline.control_extents();
+    const bool has_interior =
+        spline.active_directions() >= 2 && spline.active_directions() == spline.spatial_dim();
+    if (!has_interior) continue;
+    if (options_.propagation != Propagation::kTransfinite && options_.smoothing_iterations == 0) {
+      continue;
+    }
+    // The displacement of the net, and which controls are interior and free.
+    const int64_t count = spline.num_control_points();
+    std::vector<Point3> D(count);
+    for (int64_t c = 0; c < count; ++c) {
+      const Point3 now = ControlPoint(spline, c), was = ControlPoint(reference_[b].spline, c);
+      D[c] = {now[0] - was[0], now[1] - was[1], now[2] - was[2]};
+    }
+    if (options_.propagation == Propagation::kTransfinite) CoonsInterior(spline, D);
+    auto interior = [&](int a, int bb, int cc) {
+      const int idx[3] = {a, bb, cc};
+      for (int d = 0; d < 3; ++d) {
+        if (n[d] > 1 && (idx[d] == 0 || idx[d] == n[d] - 1)) return false;
+      }
+      return true;
+    };
+    for (int sweep = 0; sweep < options_.smoothing_iterations; ++sweep) {
+      std::vector<Point3> next = D;
+      for (int cc = 0; cc < n[2]; ++cc) {
+        for (int bb = 0; bb < n[1]; ++bb) {
+          for (int a = 0; a < n[0]; ++a) {
+            const int64_t c = a + int64_t{n[0]} * (bb + int64_t{n[1]} * cc);
+            if (!interior(a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
+            Point3 sum = {0, 0, 0};
+            double weights = 0.0;
+            const int64_t stride[3] = {1, n[0], int64_t{n[0]} * n[1]};
+            const Point3 here = ControlPoint(reference_[b].spline, c);
+            for (int d = 0; d < 3; ++d) {
+              if (n[d] == 1) continue;
+              for (int64_t q : {c - stride[d], c + stride[d]}) {
+                const double d2 = Distance2(here, ControlPoint(reference_[b].spline, q));
+                const double w = d2 > 0.0 ? 1.0 / d2 : 0.0;
+                for (int e = 0; e < 3; ++e) sum[e] += w * D[q][e];
+                weights += w;
+              }
+            }
+            if (weights > 0.0) {
+              for (int e = 0; e < 3; ++e) next[c][e] = sum[e] / weights;
+            }
+          }
+        }
+      }
+      D = std::move(next);
+    }
+    for (int cc = 0; cc < n[2]; ++cc) {
+      for (int bb = 0; bb < n[1]; ++bb) {
+        for (int a = 0; a < n[0]; ++a) {
+          const int64_t c = a + int64_t{n[0]} * (bb + int64_t{n[1]} * cc);
+          if (!interior(a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
+          const Point3 was = ControlPoint(reference_[b].spline, c);
+          SetControlPoint(spline, c, {was[0] + D[c][0], was[1] + D[c][1], was[2] + D[c][2]});
+        }
+      }
+    }
+  }
+  // Coinciding controls end up bitwise equal: the first member's value (a moved or fixed
+  // member's, when there is one, so boundaries stay exact).
+  for (const auto& group : coinciding_) {
+    std::pair<int, int64_t> source = group.front();
+    for (const auto& member : group) {
+      if (roles_[member.first][member.second] != ControlRole::kFree) {
+        source = member;
+        break;
+      }
+    }
+    const Point3 value = ControlPoint(blocks[source.first].spline, source.second);
+    for (const auto& [b, c] : group) SetControlPoint(blocks[b].spline, c, value);
+  }
+}
+
+absl::StatusOr<std::vector<FittedBlock>> Deformer::Rigid(const RigidMotion& motion) const {
+  SG_RETURN_IF_ERROR(motion.Validate());
+  std::vector<FittedBlock> blocks = reference_;
+  for (size_t q = 0; q < moved_.size(); ++q) {
+    SetControlPoint(blocks[moved_[q].first].spline, moved_[q].second,
+                    motion.Apply(moved_positions_[q]));
+  }
+  Propagate(blocks, [&](const Point3& p, double f) { return motion.Apply(p, f); });
+  return blocks;
+}
+
+Point3 Deformer::BlendedDisplacement(const Point3& p, double f,
+                                     const std::vector<Point3>& moved_displacements) const {
+  if (f == 0.0) return {0, 0, 0};
+  Point3 sum = {0, 0, 0};
+  double weights = 0.0;
+  for (size_t q = 0; q < moved_positions_.size(); ++q) {
+    const double d2 = Distance2(p, moved_positions_[q]);
+    if (d2 == 0.0)
+      return {f * moved_displacements[q][0], f * moved_displacements[q][1],
+              f * moved_displacements[q][2]};
+    const double w = 1.0 / (d2 * std::sqrt(d2));  // |P - B|^-3
+    weights += w;
+    for (int e = 0; e < 3; ++e) sum[e] += w * moved_displacements[q][e];
+  }
+  return {f * sum[0] / weights, f * sum[1] / weights, f * sum[2] / weights};
+}
+
+absl::StatusOr<std::vector<FittedBlock>> Deformer::DisplaceControls(
+    std::span<const double> displacements) const {
+  const int s = reference_.front().spline.spatial_dim();
+  if (displacements.size() != moved_.size() * s) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "displacements: ", displacements.size(), " values for ", moved_.size(),
+        " moved control points of ", s, " coordinates (", moved_.size() * s, " values)"));
+  }
+  std::vector<Point3> moved(moved_.size(), Point3{0, 0, 0});
+  for (size_t q = 0; q < moved_.size(); ++q) {
+    for (int e = 0; e < s; ++e) {
+      const double v = displacements[s * q + e];
+      if (!std::isfinite(v)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("displacements[", s * q + e, "] = ", v, " is not finite"));
+      }
+      moved[q][e] = v;
+    }
+  }
+  std::vector<FittedBlock> blocks = reference_;
+  for (size_t q = 0; q < moved_.size(); ++q) {
+    const Point3& p = moved_positions_[q];
+    SetControlPoint(blocks[moved_[q].first].spline, moved_[q].second,
+                    {p[0] + moved[q][0], p[1] + moved[q][1], p[2] + moved[q][2]});
+  }
+  Propagate(blocks, [&](const Point3& p, double f) {
+    const Point3 d = BlendedDisplacement(p, f, moved);
+    return Point3{p[0] + d[0], p[1] + d[1], p[2] + d[2]};
+  });
+  return blocks;
+}
+
+absl::StatusOr<std::shared_ptr<const Deformer::BoundaryFit>> Deformer::FitFor(
+    const FaceRange& range, int level) const {
+  const std::vector<int> key = {range.face.block,
+                                range.face.normal,
+                                range.face.upper ? 1 : 0,
+                                range.begin[0],
+                                range.begin[1],
+                                range.begin[2],
+                                range.end[0],
+                                range.end[1],
+                                range.end[2],
+                                level};
+  std::lock_guard<std::mutex> lock(*fits_mutex_);
+  if (auto it = fits_.find(key); it != fits_.end()) return it->second;
+  const FittedBlock& block = reference_[range.face.block];
+  auto fit = std::make_shared<BoundaryFit>();
+  fit->block = range.face.block;
+  for (int d = 0; d < 3; ++d) {
+    const int m = block.distribution.num_points(d);
+    if (d == range.face.normal || m == 1) {
+      const int at = d == range.face.normal ? (range.face.upper ? m - 1 : 0) : 0;
+      fit->params[d] = {block.distribution.params(d)[at]};
+      continue;
+    }
+    fit->tangential.push_back(d);
+    fit->params[d] = block.distribution.Refined(d, range.begin[d], range.end[d], level);
+    absl::StatusOr<RangeFit> f = RangeFit::Create(block.spline.knots(d), fit->params[d]);
+    if (!f.ok()) {
+      return absl::Status(f.status().code(),
+                          absl::StrCat("block ", range.face.block, " direction ", d, ": ",
+                                       f.status().message(), "; give the points at a finer level"));
+    }
+    fit->fits.push_back(*std::move(f));
+  }
+  fits_[key] = fit;
+  return std::shared_ptr<const BoundaryFit>(fit);
+}
+
+absl::StatusOr<std::vector<FittedBlock>> Deformer::MoveBoundaryPoints(
+    std::span<const BoundaryPoints> points) const {
+  const int s = reference_.front().spline.spatial_dim();
+  std::vector<Point3> moved(moved_.size(), Point3{0, 0, 0});
+  std::vector<int> hits(moved_.size(), 0);
+  std::map<std::pair<int, int64_t>, size_t> moved_index;
+  for (size_t q = 0; q < moved_.size(); ++q) moved_index[moved_[q]] = q;
+  std::vector<Extents> extents;
+  for (const FittedBlock& b : reference_) {
+    extents.push_back(
+        {b.distribution.num_points(0), b.distribution.num_points(1), b.distribution.num_points(2)});
+  }
+  for (size_t r = 0; r < points.size(); ++r) {
+    const BoundaryPoints& given = points[r];
+    const std::string name = absl::StrCat("boundary points ", r);
+    BoundarySelection one;
+    one.ranges = {given.range};
+    absl::StatusOr<std::vector<std::vector<uint8_t>>> inside = SelectedPoints(extents, kinds_, one);
+    if (!inside.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": ", inside.status().message()));
+    }
+    const int b = given.range.face.block;
+    for (size_t p = 0; p < (*inside)[b].size(); ++p) {
+      if ((*inside)[b][p] && !selected_[b][p]) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": point ", p, " of block ", b, " is not on the moved boundary"));
+      }
+    }
+    if (given.level < 0 || given.level > kMaxRefinementLevel) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": level = ", given.level,
+                                                     " is outside [0, ", kMaxRefinementLevel, "]"));
+    }
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const BoundaryFit> fit,
+                        FitFor(given.range, given.level));
+    if (fit->tangential.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": the range is a single point"));
+    }
+    int64_t count = 1;
+    for (const RangeFit& f : fit->fits) count *= f.num_samples();
+    if (static_cast<int64_t>(given.coordinates.size()) != count * s) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": ", given.coordinates.size(),
+                                                     " values for ", count, " points of ", s,
+                                                     " coordinates at level ", given.level));
+    }
+    for (size_t v = 0; v < given.coordinates.size(); ++v) {
+      if (!std::isfinite(given.coordinates[v])) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            name, ": coordinates[", v, "] = ", given.coordinates[v], " is not finite"));
+      }
+    }
+    // Displacements at the samples.
+    std::vector<double> delta = given.coordinates;
+    if (!given.displacements) {
+      const StructuredBlock was = EvaluateGrid(reference_[b].spline, fit->params);
+      for (size_t v = 0; v < delta.size(); ++v) delta[v] -= was.coords()[v];
+    }
+    // Direction by direction: first tangential direction (fastest), then the second.
+    const RangeFit& f0 = fit->fits[0];
+    const int64_t rows1 = fit->fits.size() > 1 ? fit->fits[1].num_samples() : 1;
+    std::vector<double> stage(static_cast<size_t>(f0.num_controls()) * rows1 * s);
+    for (int64_t j = 0; j < rows1; ++j) {
+      f0.Apply(delta.data() + j * f0.num_samples() * s, s,
+               stage.data() + j * f0.num_controls() * s);
+    }
+    std::vector<double> controls = stage;
+    int cols1 = 1, first1 = 0;
+    if (fit->fits.size() > 1) {
+      const RangeFit& f1 = fit->fits[1];
+      cols1 = f1.num_controls();
+      first1 = f1.first();
+      // Lines of direction 1 are strided by f0.num_controls() * s: transpose through a buffer.
+      const int64_t width = int64_t{f0.num_controls()} * s;
+      controls.assign(static_cast<size_t>(width) * cols1, 0.0);
+      f1.Apply(stage.data(), width, controls.data());
+    }
+    // Accumulate into the moved controls of the range's face.
+    const Extents n = reference_[b].spline.control_extents();
+    const int t0 = fit->tangential[0];
+    const int t1 = fit->tangential.size() > 1 ? fit->tangential[1] : -1;
+    for (int a1 = 0; a1 < cols1; ++a1) {
+      for (int a0 = 0; a0 < f0.num_controls(); ++a0) {
+        Extents c = {0, 0, 0};
+        const int normal = given.range.face.normal;
+        if (reference_[b].spline.knots(normal).num_controls() > 1 && extents[b][normal] > 1) {
+          c[normal] = given.range.face.upper ? n[normal] - 1 : 0;
+        }
+        c[t0] = f0.first() + a0;
+        if (t1 >= 0) c[t1] = first1 + a1;
+        const int64_t index = c[0] + int64_t{n[0]} * (c[1] + int64_t{n[1]} * c[2]);
+        const auto it = moved_index.find({b, index});
+        if (it == moved_index.end()) continue;  // carries none of the moved boundary
+        const double* v = controls.data() + (int64_t{a1} * f0.num_controls() + a0) * s;
+        for (int e = 0; e < s; ++e) moved[it->second][e] += v[e];
+        ++hits[it->second];
+      }
+    }
+  }
+  for (size_t q = 0; q < moved.size(); ++q) {
+    if (hits[q] > 1) {
+      for (double& v : moved[q]) v /= hits[q];
+    }
+  }
+  std::vector<double> flat(moved_.size() * s);
+  for (size_t q = 0; q < moved.size(); ++q) {
+    for (int e = 0; e < s; ++e) flat[s * q + e] = moved[q][e];
+  }
+  return DisplaceControls(flat);
+}
+
+}  // namespace splinegrid
