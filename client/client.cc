@@ -132,6 +132,15 @@ absl::StatusOr<v1::FitGridResponse> Client::Fair(const std::string& name, int64_
   return response;
 }
 
+absl::StatusOr<v1::DeformGridResponse> Client::Deform(v1::DeformGridRequest request) {
+  auto context = NewContext();
+  request.set_name(GridName(request.name()));
+  v1::DeformGridResponse response;
+  const grpc::Status status = stub_->DeformGrid(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
 absl::StatusOr<v1::GetWallCurvatureResponse> Client::WallCurvature(const std::string& name,
                                                                    int64_t revision,
                                                                    int refinement_level,

@@ -57,6 +57,8 @@ class Client {
   // A faired refit of `revision` (0: latest); fairing null: the server's default (to tolerance).
   absl::StatusOr<v1::FitGridResponse> Fair(const std::string& name, int64_t revision,
                                            const v1::Fairing* fairing = nullptr);
+  // Deforms a grid (request.name may be an id); see DeformGridRequest.
+  absl::StatusOr<v1::DeformGridResponse> Deform(v1::DeformGridRequest request);
   // Curvature samples along the walls of `revision` at `refinement_level`.
   absl::StatusOr<v1::GetWallCurvatureResponse> WallCurvature(const std::string& name,
                                                              int64_t revision, int refinement_level,

@@ -90,7 +90,8 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       return absl::InvalidArgumentError(
           absl::StrCat("revision = ", request_->revision(), " is negative"));
     }
-    SG_ASSIGN_OR_RETURN(revision_, grid_->FindRevision(request_->revision()));
+    SG_ASSIGN_OR_RETURN(revision_,
+                        grid_->FindRevision(request_->revision(), OptionalStep(*request_)));
     SG_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(*request_));
     const int num_blocks = static_cast<int>(revision_->blocks.size());
     std::vector<int> blocks(request_->blocks().begin(), request_->blocks().end());

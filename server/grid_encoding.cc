@@ -1,6 +1,7 @@
 #include "server/grid_encoding.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "absl/strings/str_cat.h"
 #include "proto/convert/convert.h"
@@ -20,11 +21,29 @@ v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
       return v1::REVISION_ORIGIN_FIT;
     case RevisionOrigin::kFair:
       return v1::REVISION_ORIGIN_FAIR;
+    case RevisionOrigin::kDeform:
+      return v1::REVISION_ORIGIN_DEFORM;
   }
   return v1::REVISION_ORIGIN_UNSPECIFIED;
 }
 
 }  // namespace
+
+void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
+  const DeformationCheck& c = deform.check;
+  out->set_check_level(c.level);
+  out->set_cells_checked(c.cells_checked);
+  if (c.cells_checked > 0) {
+    out->set_min_jacobian_ratio(c.min_jacobian_ratio);
+    out->set_max_jacobian_ratio(c.max_jacobian_ratio);
+    out->set_worst_block(c.worst_block);
+    EncodeExtents(c.worst_cell, out->mutable_worst_cell());
+  }
+  out->set_max_orthogonality_change_degrees(c.max_orthogonality_change_degrees);
+  out->set_moved_controls(deform.moved_controls);
+  out->set_decay_radius(std::isfinite(deform.decay_radius) ? deform.decay_radius : 0.0);
+  out->set_seconds(deform.seconds);
+}
 
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
                         const std::vector<int>& blocks, v1::Grid* out) {
@@ -51,6 +70,11 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
     info->set_revision(r->number);
     EncodeTime(r->create_time, info->mutable_create_time());
     info->set_origin(EncodeOrigin(r->origin));
+    info->set_parent_revision(r->parent);
+    if (r->origin == RevisionOrigin::kDeform) {
+      info->set_time(r->time);
+      info->set_step(r->step);
+    }
   }
   if (grid.revisions.empty()) {
     if (revision != 0) {
@@ -79,7 +103,13 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   r->set_compression_ratio(static_cast<double>(points) /
                            std::max<int64_t>(rev.num_control_points(), 1));
   r->set_max_deviation(rev.max_deviation());
-  EncodeFitReport(rev.report, rev.blocks, r->mutable_report());
+  if (rev.origin != RevisionOrigin::kDeform) {
+    EncodeFitReport(rev.report, rev.blocks, r->mutable_report());
+  } else {
+    r->set_time(rev.time);
+    r->set_step(rev.step);
+    EncodeDeformReport(rev.deform, r->mutable_deform_report());
+  }
   r->set_parent_revision(rev.parent);
   const bool full = view == v1::GRID_VIEW_FULL;
   auto wanted = [&](int b) {

@@ -29,6 +29,19 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(int
                                           revisions.back()->number, ")"));
 }
 
+absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(
+    int64_t number, std::optional<int64_t> step) const {
+  if (!step) return FindRevision(number);
+  if (number != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("revision = ", number, " and step = ", *step, " are both given; give one"));
+  }
+  for (auto it = revisions.rbegin(); it != revisions.rend(); ++it) {
+    if ((*it)->origin == RevisionOrigin::kDeform && (*it)->step == *step) return *it;
+  }
+  return absl::NotFoundError(absl::StrCat("grids/", id, " has no revision of step ", *step));
+}
+
 int64_t FittedBlockBytes(const FittedBlock& block) {
   int64_t bytes = static_cast<int64_t>(block.spline.control().size()) * sizeof(double);
   for (int d = 0; d < 3; ++d) {
@@ -68,12 +81,18 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> GridStore::Get(const std::stri
 }
 
 absl::StatusOr<std::shared_ptr<const StoredGrid>> GridStore::AddRevision(const std::string& id,
-                                                                         GridRevision revision) {
+                                                                         GridRevision revision,
+                                                                         int64_t expected_latest) {
   auto published = std::make_shared<GridRevision>(std::move(revision));
   std::lock_guard<std::mutex> lock(mu_);
   const auto it = grids_.find(id);
   if (it == grids_.end()) {
     return absl::NotFoundError(absl::StrCat("grids/", id, " was deleted"));
+  }
+  const int64_t latest = it->second->revisions.empty() ? 0 : it->second->revisions.back()->number;
+  if (expected_latest != 0 && latest != expected_latest) {
+    return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,
+                                           " is stale; the latest revision is ", latest));
   }
   auto next = std::make_shared<StoredGrid>(*it->second);
   published->number = next->revisions.empty() ? 1 : next->revisions.back()->number + 1;

@@ -10,11 +10,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "core/deform/deform_quality.h"
 #include "core/fit/grid_fit.h"
 #include "core/grid/structured_grid.h"
 #include "server/memory_budget.h"
@@ -22,8 +24,17 @@
 namespace splinegrid::server {
 
 enum class RevisionOrigin {
-  kFit,   // FitGrid
-  kFair,  // FairGrid: a faired refit of a parent revision's spec
+  kFit,     // FitGrid
+  kFair,    // FairGrid: a faired refit of a parent revision's spec
+  kDeform,  // DeformGrid: a parent revision with part of its boundary moved
+};
+
+// What the quality gate of a deformation measured.
+struct DeformSummary {
+  DeformationCheck check;
+  int moved_controls = 0;
+  double decay_radius = 0.0;
+  double seconds = 0.0;
 };
 
 // An immutable state of a grid's spline mapping.
@@ -31,8 +42,11 @@ struct GridRevision {
   int64_t number = 0;
   absl::Time create_time;
   RevisionOrigin origin = RevisionOrigin::kFit;
-  GridFitOptions fit_options;  // provenance
-  int64_t parent = 0;          // kFair: the revision it was faired from
+  GridFitOptions fit_options;  // provenance (kDeform: the parent's)
+  int64_t parent = 0;          // kFair, kDeform: the revision it was made from
+  double time = 0.0;           // kDeform: the solver's time and step
+  int64_t step = 0;
+  DeformSummary deform;  // kDeform
   std::vector<BlockFit> blocks;
   BoundaryKinds kinds;  // the boundary kinds the fit used (walls for curvature)
   GridFitReport report;
@@ -60,6 +74,10 @@ struct StoredGrid {
 
   // The revision `number` (0: the latest), or NOT_FOUND / FAILED_PRECONDITION (none yet).
   absl::StatusOr<std::shared_ptr<const GridRevision>> FindRevision(int64_t number) const;
+  // The revision `number`, or with `step` the latest deformed revision of that time step
+  // (INVALID_ARGUMENT if both are given; NOT_FOUND if no revision has the step).
+  absl::StatusOr<std::shared_ptr<const GridRevision>> FindRevision(
+      int64_t number, std::optional<int64_t> step) const;
 };
 
 // Bytes a block's spline, point distribution and summary take in memory.
@@ -77,9 +95,12 @@ class GridStore {
   absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) const;
 
   // Publishes `revision` (its number is assigned here: latest + 1) as the grid's newest and
-  // returns the new snapshot; NOT_FOUND if the grid was deleted meanwhile.
+  // returns the new snapshot; NOT_FOUND if the grid was deleted meanwhile, ABORTED if
+  // `expected_latest` is not 0 and the grid's latest revision is another one (a concurrent
+  // writer got there first).
   absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
-                                                                GridRevision revision);
+                                                                GridRevision revision,
+                                                                int64_t expected_latest = 0);
 
   // Removes the grid; NOT_FOUND if absent. Readers holding snapshots keep them.
   absl::Status Delete(const std::string& id);

@@ -111,7 +111,13 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
           absl::StrCat("revision = ", request->revision(), " is negative"));
     }
     const std::vector<int> blocks(request->blocks().begin(), request->blocks().end());
-    return EncodeGrid(*grid, request->revision(), request->view(), blocks, response);
+    int64_t revision = request->revision();
+    if (request->has_step()) {
+      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> found,
+                          grid->FindRevision(revision, OptionalStep(*request)));
+      revision = found->number;
+    }
+    return EncodeGrid(*grid, revision, request->view(), blocks, response);
   };
   // Encoding a FULL view copies control nets: pool work; the basic view is a lookup.
   if (request->view() == v1::GRID_VIEW_FULL) return RunOnPool(context, log, work);
@@ -152,7 +158,9 @@ grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerCont
   CallLog log("DeleteGrid", request->name(), state_->options.log_calls);
   return RunInline(context, log, [this, request]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    return state_->store.Delete(id);
+    SG_RETURN_IF_ERROR(state_->store.Delete(id));
+    state_->deformers.Forget(DeformerKeyPrefix(id));
+    return absl::OkStatus();
   });
 }
 

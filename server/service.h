@@ -6,11 +6,13 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
 #include "grpcpp/grpcpp.h"
 #include "server/call_log.h"
+#include "server/deformer_cache.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
 #include "server/server_options.h"
@@ -27,6 +29,7 @@ struct ServiceState {
   GridStore store;
   MemoryBudget budget;
   WorkerPool pool;
+  DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
 };
 
@@ -46,6 +49,16 @@ absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::st
 // Whether `id` is a valid grid id: 1-63 characters of [a-z0-9-], starting with a letter.
 bool IsValidGridId(const std::string& id);
 
+// The prefix of every DeformerCache key of grid `id`.
+inline std::string DeformerKeyPrefix(const std::string& id) { return id + "#"; }
+
+// The optional `step` field of a request that selects a revision.
+template <typename Request>
+std::optional<int64_t> OptionalStep(const Request& request) {
+  if (!request.has_step()) return std::nullopt;
+  return request.step();
+}
+
 class SplineGridService final : public v1::SplineGrid::CallbackService {
  public:
   explicit SplineGridService(ServiceState* state) : state_(state) {}
@@ -61,6 +74,9 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* GetWallCurvature(grpc::CallbackServerContext* context,
                                              const v1::GetWallCurvatureRequest* request,
                                              v1::GetWallCurvatureResponse* response) override;
+  grpc::ServerUnaryReactor* DeformGrid(grpc::CallbackServerContext* context,
+                                       const v1::DeformGridRequest* request,
+                                       v1::DeformGridResponse* response) override;
   grpc::ServerUnaryReactor* GetGrid(grpc::CallbackServerContext* context,
                                     const v1::GetGridRequest* request, v1::Grid* response) override;
   grpc::ServerUnaryReactor* ListGrids(grpc::CallbackServerContext* context,

@@ -129,6 +129,74 @@ absl::StatusOr<Face> ParseBlockFace(int block, v1::BlockFace face, const std::st
   return Face{block, (value - 1) / 2, (value - 1) % 2 == 1};
 }
 
+absl::StatusOr<FaceRange> ParseFaceRange(const v1::FaceRange& range, const std::string& field) {
+  SG_ASSIGN_OR_RETURN(const Face face, ParseBlockFace(range.block(), range.face(), field));
+  FaceRange out{face, ParseExtents(range.begin()), ParseExtents(range.end())};
+  return out;
+}
+
+void EncodeFaceRange(const FaceRange& range, v1::FaceRange* out) {
+  out->set_block(range.face.block);
+  out->set_face(EncodeBlockFace(range.face.normal, range.face.upper));
+  EncodeExtents(range.begin, out->mutable_begin());
+  EncodeExtents(range.end, out->mutable_end());
+}
+
+absl::StatusOr<BoundarySelection> ParseBoundarySelection(const v1::BoundarySelection& selection) {
+  BoundarySelection out;
+  if (selection.kinds_size() > 0) out.kinds = 0;
+  for (int q = 0; q < selection.kinds_size(); ++q) {
+    switch (selection.kinds(q)) {
+      case v1::BOUNDARY_KIND_WALL:
+        out.kinds |= static_cast<uint8_t>(BoundaryKind::kWall);
+        break;
+      case v1::BOUNDARY_KIND_INTERFACE:
+        out.kinds |= static_cast<uint8_t>(BoundaryKind::kInterface);
+        break;
+      case v1::BOUNDARY_KIND_OUTER:
+        out.kinds |= static_cast<uint8_t>(BoundaryKind::kOuter);
+        break;
+      default:
+        return absl::InvalidArgumentError(absl::StrCat("boundary.kinds[", q,
+                                                       "] = ", static_cast<int>(selection.kinds(q)),
+                                                       " is not WALL, INTERFACE or OUTER"));
+    }
+  }
+  for (int q = 0; q < selection.ranges_size(); ++q) {
+    SG_ASSIGN_OR_RETURN(FaceRange range, ParseFaceRange(selection.ranges(q),
+                                                        absl::StrCat("boundary.ranges[", q, "]")));
+    out.ranges.push_back(range);
+  }
+  return out;
+}
+
+absl::StatusOr<RigidMotion> ParseRigidMotion(const v1::RigidMotion& motion) {
+  RigidMotion out;
+  auto take = [](const google::protobuf::RepeatedField<double>& values, const char* name,
+                 bool allow_two, Point3& into) -> absl::Status {
+    if (values.empty()) return absl::OkStatus();
+    if (values.size() != 3 && !(allow_two && values.size() == 2)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "rigid.", name, ": ", values.size(), " values; give ", allow_two ? "2 or " : "", "3"));
+    }
+    into = {0.0, 0.0, 0.0};
+    for (int c = 0; c < values.size(); ++c) into[c] = values[c];
+    return absl::OkStatus();
+  };
+  SG_RETURN_IF_ERROR(take(motion.center(), "center", true, out.center));
+  SG_RETURN_IF_ERROR(take(motion.axis(), "axis", false, out.axis));
+  SG_RETURN_IF_ERROR(take(motion.translation(), "translation", true, out.translation));
+  out.angle = motion.angle_degrees() * (3.14159265358979323846 / 180.0);
+  if (!std::isfinite(motion.angle_degrees())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rigid.angle_degrees = ", motion.angle_degrees(), " is not finite"));
+  }
+  if (absl::Status s = out.Validate(); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("rigid ", s.message()));
+  }
+  return out;
+}
+
 absl::StatusOr<FairingOptions> ParseFairing(const v1::Fairing& fairing, const std::string& field) {
   FairingOptions options;
   const double weight = fairing.weight();

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/deform/boundary_controls.h"
+#include "core/deform/rigid_motion.h"
 #include "core/fit/grid_fit.h"
 #include "core/fit/tensor_fit.h"
 #include "core/grid/sampling.h"
@@ -44,6 +46,17 @@ void EncodeBoundaryMatch(const BoundaryMatch& match, v1::BoundaryMatch* out);
 v1::BlockFace EncodeBlockFace(int normal, bool upper);
 // Face `face` of block `block`, or INVALID_ARGUMENT naming `field`.
 absl::StatusOr<Face> ParseBlockFace(int block, v1::BlockFace face, const std::string& field);
+
+// A face range of the API as the kernel's, validated against nothing but itself (the
+// kernel checks it against the grid); `field` names it in errors.
+absl::StatusOr<FaceRange> ParseFaceRange(const v1::FaceRange& range, const std::string& field);
+void EncodeFaceRange(const FaceRange& range, v1::FaceRange* out);
+
+// The moved boundary of a deformation: kinds (empty: wall) or face ranges.
+absl::StatusOr<BoundarySelection> ParseBoundarySelection(const v1::BoundarySelection& selection);
+
+// A rigid motion; angles in degrees on the wire, radians in the kernel.
+absl::StatusOr<RigidMotion> ParseRigidMotion(const v1::RigidMotion& motion);
 
 // Fairing (mode and weight), validated; `field` names it in errors.
 absl::StatusOr<FairingOptions> ParseFairing(const v1::Fairing& fairing, const std::string& field);

@@ -1,0 +1,216 @@
+// DeformGrid: move part of a revision's boundary, let the grid follow, gate it for folds and
+// store it as a new revision stamped with the solver's time and step.
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+#include "core/deform/deform_quality.h"
+#include "core/deform/deformer.h"
+#include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
+#include "server/grid_encoding.h"
+#include "server/service.h"
+
+namespace splinegrid::server {
+namespace {
+
+// Highest refinement level of the fold check (16 sub-cells per cell in 2D, 64 in 3D at 2).
+constexpr int kMaxCheckLevel = 4;
+
+absl::StatusOr<DeformOptions> ParseDeformOptions(const v1::DeformGridRequest& request) {
+  DeformOptions options;
+  SG_ASSIGN_OR_RETURN(options.moved, ParseBoundarySelection(request.boundary()));
+  switch (request.propagation()) {
+    case v1::PROPAGATION_UNSPECIFIED:
+    case v1::PROPAGATION_BLEND:
+      options.propagation = Propagation::kBlend;
+      break;
+    case v1::PROPAGATION_TRANSFINITE:
+      options.propagation = Propagation::kTransfinite;
+      break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat(
+          "propagation = ", static_cast<int>(request.propagation()), " is not a known value"));
+  }
+  options.rigid_radius = request.rigid_radius();
+  options.decay_radius = request.decay_radius();
+  options.smoothing_iterations = request.smoothing_iterations();
+  SG_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+// The cache key of the deformer: the grid (id and creation), the reference revision and
+// everything the deformer is built from.
+std::string DeformerKey(const StoredGrid& grid, int64_t reference,
+                        const v1::DeformGridRequest& request) {
+  v1::DeformGridRequest shape;
+  *shape.mutable_boundary() = request.boundary();
+  shape.set_propagation(request.propagation());
+  shape.set_rigid_radius(request.rigid_radius());
+  shape.set_decay_radius(request.decay_radius());
+  shape.set_smoothing_iterations(request.smoothing_iterations());
+  return absl::StrCat(DeformerKeyPrefix(grid.id), absl::ToUnixNanos(grid.create_time), "#",
+                      reference, "#", shape.SerializeAsString());
+}
+
+// The moved controls' displacements from a ControlMotion, in the deformer's order.
+absl::StatusOr<std::vector<double>> ControlDisplacementsOf(const Deformer& deformer,
+                                                           const v1::ControlMotion& motion) {
+  const int s = deformer.reference().front().spline.spatial_dim();
+  std::map<std::pair<int, int64_t>, size_t> index;
+  for (size_t q = 0; q < deformer.moved_controls().size(); ++q) {
+    index[deformer.moved_controls()[q]] = q;
+  }
+  std::vector<double> out(deformer.moved_controls().size() * s, 0.0);
+  const int num_blocks = static_cast<int>(deformer.reference().size());
+  for (int e = 0; e < motion.blocks_size(); ++e) {
+    const v1::ControlDisplacements& given = motion.blocks(e);
+    const std::string field = absl::StrCat("controls.blocks[", e, "]");
+    if (given.block() < 0 || given.block() >= num_blocks) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".block = ", given.block(), " is outside [0, ", num_blocks - 1, "]"));
+    }
+    if (given.values_size() != s * given.controls_size()) {
+      return absl::InvalidArgumentError(absl::StrCat(field, ": ", given.values_size(),
+                                                     " values for ", given.controls_size(),
+                                                     " controls of ", s, " coordinates"));
+    }
+    for (int q = 0; q < given.controls_size(); ++q) {
+      const auto it = index.find({given.block(), given.controls(q)});
+      if (it == index.end()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            field, ".controls[", q, "] = ", given.controls(q),
+            " does not carry the moved boundary (or is no control of block ", given.block(), ")"));
+      }
+      for (int c = 0; c < s; ++c) out[s * it->second + c] = given.values(s * q + c);
+    }
+  }
+  return out;
+}
+
+absl::StatusOr<std::vector<BoundaryPoints>> BoundaryPointsOf(const v1::BoundaryPointsMotion& m) {
+  std::vector<BoundaryPoints> out;
+  for (int q = 0; q < m.ranges_size(); ++q) {
+    const v1::BoundaryPointMotion& given = m.ranges(q);
+    BoundaryPoints points;
+    SG_ASSIGN_OR_RETURN(
+        points.range,
+        ParseFaceRange(given.range(), absl::StrCat("boundary_points.ranges[", q, "].range")));
+    points.level = given.refinement_level();
+    points.coordinates.assign(given.coordinates().begin(), given.coordinates().end());
+    points.displacements = given.displacements();
+    out.push_back(std::move(points));
+  }
+  return out;
+}
+
+}  // namespace
+
+grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerContext* context,
+                                                        const v1::DeformGridRequest* request,
+                                                        v1::DeformGridResponse* response) {
+  CallLog log("DeformGrid", request->name(), state_->options.log_calls);
+  CancelCheck cancel = CallCancelCheck(context);
+  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
+    const auto start = std::chrono::steady_clock::now();
+    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    if (request->base_revision() < 0 || request->reference_revision() < 0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "base_revision = ", request->base_revision(),
+          " and reference_revision = ", request->reference_revision(), " must not be negative"));
+    }
+    if (request->check_level() < 0 || request->check_level() > kMaxCheckLevel) {
+      return absl::InvalidArgumentError(absl::StrCat("check_level = ", request->check_level(),
+                                                     " is outside [0, ", kMaxCheckLevel, "]"));
+    }
+    if (!std::isfinite(request->time())) {
+      return absl::InvalidArgumentError(absl::StrCat("time = ", request->time(), " is not finite"));
+    }
+    if (request->motion_case() == v1::DeformGridRequest::MOTION_NOT_SET) {
+      return absl::InvalidArgumentError("motion is unset: give rigid, controls or boundary_points");
+    }
+    SG_ASSIGN_OR_RETURN(const DeformOptions options, ParseDeformOptions(*request));
+    const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
+    if (request->base_revision() != 0 && request->base_revision() != latest) {
+      return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ",
+                                             request->base_revision(),
+                                             " is stale; the latest revision is ", latest));
+    }
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> reference,
+                        grid->FindRevision(request->reference_revision()));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const Deformer> deformer,
+                        state_->deformers.Get(DeformerKey(*grid, reference->number, *request),
+                                              [&]() -> absl::StatusOr<Deformer> {
+                                                std::vector<FittedBlock> blocks;
+                                                for (const BlockFit& b : reference->blocks)
+                                                  blocks.push_back(b.fitted);
+                                                return Deformer::Create(std::move(blocks),
+                                                                        reference->kinds, options);
+                                              }));
+    std::vector<FittedBlock> moved;
+    switch (request->motion_case()) {
+      case v1::DeformGridRequest::kRigid: {
+        SG_ASSIGN_OR_RETURN(const RigidMotion motion, ParseRigidMotion(request->rigid()));
+        SG_ASSIGN_OR_RETURN(moved, deformer->Rigid(motion));
+        break;
+      }
+      case v1::DeformGridRequest::kControls: {
+        SG_ASSIGN_OR_RETURN(const std::vector<double> displacements,
+                            ControlDisplacementsOf(*deformer, request->controls()));
+        SG_ASSIGN_OR_RETURN(moved, deformer->DisplaceControls(displacements));
+        break;
+      }
+      case v1::DeformGridRequest::kBoundaryPoints: {
+        SG_ASSIGN_OR_RETURN(const std::vector<BoundaryPoints> points,
+                            BoundaryPointsOf(request->boundary_points()));
+        SG_ASSIGN_OR_RETURN(moved, deformer->MoveBoundaryPoints(points));
+        break;
+      }
+      case v1::DeformGridRequest::MOTION_NOT_SET:
+        break;
+    }
+    SG_ASSIGN_OR_RETURN(const DeformationCheck check,
+                        CheckDeformation(deformer->reference(), moved, deformer->kinds(),
+                                         request->check_level(), cancel));
+    if (!check.ok()) {
+      const Extents& c = check.worst_cell;
+      return absl::FailedPreconditionError(
+          absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",
+                       check.level, "; the worst in block ", check.worst_block, " at cell (", c[0],
+                       ", ", c[1], ", ", c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
+                       "; nothing was stored (move less per step, or widen decay_radius)"));
+    }
+    GridRevision revision;
+    revision.create_time = absl::Now();
+    revision.origin = RevisionOrigin::kDeform;
+    revision.parent = reference->number;
+    revision.time = request->time();
+    revision.step = request->step();
+    revision.fit_options = reference->fit_options;
+    revision.kinds = reference->kinds;
+    revision.blocks = reference->blocks;
+    for (size_t b = 0; b < moved.size(); ++b) revision.blocks[b].fitted.spline = moved[b].spline;
+    revision.deform.check = check;
+    revision.deform.moved_controls = static_cast<int>(deformer->moved_controls().size());
+    revision.deform.decay_radius = deformer->decay_radius();
+    revision.deform.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    int64_t bytes = 0;
+    for (const BlockFit& b : revision.blocks) bytes += FittedBlockBytes(b.fitted);
+    for (const std::vector<uint8_t>& k : revision.kinds.point_kinds) {
+      bytes += static_cast<int64_t>(k.size());
+    }
+    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(bytes, "the deformed revision"));
+    SG_ASSIGN_OR_RETURN(
+        const std::shared_ptr<const StoredGrid> stored,
+        state_->store.AddRevision(id, std::move(revision), request->base_revision()));
+    const GridRevision& published = *stored->revisions.back();
+    response->set_revision(published.number);
+    EncodeDeformReport(published.deform, response->mutable_report());
+    return absl::OkStatus();
+  });
+}
+
+}  // namespace splinegrid::server

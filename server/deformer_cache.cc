@@ -1,0 +1,29 @@
+#include "server/deformer_cache.h"
+
+namespace splinegrid::server {
+
+absl::StatusOr<std::shared_ptr<const Deformer>> DeformerCache::Get(
+    const std::string& key, const std::function<absl::StatusOr<Deformer>()>& make) {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+      if (it->first != key) continue;
+      entries_.splice(entries_.begin(), entries_, it);
+      return entries_.front().second;
+    }
+  }
+  absl::StatusOr<Deformer> made = make();
+  if (!made.ok()) return made.status();
+  auto deformer = std::make_shared<const Deformer>(*std::move(made));
+  std::lock_guard<std::mutex> lock(mu_);
+  entries_.emplace_front(key, deformer);
+  while (static_cast<int>(entries_.size()) > capacity_) entries_.pop_back();
+  return deformer;
+}
+
+void DeformerCache::Forget(const std::string& prefix) {
+  std::lock_guard<std::mutex> lock(mu_);
+  entries_.remove_if([&](const auto& e) { return e.first.rfind(prefix, 0) == 0; });
+}
+
+}  // namespace splinegrid::server

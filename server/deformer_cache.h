@@ -1,0 +1,39 @@
+// Deformers kept between DeformGrid calls. Building one costs O(controls x boundary points) and
+// the factored boundary fits, and a coupled simulation deforms the same reference revision with
+// the same boundary every step, so the server keeps the most recently used few.
+#ifndef SPLINEGRID_SERVER_DEFORMER_CACHE_H_
+#define SPLINEGRID_SERVER_DEFORMER_CACHE_H_
+
+#include <functional>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "absl/status/statusor.h"
+#include "core/deform/deformer.h"
+
+namespace splinegrid::server {
+
+class DeformerCache {
+ public:
+  explicit DeformerCache(int capacity = 16) : capacity_(capacity) {}
+
+  // The deformer of `key`, made by `make` (outside the lock) when it is not kept; the least
+  // recently used entry goes when more than `capacity` are kept.
+  absl::StatusOr<std::shared_ptr<const Deformer>> Get(
+      const std::string& key, const std::function<absl::StatusOr<Deformer>()>& make);
+
+  // Drops every entry whose key starts with `prefix` (a deleted grid's).
+  void Forget(const std::string& prefix);
+
+ private:
+  const int capacity_;
+  std::mutex mu_;
+  std::list<std::pair<std::string, std::shared_ptr<const Deformer>>> entries_;  // newest first
+};
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_DEFORMER_CACHE_H_
