@@ -29,6 +29,17 @@ v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
 
 }  // namespace
 
+void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out) {
+  out->set_revision(revision.number);
+  EncodeTime(revision.create_time, out->mutable_create_time());
+  out->set_origin(EncodeOrigin(revision.origin));
+  out->set_parent_revision(revision.parent);
+  if (revision.origin == RevisionOrigin::kDeform) {
+    out->set_time(revision.time);
+    out->set_step(revision.step);
+  }
+}
+
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
   const DeformationCheck& c = deform.check;
   out->set_check_level(c.level);
@@ -66,15 +77,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
     for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
   }
   for (const auto& r : grid.revisions) {
-    v1::RevisionInfo* info = out->add_revisions();
-    info->set_revision(r->number);
-    EncodeTime(r->create_time, info->mutable_create_time());
-    info->set_origin(EncodeOrigin(r->origin));
-    info->set_parent_revision(r->parent);
-    if (r->origin == RevisionOrigin::kDeform) {
-      info->set_time(r->time);
-      info->set_step(r->step);
-    }
+    EncodeRevisionInfo(RevisionSummary::Of(*r), out->add_revisions());
   }
   if (grid.revisions.empty()) {
     if (revision != 0) {

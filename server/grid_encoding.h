@@ -19,6 +19,9 @@ inline constexpr int64_t kMaxMessageBytes = (int64_t{4} << 20) - (64 << 10);
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
                         const std::vector<int>& blocks, v1::Grid* out);
 
+// One entry of a grid's revision history (time and step for deformed revisions only).
+void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out);
+
 // What a deformation's quality gate measured.
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out);
 

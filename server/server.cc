@@ -13,11 +13,14 @@ namespace splinegrid::server {
 
 absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& options) {
   if (options.worker_threads < 0 || options.max_queued_tasks < 1 ||
-      options.memory_budget_bytes < 1 || options.max_output_points < 1) {
+      options.memory_budget_bytes < 1 || options.max_output_points < 1 ||
+      options.max_deform_revisions < 1 || options.max_watch_lag < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "server options out of range: worker_threads = ", options.worker_threads,
         ", max_queued_tasks = ", options.max_queued_tasks, ", memory_budget_bytes = ",
-        options.memory_budget_bytes, ", max_output_points = ", options.max_output_points));
+        options.memory_budget_bytes, ", max_output_points = ", options.max_output_points,
+        ", max_deform_revisions = ", options.max_deform_revisions,
+        ", max_watch_lag = ", options.max_watch_lag));
   }
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -52,6 +55,9 @@ void Server::Shutdown() {
     health->SetServingStatus(kServiceName, false);
     health->SetServingStatus(false);
     state_->draining.store(true);
+    // Watches would otherwise wait for revisions until the grace period ends: end them now
+    // (UNAVAILABLE); new ones are refused.
+    state_->store.CloseSubscriptions();
     server_->Shutdown(std::chrono::system_clock::now() +
                       absl::ToChronoNanoseconds(state_->options.shutdown_grace));
     server_->Wait();

@@ -27,7 +27,8 @@ class Server {
   // A channel to this server that bypasses the network (for tests).
   std::shared_ptr<grpc::Channel> InProcessChannel();
 
-  // NOT_SERVING, refuse new calls (UNAVAILABLE), let in-flight calls finish within
+  // NOT_SERVING, refuse new calls and end WatchGrid streams (UNAVAILABLE), let in-flight calls
+  // finish within
   // options.shutdown_grace, cancel the rest, stop the workers. Idempotent.
   void Shutdown();
 

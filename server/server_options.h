@@ -21,6 +21,12 @@ struct ServerOptions {
   int64_t memory_budget_bytes = int64_t{4} << 30;
   // The most points one EvaluateGrid or EvaluatePoints call may ask for (OUT_OF_RANGE beyond).
   int64_t max_output_points = int64_t{1} << 30;
+  // Deformed revisions kept per grid: publishing a revision drops the older ones (fitted and
+  // faired revisions are always kept). At least 1.
+  int max_deform_revisions = 64;
+  // Revisions a WatchGrid call may fall behind (published, not yet written to the client)
+  // before it is ended with RESOURCE_EXHAUSTED. At least 1.
+  int max_watch_lag = 1024;
   // On shutdown, in-flight calls get this long to finish before they are cancelled.
   absl::Duration shutdown_grace = absl::Seconds(10);
   // One line per call on stderr.

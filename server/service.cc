@@ -23,6 +23,7 @@ int DefaultThreads(int requested) {
 
 ServiceState::ServiceState(const ServerOptions& opts)
     : options(opts),
+      store(opts.max_deform_revisions),
       budget(opts.memory_budget_bytes),
       pool(DefaultThreads(opts.worker_threads), opts.max_queued_tasks) {}
 

@@ -77,6 +77,8 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* DeformGrid(grpc::CallbackServerContext* context,
                                        const v1::DeformGridRequest* request,
                                        v1::DeformGridResponse* response) override;
+  grpc::ServerWriteReactor<v1::WatchGridResponse>* WatchGrid(
+      grpc::CallbackServerContext* context, const v1::WatchGridRequest* request) override;
   grpc::ServerUnaryReactor* GetGrid(grpc::CallbackServerContext* context,
                                     const v1::GetGridRequest* request, v1::Grid* response) override;
   grpc::ServerUnaryReactor* ListGrids(grpc::CallbackServerContext* context,

@@ -1,7 +1,10 @@
-// Eight client threads mixing import, fit, fair, evaluate, wall curvature, list and delete on
-// shared and on each other's grids. Every answer must be OK or an expected race outcome (NOT_FOUND when another
-// thread deleted the grid, FAILED_PRECONDITION when it is not fitted yet); the shared grid must
-// end exactly as it began. Runs clean under ThreadSanitizer (.ci/tsan).
+// Eight client threads mixing import, fit, fair, deform, watch, evaluate, wall curvature, list
+// and delete on shared and on each other's grids. Every answer must be OK or an expected race
+// outcome (NOT_FOUND when another thread deleted the grid, FAILED_PRECONDITION when it is not
+// fitted yet or a deformation folds, ABORTED when another writer stored a revision first,
+// CANCELLED for the watch the thread cancels itself); the shared grid must end exactly as it
+// began. Runs clean under ThreadSanitizer (.ci/tsan).
+#include <chrono>
 #include <random>
 #include <thread>
 
@@ -17,7 +20,25 @@ constexpr int kRounds = 25;
 
 bool Expected(const absl::Status& status) {
   return status.ok() || status.code() == absl::StatusCode::kNotFound ||
-         status.code() == absl::StatusCode::kFailedPrecondition;
+         status.code() == absl::StatusCode::kFailedPrecondition ||
+         status.code() == absl::StatusCode::kAborted;
+}
+
+// Watches `name` from its first revision, reads one message (there is one, or the grid is
+// gone and the stream ends) and cancels.
+absl::Status WatchBriefly(client::Client& client, const std::string& name) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  v1::WatchGridRequest request;
+  request.set_name("grids/" + name);
+  auto reader = client.stub().WatchGrid(&context, request);
+  v1::WatchGridResponse message;
+  reader->Read(&message);
+  context.TryCancel();
+  while (reader->Read(&message)) {
+  }
+  const absl::Status status = client::FromGrpc(reader->Finish());
+  return status.code() == absl::StatusCode::kCancelled ? absl::OkStatus() : status;
 }
 
 TEST_F(ServiceTest, ConcurrentClientsMixingEveryMethod) {
@@ -47,7 +68,26 @@ TEST_F(ServiceTest, ConcurrentClientsMixingEveryMethod) {
         spec.mutable_control_counts()->set_i(4 + rng() % 2);
         spec.mutable_control_counts()->set_j(4);
       }
-      check(client_->Fit(mine, spec).status(), "fit");
+      const absl::Status fitted = client_->Fit(mine, spec).status();
+      check(fitted, "fit");
+      v1::DeformGridRequest deform;
+      deform.set_name(mine);
+      deform.set_base_revision(1);
+      deform.set_step(round);
+      v1::FaceRange* surface = deform.mutable_boundary()->add_ranges();
+      const int moved = static_cast<int>(rng() % sphere.blocks.size());
+      surface->set_block(moved);
+      surface->set_face(v1::BLOCK_FACE_K_MIN);  // the whole surface block
+      surface->mutable_end()->set_i(sphere.blocks[moved].extent(0) - 1);
+      surface->mutable_end()->set_j(sphere.blocks[moved].extent(1) - 1);
+      deform.set_decay_radius(0.5);
+      for (double d : {1e-3, 0.0, 0.0}) deform.mutable_rigid()->add_translation(d);
+      {
+        auto st = client_->Deform(deform).status();
+        fprintf(stderr, "DEFORM %s\n", st.ToString().c_str());
+        check(st, "deform");
+      }
+      if (fitted.ok()) check(WatchBriefly(*client_, mine), "watch");
       v1::EvaluateGridRequest eval;
       eval.set_name(rng() % 2 ? "shared" : theirs);
       eval.set_refinement_level(1);

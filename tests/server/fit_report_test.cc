@@ -8,12 +8,6 @@
 namespace splinegrid::testing {
 namespace {
 
-MATCHER_P2(StatusIs, code, fragment, "") {
-  const absl::Status status = arg;
-  *result_listener << "status " << status;
-  return status.code() == code && status.message().find(fragment) != std::string::npos;
-}
-
 class FitReportTest : public ServiceTest {
  protected:
   void SetUp() override {

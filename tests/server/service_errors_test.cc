@@ -10,12 +10,6 @@ namespace {
 using ::testing::HasSubstr;
 
 // A status matcher: code and a message fragment.
-MATCHER_P2(StatusIs, code, fragment, "") {
-  const absl::Status status = arg;
-  *result_listener << "status " << status;
-  return status.code() == code && status.message().find(fragment) != std::string::npos;
-}
-
 class ServiceErrorsTest : public ServiceTest {
  protected:
   void SetUp() override {

@@ -9,6 +9,7 @@
 
 #include "client/client.h"
 #include "core/io/file_util.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
 
@@ -19,6 +20,13 @@ inline std::string SharedData(const std::string& relative) {
     return std::string(dir) + "/" + relative;
   }
   return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
+}
+
+// A status with `code` whose message contains `fragment`.
+MATCHER_P2(StatusIs, code, fragment, "") {
+  const absl::Status status = arg;
+  *result_listener << "status " << status;
+  return status.code() == code && status.message().find(fragment) != std::string::npos;
 }
 
 class ServiceTest : public ::testing::Test {
