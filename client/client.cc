@@ -141,6 +141,57 @@ absl::StatusOr<v1::DeformGridResponse> Client::Deform(v1::DeformGridRequest requ
   return response;
 }
 
+void WatchCancel::Cancel() {
+  std::lock_guard<std::mutex> lock(mu_);
+  cancelled_ = true;
+  if (context_ != nullptr) context_->TryCancel();
+}
+
+bool WatchCancel::cancelled() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return cancelled_;
+}
+
+void WatchCancel::Attach(grpc::ClientContext* context) {
+  std::lock_guard<std::mutex> lock(mu_);
+  context_ = context;
+  if (context_ != nullptr && cancelled_) context_->TryCancel();
+}
+
+RevisionStream::RevisionStream(std::unique_ptr<grpc::ClientContext> context,
+                               std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader,
+                               std::shared_ptr<WatchCancel> cancel)
+    : context_(std::move(context)), reader_(std::move(reader)), cancel_(std::move(cancel)) {
+  cancel_->Attach(context_.get());
+}
+
+RevisionStream::~RevisionStream() { (void)Finish(); }
+
+bool RevisionStream::Next(v1::WatchGridResponse* message) {
+  if (ended_) return false;
+  if (reader_->Read(message)) return true;
+  ended_ = true;
+  return false;
+}
+
+absl::Status RevisionStream::Finish() {
+  if (status_.has_value()) return *status_;
+  if (!ended_) {
+    context_->TryCancel();
+    v1::WatchGridResponse ignored;
+    while (reader_->Read(&ignored)) {
+    }
+    ended_ = true;
+  }
+  const grpc::Status status = reader_->Finish();
+  cancel_->Attach(nullptr);
+  status_ = FromGrpc(status);
+  if (status.error_code() == grpc::StatusCode::CANCELLED && cancel_->cancelled()) {
+    status_ = absl::CancelledError("the watch was cancelled");
+  }
+  return *status_;
+}
+
 absl::StatusOr<v1::GetWallCurvatureResponse> Client::WallCurvature(const std::string& name,
                                                                    int64_t revision,
                                                                    int refinement_level,
@@ -165,6 +216,15 @@ absl::StatusOr<v1::Grid> Client::Get(const std::string& name, int64_t revision, 
   request.set_revision(revision);
   request.set_view(view);
   for (int b : blocks) request.add_blocks(b);
+  v1::Grid grid;
+  const grpc::Status status = stub_->GetGrid(context.get(), request, &grid);
+  if (!status.ok()) return FromGrpc(status);
+  return grid;
+}
+
+absl::StatusOr<v1::Grid> Client::Get(v1::GetGridRequest request) {
+  auto context = NewContext();
+  request.set_name(GridName(request.name()));
   v1::Grid grid;
   const grpc::Status status = stub_->GetGrid(context.get(), request, &grid);
   if (!status.ok()) return FromGrpc(status);
@@ -269,6 +329,37 @@ absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
         absl::StrCat("received ", received, " of ", total_values, " values"));
   }
   return result;
+}
+
+std::unique_ptr<RevisionStream> Client::Watch(const std::string& name, int64_t after_revision,
+                                              std::shared_ptr<WatchCancel> cancel) {
+  auto context = std::make_unique<grpc::ClientContext>();  // no deadline: a watch lasts
+  v1::WatchGridRequest request;
+  request.set_name(GridName(name));
+  request.set_after_revision(after_revision);
+  auto reader = stub_->WatchGrid(context.get(), request);
+  if (cancel == nullptr) cancel = std::make_shared<WatchCancel>();
+  return std::make_unique<RevisionStream>(std::move(context), std::move(reader), std::move(cancel));
+}
+
+absl::Status Client::Watch(const std::string& name, int64_t after_revision,
+                           const std::function<bool(const v1::WatchGridResponse&)>& on_revision,
+                           std::shared_ptr<WatchCancel> cancel) {
+  std::unique_ptr<RevisionStream> stream = Watch(name, after_revision, std::move(cancel));
+  v1::WatchGridResponse message;
+  bool stopped = false;
+  while (stream->Next(&message)) {
+    if (!on_revision(message)) {
+      stopped = true;
+      stream->Cancel();
+      break;
+    }
+  }
+  const absl::Status status = stream->Finish();
+  if (status.ok() || ((stopped || stream->cancel()->cancelled()) && absl::IsCancelled(status))) {
+    return absl::OkStatus();
+  }
+  return status;
 }
 
 absl::StatusOr<v1::EvaluatePointsResponse> Client::EvaluatePoints(

@@ -5,6 +5,8 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,64 @@ struct EvaluatedGrid {
 // "name" or "grids/name" -> "grids/name".
 std::string GridName(const std::string& name_or_id);
 
+// Stops a watch (Client::Watch) from any thread, also before the call has started or after it
+// ended. Shared between the caller and the watch.
+class WatchCancel {
+ public:
+  // Cancels the call: a Next() blocked in another thread returns false, the watch's status is
+  // CANCELLED (Client::Watch with a callback returns OK). Thread-safe; idempotent.
+  void Cancel();
+  bool cancelled() const;
+
+ private:
+  friend class RevisionStream;
+  // Registers the call's context (nullptr: the call is over); cancels it at once when Cancel
+  // came first.
+  void Attach(grpc::ClientContext* context);
+
+  mutable std::mutex mu_;
+  bool cancelled_ = false;
+  grpc::ClientContext* context_ = nullptr;
+};
+
+// A WatchGrid call: the grid's revisions as they are stored, read one at a time.
+//
+//   auto watch = client.Watch("naca", 0);
+//   v1::WatchGridResponse message;
+//   while (watch->Next(&message)) Use(message.revision());
+//   absl::Status why = watch->Finish();
+//
+// Next() blocks until the server sends the next revision. Cancel() (or cancel()->Cancel()) may
+// be called from any other thread while Next() blocks; the stream must outlive those calls.
+// Destroying an unfinished stream cancels the call.
+class RevisionStream {
+ public:
+  RevisionStream(std::unique_ptr<grpc::ClientContext> context,
+                 std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader,
+                 std::shared_ptr<WatchCancel> cancel);
+  ~RevisionStream();
+  RevisionStream(const RevisionStream&) = delete;
+  RevisionStream& operator=(const RevisionStream&) = delete;
+
+  // The next message; false when the stream has ended (the grid was deleted, the server
+  // stopped, the call failed or was cancelled): then Finish() says why.
+  bool Next(v1::WatchGridResponse* message);
+  // Thread-safe: ends the call, a blocked Next() returns false.
+  void Cancel() { cancel_->Cancel(); }
+  const std::shared_ptr<WatchCancel>& cancel() const { return cancel_; }
+  // The call's status once Next() has returned false (cancels the call first otherwise): OK
+  // when the server ended the stream (the grid was deleted, or the server is stopping),
+  // CANCELLED after Cancel(), the error otherwise (NOT_FOUND for an unknown grid, ...).
+  absl::Status Finish();
+
+ private:
+  std::unique_ptr<grpc::ClientContext> context_;
+  std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader_;
+  std::shared_ptr<WatchCancel> cancel_;
+  bool ended_ = false;
+  std::optional<absl::Status> status_;
+};
+
 class Client {
  public:
   Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
@@ -57,8 +117,21 @@ class Client {
   // A faired refit of `revision` (0: latest); fairing null: the server's default (to tolerance).
   absl::StatusOr<v1::FitGridResponse> Fair(const std::string& name, int64_t revision,
                                            const v1::Fairing* fairing = nullptr);
-  // Deforms a grid (request.name may be an id); see DeformGridRequest.
+  // Deforms a grid (request.name may be an id); see DeformGridRequest. A deformation that
+  // folds cells is FAILED_PRECONDITION with the server's message (nothing was stored).
   absl::StatusOr<v1::DeformGridResponse> Deform(v1::DeformGridRequest request);
+  // Watches a grid's revisions (WatchGrid): those after `after_revision` (0: every stored one
+  // first, -1: only new ones), then each new one as it is stored. The call has no deadline; it
+  // lasts until the grid is deleted, the server stops or the call is cancelled (`cancel`, or
+  // the stream's Cancel(), from any thread).
+  std::unique_ptr<RevisionStream> Watch(const std::string& name, int64_t after_revision,
+                                        std::shared_ptr<WatchCancel> cancel = nullptr);
+  // The same with a callback per revision, on the calling thread; returning false stops the
+  // watch. Returns OK when the callback stopped it, `cancel` cancelled it or the server ended
+  // the stream (the grid was deleted); the call's error otherwise.
+  absl::Status Watch(const std::string& name, int64_t after_revision,
+                     const std::function<bool(const v1::WatchGridResponse&)>& on_revision,
+                     std::shared_ptr<WatchCancel> cancel = nullptr);
   // Curvature samples along the walls of `revision` at `refinement_level`.
   absl::StatusOr<v1::GetWallCurvatureResponse> WallCurvature(const std::string& name,
                                                              int64_t revision, int refinement_level,
@@ -66,6 +139,8 @@ class Client {
   absl::StatusOr<v1::Grid> Get(const std::string& name, int64_t revision = 0,
                                v1::GridView view = v1::GRID_VIEW_BASIC,
                                const std::vector<int>& blocks = {});
+  // Any GetGridRequest (request.name may be an id), e.g. with `step` instead of a revision.
+  absl::StatusOr<v1::Grid> Get(v1::GetGridRequest request);
   // Every grid, following the pages.
   absl::StatusOr<std::vector<v1::Grid>> List();
   absl::Status Delete(const std::string& name);

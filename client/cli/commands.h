@@ -22,6 +22,10 @@ absl::Status Fair(const Args& args);
 absl::Status Curvature(const Args& args);
 // Local (no server): fits an airfoil's coordinates (core/fit/airfoil_fit.h).
 absl::Status Airfoil(const Args& args);
+// Rigidly moves part of a grid's boundary (DeformGrid) and prints the new revision's report.
+absl::Status Deform(const Args& args);
+// Prints one line per new revision of a grid (WatchGrid) until interrupted or it is deleted.
+absl::Status Watch(const Args& args);
 absl::Status Remove(const Args& args);
 absl::Status Health(const Args& args);
 

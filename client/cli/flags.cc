@@ -1,6 +1,7 @@
 #include "client/cli/flags.h"
 
 #include "absl/flags/flag.h"
+#include "server/server_options.h"
 
 ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to (host:port)");
 ABSL_FLAG(bool, json, false, "print results as JSON");
@@ -35,6 +36,37 @@ ABSL_FLAG(std::string, o, "",
 ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
 
+ABSL_FLAG(
+    double, rotate, 0.0,
+    "deform: rotation angle in degrees (2D: counter-clockwise about z) of the moved boundary");
+ABSL_FLAG(std::string, about, "", "deform: centre of the rotation X,Y[,Z] (default: the origin)");
+ABSL_FLAG(std::string, axis, "", "deform: rotation axis X,Y,Z (default: z)");
+ABSL_FLAG(std::string, translate, "",
+          "deform: translation DX,DY[,DZ] applied after the rotation (default: none)");
+ABSL_FLAG(std::string, boundary, "",
+          "deform: what moves: kinds wall, outer, interface (comma-separated), or face ranges "
+          "BLOCK:FACE[:A0:A1[:B0:B1]] with FACE imin..kmax and A, B the face's index ranges in "
+          "i, j, k order (default: wall)");
+ABSL_FLAG(int64_t, reference, 0,
+          "deform: revision whose geometry is moved (0: latest; the fit's makes motions absolute)");
+ABSL_FLAG(int64_t, base, 0,
+          "deform: the latest revision seen; ABORTED if the grid has a newer one (0: no check)");
+ABSL_FLAG(double, time, 0.0, "deform: solver time stamped on the new revision");
+ABSL_FLAG(std::optional<int64_t>, step, std::nullopt,
+          "deform: solver time step stamped on the new revision (default 0); get/eval: the "
+          "latest revision of this time step instead of --revision");
+ABSL_FLAG(int, check_level, 0, "deform: refinement level of the fold check, 0 to 4");
+ABSL_FLAG(std::string, propagation, "blend",
+          "deform: how the interior follows: blend (by distance) or transfinite (Coons)");
+ABSL_FLAG(double, decay_radius, 0.0,
+          "deform: controls farther from the moved boundary stay (0: the nearest fixed boundary)");
+ABSL_FLAG(double, rigid_radius, 0.0,
+          "deform: controls within it move with the boundary in full (0: none)");
+ABSL_FLAG(int, smoothing, 0, "deform: Laplacian smoothing sweeps of the interior (0: none)");
+
+ABSL_FLAG(int64_t, after, 0,
+          "watch: send the revisions after this one (0: every stored one, -1: only new ones)");
+
 ABSL_FLAG(std::string, service, "splinegrid.v1.SplineGrid",
           "health: service to check (empty: the whole server)");
 
@@ -46,3 +78,6 @@ ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(10),
           "serve: time in-flight calls get on SIGTERM before they are cancelled");
 ABSL_FLAG(bool, log_calls, true, "serve: one log line per call on stderr");
+ABSL_FLAG(int, keep_revisions, splinegrid::server::ServerOptions().max_deform_revisions,
+          "serve: deformed revisions kept per grid (older ones are dropped; fitted and faired "
+          "revisions are always kept)");

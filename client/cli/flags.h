@@ -3,6 +3,7 @@
 #define SPLINEGRID_CLIENT_CLI_FLAGS_H_
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "absl/flags/declare.h"
@@ -37,6 +38,23 @@ ABSL_DECLARE_FLAG(std::string, box);
 ABSL_DECLARE_FLAG(std::string, o);
 ABSL_DECLARE_FLAG(bool, derivs);
 ABSL_DECLARE_FLAG(bool, float32);
+// deform
+ABSL_DECLARE_FLAG(double, rotate);
+ABSL_DECLARE_FLAG(std::string, about);
+ABSL_DECLARE_FLAG(std::string, axis);
+ABSL_DECLARE_FLAG(std::string, translate);
+ABSL_DECLARE_FLAG(std::string, boundary);
+ABSL_DECLARE_FLAG(int64_t, reference);
+ABSL_DECLARE_FLAG(int64_t, base);
+ABSL_DECLARE_FLAG(double, time);
+ABSL_DECLARE_FLAG(std::optional<int64_t>, step);
+ABSL_DECLARE_FLAG(int, check_level);
+ABSL_DECLARE_FLAG(std::string, propagation);
+ABSL_DECLARE_FLAG(double, decay_radius);
+ABSL_DECLARE_FLAG(double, rigid_radius);
+ABSL_DECLARE_FLAG(int, smoothing);
+// watch
+ABSL_DECLARE_FLAG(int64_t, after);
 // health
 ABSL_DECLARE_FLAG(std::string, service);
 // serve
@@ -46,5 +64,6 @@ ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);
 ABSL_DECLARE_FLAG(int64_t, max_output_points);
 ABSL_DECLARE_FLAG(absl::Duration, shutdown_grace);
 ABSL_DECLARE_FLAG(bool, log_calls);
+ABSL_DECLARE_FLAG(int, keep_revisions);
 
 #endif  // SPLINEGRID_CLIENT_CLI_FLAGS_H_

@@ -1,12 +1,14 @@
 // splinegrid: the command-line tool of the splinegrid service.
 //
-//   splinegrid serve [--address host:port] [--threads N] [--memory_budget_mb M]
-//   splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] [--fair F]
+//   splinegrid serve [--address host:port] [--threads N] [--memory_budget_mb M] [--keep_revisions
+//   N] splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] [--fair F]
 //   splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]
 //   splinegrid curvature NAME [--revision R] [--level L] [-o OUT.csv]
 //   splinegrid airfoil FILE.dat [--tol T] [--fair tol|LAMBDA|off] [-o OUT.csv]   (no server)
 //   splinegrid get NAME [--full]      splinegrid list      splinegrid rm NAME
-//   splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}
+//   splinegrid eval NAME (--level L | --res a,b,c) [--step N] [--block b] -o OUT.{vts,...}
+//   splinegrid deform NAME --rotate DEG [--about X,Y[,Z]] [--translate DX,DY[,DZ]] ...
+//   splinegrid watch NAME [--after R]
 //   splinegrid health
 // Client commands talk to --server (default localhost:50051); --json prints JSON.
 #include <cstdio>
@@ -23,13 +25,22 @@ namespace {
 constexpr char kUsage[] =
     "splinegrid: structured grids as B-spline mappings.\n"
     "  splinegrid serve [--address localhost:50051] [--threads N] [--memory_budget_mb M]\n"
+    "                   [--keep_revisions N]   (deformed revisions kept per grid, default 64)\n"
     "  splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] |\n"
     "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
     "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]\n"
     "  splinegrid curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]\n"
     "  splinegrid airfoil FILE.dat [--tol 1e-4] [--fair tol|LAMBDA|off] [-o OUT.csv]   (local)\n"
-    "  splinegrid get NAME [--full] | list | rm NAME | health\n"
-    "  splinegrid eval NAME (--level L | --res a,b,c) [--block b] -o OUT.{vts,vtm,x,xyz}\n"
+    "  splinegrid get NAME [--revision R | --step N] [--full] | list | rm NAME | health\n"
+    "  splinegrid eval NAME (--level L | --res a,b,c) [--revision R | --step N] [--block b]\n"
+    "                  -o OUT.{vts,vtm,x,xyz}\n"
+    "  splinegrid deform NAME [--rotate DEG [--about X,Y[,Z]] [--axis X,Y,Z]]\n"
+    "                  [--translate DX,DY[,DZ]] [--boundary wall|outer|interface|\n"
+    "                  BLOCK:FACE[:A0:A1[:B0:B1]],...] [--reference R] [--base R] [--time T]\n"
+    "                  [--step N] [--check_level L] [--propagation blend|transfinite]\n"
+    "                  [--decay_radius D] [--rigid_radius R] [--smoothing N]\n"
+    "      a fold is FAILED_PRECONDITION (exit 1), nothing stored\n"
+    "  splinegrid watch NAME [--after R]   one line per new revision until ^C or deletion\n"
     "Client commands use --server host:port (default localhost:50051) and --json.";
 
 }  // namespace
@@ -47,7 +58,8 @@ int main(int argc, char** argv) {
       {"get", splinegrid::cli::Get},         {"list", splinegrid::cli::List},
       {"eval", splinegrid::cli::Eval},       {"rm", splinegrid::cli::Remove},
       {"fair", splinegrid::cli::Fair},       {"curvature", splinegrid::cli::Curvature},
-      {"airfoil", splinegrid::cli::Airfoil}, {"health", splinegrid::cli::Health}};
+      {"airfoil", splinegrid::cli::Airfoil}, {"health", splinegrid::cli::Health},
+      {"deform", splinegrid::cli::Deform},   {"watch", splinegrid::cli::Watch}};
   const auto command = commands.find(positional[1]);
   if (command == commands.end()) {
     std::fprintf(stderr, "unknown command '%s'\n%s\n", positional[1], kUsage);

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/time/time.h"
 #include "core/bspline/differential_geometry.h"
 #include "core/bspline/evaluation.h"
 #include "google/protobuf/util/json_util.h"
@@ -19,6 +20,59 @@ std::string ToJson(const google::protobuf::Message& message) {
   std::string json;
   (void)google::protobuf::util::MessageToJsonString(message, &json, options);
   return json;
+}
+
+std::string ToJsonLine(const google::protobuf::Message& message) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  std::string json;
+  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
+  return json + "\n";
+}
+
+std::string OriginName(v1::RevisionOrigin origin) {
+  const std::string name = v1::RevisionOrigin_Name(origin);
+  constexpr char kPrefix[] = "REVISION_ORIGIN_";
+  return name.rfind(kPrefix, 0) == 0 ? name.substr(sizeof(kPrefix) - 1)
+                                     : absl::StrCat(static_cast<int>(origin));
+}
+
+std::string FormatDeformReport(const v1::DeformReport& r) {
+  const v1::Extents& c = r.worst_cell();
+  return absl::StrFormat(
+      "  fold check at level %d: %d cells, Jacobian ratio min %.4g (block %d, cell %d,%d,%d) "
+      "max %.4g\n"
+      "  wall orthogonality change %.3g degrees; %d moved controls, decay radius %.4g; %.2f ms\n",
+      r.check_level(), r.cells_checked(), r.min_jacobian_ratio(), r.worst_block(), c.i(), c.j(),
+      c.k(), r.max_jacobian_ratio(), r.max_orthogonality_change_degrees(), r.moved_controls(),
+      r.decay_radius(), 1e3 * r.seconds());
+}
+
+std::string FormatDeform(const std::string& name, const v1::DeformGridRequest& request,
+                         const v1::DeformGridResponse& response) {
+  std::string out = absl::StrFormat(
+      "%s revision %d: deformed %s, time %.6g, step %d\n", name, response.revision(),
+      request.reference_revision() == 0 ? std::string("the latest revision")
+                                        : absl::StrCat("revision ", request.reference_revision()),
+      request.time(), request.step());
+  absl::StrAppend(&out, FormatDeformReport(response.report()));
+  return out;
+}
+
+std::string FormatRevisionLine(const v1::RevisionInfo& r) {
+  std::string out = absl::StrFormat("revision %d origin %s", r.revision(), OriginName(r.origin()));
+  if (r.parent_revision() != 0) absl::StrAppend(&out, " parent ", r.parent_revision());
+  if (r.origin() == v1::REVISION_ORIGIN_DEFORM) {
+    absl::StrAppend(&out, absl::StrFormat(" time %.6g step %d", r.time(), r.step()));
+  }
+  if (r.has_create_time()) {
+    absl::StrAppend(&out, " created ",
+                    absl::FormatTime(absl::RFC3339_full,
+                                     absl::FromUnixSeconds(r.create_time().seconds()) +
+                                         absl::Nanoseconds(r.create_time().nanos()),
+                                     absl::UTCTimeZone()));
+  }
+  return out + "\n";
 }
 
 std::string FormatExtents(const v1::Extents& e) {
@@ -142,6 +196,13 @@ std::string FormatGrid(const v1::Grid& grid) {
       &out, absl::StrFormat("  revision %d of %d: %d control points (%.1fx), max deviation %.3g\n",
                             r.revision(), grid.latest_revision(), r.num_control_points(),
                             r.compression_ratio(), r.max_deviation()));
+  absl::StrAppend(&out, "  origin ", OriginName(r.origin()));
+  if (r.parent_revision() != 0) absl::StrAppend(&out, " of revision ", r.parent_revision());
+  if (r.origin() == v1::REVISION_ORIGIN_DEFORM) {
+    absl::StrAppend(&out, absl::StrFormat(", time %.6g, step %d", r.time(), r.step()));
+  }
+  absl::StrAppend(&out, "\n");
+  if (r.has_deform_report()) absl::StrAppend(&out, FormatDeformReport(r.deform_report()));
   for (const v1::SplineBlock& b : r.blocks()) {
     absl::StrAppend(
         &out,

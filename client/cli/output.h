@@ -22,6 +22,22 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit);
 // One grid: source, revisions, blocks.
 std::string FormatGrid(const v1::Grid& grid);
 
+// The message as JSON on one line (for streams: one object per line).
+std::string ToJsonLine(const google::protobuf::Message& message);
+
+// "DEFORM" for REVISION_ORIGIN_DEFORM.
+std::string OriginName(v1::RevisionOrigin origin);
+
+// A deformation's new revision and its report (the request gives time and step).
+std::string FormatDeform(const std::string& name, const v1::DeformGridRequest& request,
+                         const v1::DeformGridResponse& response);
+
+// The quality gate's lines of a deform report.
+std::string FormatDeformReport(const v1::DeformReport& report);
+
+// One line of `splinegrid watch`: "revision 3 origin DEFORM parent 1 time 0.02 step 2 ...".
+std::string FormatRevisionLine(const v1::RevisionInfo& revision);
+
 // The fit report's grid-wide lines (tolerances, quality, connectivity, fairing, curvature).
 std::string FormatReport(const v1::FitReport& report);
 

@@ -14,10 +14,12 @@ the conventions (names, array layout, deadlines, errors).
 
 from splinegrid.client import (
     SERVICE,
+    BoundaryPoints,
     Client,
     EvaluatedBlock,
     EvaluatedGrid,
     EvaluatedPoints,
+    RevisionWatch,
     SplinegridError,
     WallCurvatureLine,
     grid_name,
@@ -25,10 +27,12 @@ from splinegrid.client import (
 
 __all__ = [
     "SERVICE",
+    "BoundaryPoints",
     "Client",
     "EvaluatedBlock",
     "EvaluatedGrid",
     "EvaluatedPoints",
+    "RevisionWatch",
     "SplinegridError",
     "WallCurvatureLine",
     "grid_name",

@@ -34,10 +34,13 @@ arrays without a step per value, see ``_wire``.
 
 from __future__ import annotations
 
+import collections.abc
 import contextlib
+import math
 import os
+import threading
 from dataclasses import dataclass
-from typing import Iterable, Iterator, NamedTuple, Optional, Sequence, Union
+from typing import (Any, Iterable, Iterator, Mapping, NamedTuple, Optional, Sequence, Union)
 
 import grpc
 import numpy as np
@@ -51,10 +54,12 @@ from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
 __all__ = [
     "SERVICE",
+    "BoundaryPoints",
     "Client",
     "EvaluatedBlock",
     "EvaluatedGrid",
     "EvaluatedPoints",
+    "RevisionWatch",
     "SplinegridError",
     "WallCurvatureLine",
     "grid_name",
@@ -77,6 +82,25 @@ _FIELD_NAMES = {
     service_pb2.FIELD_DW: "dw",
 }
 _HEALTH_STATUS = ("UNKNOWN", "SERVING", "NOT_SERVING", "SERVICE_UNKNOWN")
+_KINDS = {
+    "wall": grid_pb2.BOUNDARY_KIND_WALL,
+    "interface": grid_pb2.BOUNDARY_KIND_INTERFACE,
+    "outer": grid_pb2.BOUNDARY_KIND_OUTER,
+}
+_FACES = {
+    "imin": grid_pb2.BLOCK_FACE_I_MIN, "imax": grid_pb2.BLOCK_FACE_I_MAX,
+    "jmin": grid_pb2.BLOCK_FACE_J_MIN, "jmax": grid_pb2.BLOCK_FACE_J_MAX,
+    "kmin": grid_pb2.BLOCK_FACE_K_MIN, "kmax": grid_pb2.BLOCK_FACE_K_MAX,
+}
+_PROPAGATIONS = {
+    "blend": service_pb2.PROPAGATION_BLEND,
+    "transfinite": service_pb2.PROPAGATION_TRANSFINITE,
+}
+MAX_CHECK_LEVEL = 4  # the server's highest fold-check level
+
+# A face range: a grid_pb2.FaceRange, a (block, face, begin, end) tuple or a dict with those
+# keys; face "imin" ... "kmax" (or the BlockFace value), begin/end (i, j[, k]) inclusive.
+FaceRangeLike = Union[grid_pb2.FaceRange, tuple, Mapping[str, Any]]
 
 
 class SplinegridError(grpc.RpcError):
@@ -134,6 +158,86 @@ class EvaluatedPoints:
     du: Optional[np.ndarray] = None
     dv: Optional[np.ndarray] = None
     dw: Optional[np.ndarray] = None
+
+
+class BoundaryPoints(NamedTuple):
+    """New positions (or, with ``displacements=True``, displacements) of the points of one face
+    range at refinement level ``level``, for :meth:`Client.deform`: ``coordinates`` is shaped
+    ``(N, s)`` with the range's points at that level in point order (i fastest)."""
+    range: FaceRangeLike
+    coordinates: npt.ArrayLike
+    level: int = 0
+    displacements: bool = False
+
+
+class RevisionWatch(collections.abc.Generator):
+    """The revisions of a grid as they are stored: what :meth:`Client.watch` returns.
+
+    A generator of ``RevisionInfo`` protos (``revision``, ``create_time``, ``origin``,
+    ``parent_revision``, ``time``, ``step``): iterating blocks until the server stores the next
+    revision, and ends when the server ends the stream (the grid was deleted, or the server is
+    stopping) or the watch is cancelled. ``close()`` (also by a ``with`` block or garbage
+    collection) cancels the call; ``cancel()`` does the same from any other thread, and a
+    ``next()`` blocked there then ends the iteration (StopIteration). A failed call raises
+    :class:`SplinegridError` (e.g. ``NOT_FOUND``; ``UNIMPLEMENTED`` from a server without
+    WatchGrid). ``name`` is the grid's resource name.
+    """
+
+    def __init__(self, call: Any, name: str) -> None:
+        self._call = call
+        self.name = name
+        self._cancelled = threading.Event()
+        self._done = False
+
+    def send(self, value: object) -> grid_pb2.RevisionInfo:
+        """The next revision (``value`` is ignored, as for ``next()``)."""
+        if self._done:
+            raise StopIteration
+        try:
+            message = next(self._call)
+        except StopIteration:
+            self._done = True
+            raise
+        except grpc.RpcError as error:
+            self._done = True
+            if self._cancelled.is_set() and error.code() == grpc.StatusCode.CANCELLED:
+                raise StopIteration from None
+            raise SplinegridError.from_rpc_error(error) from error
+        return message.revision
+
+    def throw(self, typ: Any, val: Any = None, tb: Any = None) -> grid_pb2.RevisionInfo:
+        """Cancels the call and raises the exception (a generator that does not catch it)."""
+        self.cancel()
+        if val is None:
+            val = typ() if isinstance(typ, type) else typ
+        if tb is not None:
+            val = val.with_traceback(tb)
+        raise val
+
+    def close(self) -> None:
+        """Cancels the call; iterating afterwards ends at once."""
+        self.cancel()
+
+    def cancel(self) -> None:
+        """Cancels the call; safe from any thread, also while another one iterates."""
+        self._cancelled.set()
+        self._done = True
+        self._call.cancel()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._cancelled.is_set()
+
+    def __enter__(self) -> RevisionWatch:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        if not self._done:
+            with contextlib.suppress(Exception):
+                self._call.cancel()
 
 
 class WallCurvatureLine(NamedTuple):
@@ -348,12 +452,15 @@ class Client:
             curvature=np.asarray(line.curvature, dtype=np.float64)) for line in response.lines]
 
     def get(self, name: str, revision: int = 0, full: bool = False,
-            blocks: Iterable[int] = ()) -> grid_pb2.Grid:
+            blocks: Iterable[int] = (), step: Optional[int] = None) -> grid_pb2.Grid:
         """The grid with revision ``revision`` (0: latest). ``full`` adds knots, control points
-        and point distributions (of ``blocks`` only, when given)."""
+        and point distributions (of ``blocks`` only, when given). ``step``: instead of a
+        revision, the latest revision stamped with this solver time step (see
+        :meth:`deform`); NOT_FOUND if there is none."""
         request = service_pb2.GetGridRequest(
             name=grid_name(name), revision=revision, blocks=list(blocks),
             view=service_pb2.GRID_VIEW_FULL if full else service_pb2.GRID_VIEW_BASIC)
+        _set_step(request, revision, step)
         with _translated_errors():
             return self.stub.GetGrid(request, timeout=self.timeout)
 
@@ -374,13 +481,178 @@ class Client:
             self.stub.DeleteGrid(service_pb2.DeleteGridRequest(name=grid_name(name)),
                                  timeout=self.timeout)
 
+    # Deformation (fluid-structure coupling)
+
+    def deform(self, name: str, rotate_degrees: Optional[float] = None,
+               about: Optional[Sequence[float]] = None,
+               axis: Optional[Sequence[float]] = None,
+               translate: Optional[Sequence[float]] = None,
+               boundary: Union[None, str, FaceRangeLike,
+                               Iterable[Union[str, FaceRangeLike]]] = None,
+               reference_revision: int = 0, base_revision: int = 0, time: float = 0.0,
+               step: int = 0, check_level: int = 0,
+               control_displacements: Optional[Mapping[int, tuple[npt.ArrayLike,
+                                                                  npt.ArrayLike]]] = None,
+               boundary_points: Optional[Iterable[BoundaryPoints]] = None,
+               propagation: str = "blend", decay_radius: float = 0.0,
+               rigid_radius: float = 0.0,
+               smoothing_iterations: int = 0) -> service_pb2.DeformGridResponse:
+        """Moves part of a revision's boundary, lets the grid follow, checks it for folded cells
+        and stores it as a new revision (DeformGrid); returns the DeformGridResponse proto:
+        ``revision`` and ``report`` (DeformReport: ``min_jacobian_ratio``,
+        ``max_orthogonality_change_degrees``, ``moved_controls``, ``decay_radius``,
+        ``seconds``, ...).
+
+        The motion is one of
+          - a rigid motion: ``rotate_degrees`` about the axis ``axis`` (3 values; default z,
+            the only axis of a 2-D grid, positive turning counter-clockwise) through ``about``
+            (2 or 3 values; default the origin), then ``translate`` (2 or 3 values);
+          - ``control_displacements``: ``{block: (controls, displacements)}``, control indices
+            (i fastest) of moved controls and their displacements shaped ``(N, s)``; moved
+            controls not listed stay;
+          - ``boundary_points``: :class:`BoundaryPoints`, new positions (or displacements) of
+            the points of boundary ranges at a refinement level, fitted with the stored basis.
+
+        ``boundary`` says what moves: ``"wall"`` (the default), ``"outer"``, ``"interface"``, a
+        list of those, or face ranges (one or a list): ``(block, face, begin, end)`` tuples or
+        dicts with those keys, ``face`` one of ``"imin"``, ..., ``"kmax"``, ``begin``/``end``
+        ``(i, j[, k])`` grid indices inclusive at both ends. Kinds and ranges do not mix.
+
+        ``reference_revision`` is the revision whose geometry is moved (0: the latest): giving
+        the fit's revision every step makes the motions absolute (no drift).
+        ``base_revision`` is the latest revision the caller has seen: if the grid has a newer
+        one the call fails with ABORTED (0: no check). ``time`` and ``step`` stamp the new
+        revision (see ``get``/``evaluate(step=...)``). ``check_level`` (0 to 4) is the
+        refinement level of the fold check. ``propagation``: ``"blend"`` (free controls by
+        their distance to the moved boundary) or ``"transfinite"`` (block interiors by Coons
+        interpolation); ``decay_radius`` (0: the distance to the nearest fixed boundary),
+        ``rigid_radius`` and ``smoothing_iterations`` shape it.
+
+        A deformation that folds cells raises :class:`SplinegridError` with code
+        ``FAILED_PRECONDITION`` and the server's message (how many cells, where); nothing is
+        stored. Wrong arguments raise ``ValueError`` before any call.
+        """
+        request = service_pb2.DeformGridRequest(name=grid_name(name))
+        request.reference_revision = _non_negative_int(reference_revision, "reference_revision")
+        request.base_revision = _non_negative_int(base_revision, "base_revision")
+        request.time = _finite(time, "time")
+        request.step = _integer(step, "step")
+        request.check_level = _integer(check_level, "check_level")
+        if not 0 <= request.check_level <= MAX_CHECK_LEVEL:
+            raise ValueError(f"check_level = {check_level}; must be in [0, {MAX_CHECK_LEVEL}]")
+        if propagation not in _PROPAGATIONS:
+            raise ValueError(f"propagation = {propagation!r}; give 'blend' or 'transfinite'")
+        request.propagation = _PROPAGATIONS[propagation]
+        request.decay_radius = _non_negative(decay_radius, "decay_radius")
+        request.rigid_radius = _non_negative(rigid_radius, "rigid_radius")
+        if request.decay_radius > 0.0 and request.rigid_radius > request.decay_radius:
+            raise ValueError(f"rigid_radius = {rigid_radius} exceeds decay_radius = "
+                             f"{decay_radius}")
+        request.smoothing_iterations = _non_negative_int(smoothing_iterations,
+                                                         "smoothing_iterations")
+        request.boundary.CopyFrom(_boundary_selection(boundary))
+
+        rigid = rotate_degrees is not None or translate is not None
+        motions = [label for label, given in (("rotate_degrees/translate", rigid),
+                                            ("control_displacements",
+                                             control_displacements is not None),
+                                            ("boundary_points", boundary_points is not None))
+                   if given]
+        if len(motions) != 1:
+            raise ValueError("give one motion: rotate_degrees (and/or translate), "
+                             "control_displacements or boundary_points"
+                             + (f"; got {', '.join(motions)}" if motions else ""))
+        if not rigid and (about is not None or axis is not None):
+            raise ValueError("about and axis belong to a rotation (rotate_degrees)")
+        if rigid:
+            motion = request.rigid
+            motion.angle_degrees = _finite(0.0 if rotate_degrees is None else rotate_degrees,
+                                           "rotate_degrees")
+            if about is not None:
+                motion.center.extend(_vector(about, "about", (2, 3)))
+            if axis is not None:
+                values = _vector(axis, "axis", (3,))
+                if not any(values):
+                    raise ValueError("axis = (0, 0, 0); the rotation axis must not be zero")
+                motion.axis.extend(values)
+            if translate is not None:
+                motion.translation.extend(_vector(translate, "translate", (2, 3)))
+        elif control_displacements is not None:
+            request.controls.SetInParent()
+            if not isinstance(control_displacements, Mapping):
+                raise ValueError("control_displacements: give {block: (controls, "
+                                 "displacements)}")
+            for block, pair in control_displacements.items():
+                what = f"control_displacements[{block}]"
+                try:
+                    controls, values = pair
+                except (TypeError, ValueError):
+                    raise ValueError(f"{what}: give (controls, displacements)") from None
+                index = np.asarray(controls).reshape(-1)
+                if index.size and not np.issubdtype(index.dtype, np.integer):
+                    raise ValueError(f"{what}: control indices must be integers")
+                moved = np.asarray(values, dtype=np.float64)
+                if moved.ndim != 2 or moved.shape[0] != index.size or moved.shape[1] not in (2, 3):
+                    raise ValueError(f"{what}: displacements have shape {moved.shape}; expected "
+                                     f"({index.size}, s) with s = 2 or 3")
+                if not np.all(np.isfinite(moved)):
+                    raise ValueError(f"{what}: displacements must be finite")
+                if np.any(index < 0):
+                    raise ValueError(f"{what}: control indices must not be negative")
+                request.controls.blocks.add(block=_non_negative_int(block, what + " block"),
+                                            controls=index.tolist(),
+                                            values=moved.reshape(-1).tolist())
+        else:
+            request.boundary_points.SetInParent()
+            for q, item in enumerate(boundary_points):
+                what = f"boundary_points[{q}]"
+                if not isinstance(item, BoundaryPoints):
+                    item = BoundaryPoints(*item) if isinstance(item, tuple) else \
+                        BoundaryPoints(**item)
+                points = np.asarray(item.coordinates, dtype=np.float64)
+                if points.ndim != 2 or points.shape[1] not in (2, 3):
+                    raise ValueError(f"{what}: coordinates have shape {points.shape}; expected "
+                                     "(N, s) with s = 2 or 3")
+                if not np.all(np.isfinite(points)):
+                    raise ValueError(f"{what}: coordinates must be finite")
+                request.boundary_points.ranges.add(
+                    range=_face_range(item.range, what + ".range"),
+                    refinement_level=_non_negative_int(item.level, what + ".level"),
+                    coordinates=points.reshape(-1).tolist(),
+                    displacements=bool(item.displacements))
+            if not request.boundary_points.ranges:
+                raise ValueError("boundary_points is empty")
+        with _translated_errors():
+            return self.stub.DeformGrid(request, timeout=self.timeout)
+
+    def watch(self, name: str, after_revision: int = 0) -> RevisionWatch:
+        """The grid's revisions as they are stored (WatchGrid): a generator of
+        ``RevisionInfo`` (see :class:`RevisionWatch`).
+
+        The revisions after ``after_revision`` that are stored already come first (0: all of
+        them, -1: none), then each new one (a fit, a fairing, a deformation) as it is stored.
+        The call has no deadline: it lasts until the grid is deleted, the server stops, or the
+        watch is closed or cancelled::
+
+            with client.watch("naca") as revisions:
+                for info in revisions:
+                    print(info.revision, info.step)
+        """
+        after = _integer(after_revision, "after_revision")
+        if after < -1:
+            raise ValueError(f"after_revision = {after_revision}; must be >= -1")
+        request = service_pb2.WatchGridRequest(name=grid_name(name), after_revision=after)
+        with _translated_errors():
+            call = self.stub.WatchGrid(request)
+        return RevisionWatch(call, request.name)
+
     # Evaluation
 
     def evaluate(self, name: str, level: Optional[int] = None,
                  counts: Optional[Triple] = None, blocks: Blocks = None,
                  index_box: Optional[tuple[Triple, Triple]] = None,
                  derivatives: bool = False, dtype: npt.DTypeLike = np.float64,
-                 revision: int = 0) -> EvaluatedGrid:
+                 revision: int = 0, step: Optional[int] = None) -> EvaluatedGrid:
         """Evaluates blocks of a revision (0: latest) on a grid of parameters.
 
         Resolution: ``level`` l puts 2^l - 1 new points in every original interval (0, the
@@ -389,7 +661,9 @@ class Client:
         both following the original clustering. ``blocks``: an
         index or indices (None: all, in order). ``index_box``: ``(begin, end)``, each
         ``(i, j[, k])`` in original grid indices, inclusive at both ends (missing: 0).
-        ``dtype`` float32 transfers single precision (half the bytes).
+        ``dtype`` float32 transfers single precision (half the bytes). ``step``: instead of
+        ``revision``, the latest revision stamped with this solver time step (the result's
+        ``revision`` says which one).
 
         Returns an :class:`EvaluatedGrid`, a list of :class:`EvaluatedBlock` whose arrays are
         shaped ``(nk, nj, ni, s)`` with ``dtype``.
@@ -408,6 +682,7 @@ class Client:
             derivatives=derivatives,
             precision=(service_pb2.PRECISION_FLOAT if out_dtype == np.float32
                        else service_pb2.PRECISION_DOUBLE))
+        _set_step(request, revision, step)
         if counts is not None:
             request.counts.CopyFrom(_extents(counts, "counts", fill=1))
         else:
@@ -426,13 +701,14 @@ class Client:
 
     def evaluate_points(self, name: str, params: npt.ArrayLike,
                         blocks: Union[int, npt.ArrayLike] = 0, derivatives: bool = False,
-                        revision: int = 0) -> EvaluatedPoints:
+                        revision: int = 0, step: Optional[int] = None) -> EvaluatedPoints:
         """Evaluates N parameter points ``params`` (shape ``(N, 3)``: u, v, w in [0, 1]; use
         w = 0 for a 2-D block) of block ``blocks`` (one index for all, or one per point).
 
         Returns :class:`EvaluatedPoints` with arrays shaped ``(N, s)``. Requests and responses
         must stay under gRPC's 4 MiB message limit, so large N is sent in several calls (each
-        with its own deadline), all pinned to the revision the first one evaluated.
+        with its own deadline), all pinned to the revision the first one evaluated. ``step``:
+        instead of ``revision``, the latest revision stamped with this solver time step.
         """
         uvw = np.ascontiguousarray(params, dtype=_wire.DOUBLE)
         if uvw.ndim == 1 and uvw.size == 3:
@@ -445,6 +721,8 @@ class Client:
                              "or one per point")
         # Bytes per point: 24 of parameters + up to 5 of block index in the request; up to
         # 3 coordinates x (1 or 4 fields) x 9 in the response (the server's own estimate).
+        if step is not None and revision != 0:
+            raise ValueError(f"give revision ({revision}) or step ({step}), not both")
         per_point = max(29, 3 * (4 if derivatives else 1) * 9)
         batch = max(1, POINTS_BATCH_BYTES // per_point)
         parts: list[EvaluatedPoints] = []
@@ -454,6 +732,8 @@ class Client:
                     name=grid_name(name), revision=revision, derivatives=derivatives,
                     blocks=(block_array if block_array.size == 1
                             else block_array[at:at + batch]).tolist())
+                if step is not None and not parts:  # later batches: the first's revision
+                    head.step = int(step)
                 request = head.SerializeToString() + _wire.packed_doubles(  # + parameters
                     4, uvw[at:at + batch])
                 parts.append(self._evaluate_points(request, timeout=self.timeout))
@@ -522,6 +802,110 @@ def _fairing(fairing: Union[str, float]) -> grid_pb2.Fairing:
     if isinstance(fairing, str) or not float(fairing) > 0.0:
         raise ValueError(f"fairing = {fairing!r}: give 'tol' or a positive weight")
     return grid_pb2.Fairing(mode=grid_pb2.FAIRING_MODE_WEIGHT, weight=float(fairing))
+
+
+def _set_step(request: Message, revision: int, step: Optional[int]) -> None:
+    """Sets the optional ``step`` of a Get/Evaluate request (not together with a revision)."""
+    if step is None:
+        return
+    if revision != 0:
+        raise ValueError(f"give revision ({revision}) or step ({step}), not both")
+    request.step = _integer(step, "step")
+
+
+def _integer(value: Any, what: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{what} = {value!r}; must be an integer")
+    return int(value)
+
+
+def _non_negative_int(value: Any, what: str) -> int:
+    number = _integer(value, what)
+    if number < 0:
+        raise ValueError(f"{what} = {value}; must not be negative")
+    return number
+
+
+def _finite(value: Any, what: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} = {value!r}; must be a number") from None
+    if not math.isfinite(number):
+        raise ValueError(f"{what} = {value}; must be finite")
+    return number
+
+
+def _non_negative(value: Any, what: str) -> float:
+    number = _finite(value, what)
+    if number < 0.0:
+        raise ValueError(f"{what} = {value}; must not be negative")
+    return number
+
+
+def _vector(values: Sequence[float], what: str, sizes: tuple[int, ...]) -> list[float]:
+    try:
+        numbers = [_finite(v, what) for v in values]
+    except TypeError:
+        raise ValueError(f"{what} = {values!r}; give {' or '.join(map(str, sizes))} numbers") \
+            from None
+    if len(numbers) not in sizes:
+        raise ValueError(f"{what} = {list(values)}; give {' or '.join(map(str, sizes))} "
+                         "numbers")
+    return numbers
+
+
+def _face_range(spec: FaceRangeLike, what: str) -> grid_pb2.FaceRange:
+    """A FaceRange from a proto, a (block, face, begin, end) tuple or a dict."""
+    if isinstance(spec, grid_pb2.FaceRange):
+        return spec
+    if isinstance(spec, Mapping):
+        unknown = set(spec) - {"block", "face", "begin", "end"}
+        if unknown or not {"block", "face", "begin", "end"} <= set(spec):
+            raise ValueError(f"{what} = {dict(spec)}; give the keys block, face, begin, end")
+        block, face, begin, end = spec["block"], spec["face"], spec["begin"], spec["end"]
+    elif isinstance(spec, (tuple, list)) and len(spec) == 4:
+        block, face, begin, end = spec
+    else:
+        raise ValueError(f"{what} = {spec!r}; give (block, face, begin, end)")
+    if isinstance(face, str):
+        key = face.lower().replace("_", "").replace("-", "")
+        if key not in _FACES:
+            raise ValueError(f"{what}: face = {face!r}; give one of {', '.join(_FACES)}")
+        face = _FACES[key]
+    elif face not in _FACES.values():
+        raise ValueError(f"{what}: face = {face!r}; give one of {', '.join(_FACES)}")
+    begin_e = _extents(begin, f"{what} begin", fill=0)
+    end_e = _extents(end, f"{what} end", fill=0)
+    for axis in "ijk":
+        lo, hi = getattr(begin_e, axis), getattr(end_e, axis)
+        if lo < 0 or hi < lo:
+            raise ValueError(f"{what}: {axis} range [{lo}, {hi}] is not 0 <= begin <= end")
+    return grid_pb2.FaceRange(block=_non_negative_int(block, f"{what} block"), face=face,
+                              begin=begin_e, end=end_e)
+
+
+def _boundary_selection(boundary: Any) -> service_pb2.BoundarySelection:
+    """``boundary`` of :meth:`Client.deform` as a BoundarySelection."""
+    selection = service_pb2.BoundarySelection()
+    if boundary is None:
+        return selection
+    if isinstance(boundary, service_pb2.BoundarySelection):
+        return boundary
+    single = (isinstance(boundary, (str, grid_pb2.FaceRange, Mapping))
+              or (isinstance(boundary, tuple) and len(boundary) == 4
+                  and isinstance(boundary[0], (int, np.integer))))
+    for q, item in enumerate([boundary] if single else list(boundary)):
+        if isinstance(item, str):
+            if item.lower() not in _KINDS:
+                raise ValueError(f"boundary[{q}] = {item!r}; give wall, outer, interface or a "
+                                 "face range")
+            selection.kinds.append(_KINDS[item.lower()])
+        else:
+            selection.ranges.append(_face_range(item, f"boundary[{q}]"))
+    if selection.kinds and selection.ranges:
+        raise ValueError("boundary: give boundary kinds or face ranges, not both")
+    return selection
 
 
 def _block_list(blocks: Blocks) -> list[int]:

@@ -1,5 +1,6 @@
-// End to end: the real `splinegrid serve` on a free loopback port, driven by the CLI and by the
-// Python example, then stopped with SIGTERM (exit code 0, one log line per call).
+// End to end: the real `splinegrid serve` on a free loopback port, driven by the CLI, the C++
+// coupling example and the Python examples, then stopped with SIGTERM (exit code 0, one log line
+// per call).
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -229,6 +230,136 @@ TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
   const std::string image = ReadFileToString(png).value();
   ASSERT_GT(image.size(), 1000u);
   EXPECT_EQ(image.substr(1, 3), "PNG");
+}
+
+TEST_F(EndToEndTest, CliDeformsRefusesAFoldAndGetsTheDeformedRevision) {
+  ASSERT_EQ(
+      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=naca --kinds"))
+          .exit_code,
+      0);
+  const Result deform =
+      Cli("deform naca --rotate=5 --about=0.25,0 --reference=1 --base=1 --time=0.5 --step=3 "
+          "--check_level=1");
+  ASSERT_EQ(deform.exit_code, 0) << deform.out;
+  EXPECT_THAT(deform.out,
+              HasSubstr("grids/naca revision 2: deformed revision 1, time 0.5, step 3"));
+  EXPECT_THAT(deform.out, HasSubstr("fold check at level 1"));
+  EXPECT_THAT(deform.out, HasSubstr("Jacobian ratio min 0.9"));
+  EXPECT_THAT(deform.out, HasSubstr("moved controls"));
+  EXPECT_THAT(deform.out, HasSubstr("wall orthogonality change"));
+
+  // Everything a third of a chord away stays: turning the wall by 60 degrees tears the nose.
+  const Result fold =
+      Cli("deform naca --rotate=60 --about=0.25,0 --decay_radius=0.3 --reference=1 --step=4");
+  EXPECT_EQ(fold.exit_code, 1) << fold.out;
+  EXPECT_THAT(fold.out, HasSubstr("FAILED_PRECONDITION"));
+  EXPECT_THAT(fold.out, HasSubstr("folds"));
+  // A stale base revision is ABORTED.
+  const Result stale = Cli("deform naca --rotate=1 --base=1");
+  EXPECT_EQ(stale.exit_code, 1) << stale.out;
+  EXPECT_THAT(stale.out, HasSubstr("ABORTED"));
+
+  // Only the good deformation was stored.
+  const Result get = Cli("get naca");
+  ASSERT_EQ(get.exit_code, 0) << get.out;
+  EXPECT_THAT(get.out, HasSubstr("revision 2 of 2"));
+  EXPECT_THAT(get.out, HasSubstr("origin DEFORM of revision 1, time 0.5, step 3"));
+  const Result by_step = Cli("get naca --step=3 --json");
+  ASSERT_EQ(by_step.exit_code, 0) << by_step.out;
+  EXPECT_THAT(by_step.out, HasSubstr("\"origin\": \"REVISION_ORIGIN_DEFORM\""));
+  EXPECT_THAT(by_step.out, HasSubstr("\"min_jacobian_ratio\""));
+
+  // A face range instead of the wall (the airfoil part of the C-grid's j = 0 line), as JSON.
+  const Result range =
+      Cli("deform naca --rotate=-3 --about=0.25,0 --boundary=0:jmin:20:92 --reference=1 --json");
+  ASSERT_EQ(range.exit_code, 0) << range.out;
+  EXPECT_THAT(range.out, HasSubstr("\"revision\": \"3\""));
+  EXPECT_THAT(range.out, HasSubstr("\"moved_controls\""));
+  const Result eval =
+      Cli(absl::StrCat("eval naca --step=3 --level=1 -o ", (dir_ / "s.vts").string()));
+  ASSERT_EQ(eval.exit_code, 0) << eval.out;
+  EXPECT_THAT(eval.out, HasSubstr("(revision 2)"));
+
+  const Result usage = Cli("deform naca --rotate=5 --about=1");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_THAT(usage.out, HasSubstr("--about"));
+  EXPECT_EQ(Cli("deform naca --rotate=5 --boundary=0:lmin").exit_code, 2);
+  EXPECT_EQ(Cli("deform naca").exit_code, 2);
+}
+
+TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) {
+  ASSERT_EQ(
+      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=watched --kinds"))
+          .exit_code,
+      0);
+  // In the background; --after=1: revisions after the fit, the stored ones first, so the
+  // deformations below are seen however late the watch starts.
+  const std::string out = (dir_ / "watch.out").string();
+  const std::string watch =
+      absl::StrCat(kBinary, " watch watched --after=1 --server=127.0.0.1:", port_);
+  RunCommand(absl::StrCat("(timeout 60 ", watch, " > ", out, " 2>&1; echo exit=$? >> ", out,
+                          ") > /dev/null 2>&1 < /dev/null &"));
+  const std::string deform = "deform watched --about=0.25,0 --reference=1 ";
+  ASSERT_EQ(Cli(deform + "--rotate=2 --time=0.1 --step=1").exit_code, 0);
+  ASSERT_EQ(Cli(deform + "--rotate=4 --time=0.2 --step=2").exit_code, 0);
+  // Deleting the grid ends the stream, and the watch with it.
+  std::string text;
+  for (int i = 0; i < 100 && text.find("revision 3") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    text = ReadFileToString(out).value_or("");
+  }
+  ASSERT_EQ(Cli("rm watched").exit_code, 0);
+  for (int i = 0; i < 200 && text.find("exit=") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    text = ReadFileToString(out).value_or("");
+  }
+  EXPECT_THAT(text, HasSubstr("revision 2 origin DEFORM parent 1 time 0.1 step 1"));
+  EXPECT_THAT(text, HasSubstr("revision 3 origin DEFORM parent 1 time 0.2 step 2"));
+  EXPECT_EQ(text.find("revision 1 "), std::string::npos) << text;  // --after=1
+  EXPECT_THAT(text, HasSubstr("the stream ended"));
+  EXPECT_THAT(text, HasSubstr("exit=0"));
+
+  // ^C ends a watch cleanly (exit 0); --json prints one object per line.
+  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+                             " --name=again --ctl=40,16"))
+                .exit_code,
+            0);
+  const Result interrupted =
+      RunCommand(absl::StrCat("timeout --preserve-status -s INT 2 ", kBinary,
+                              " watch again --json --server=127.0.0.1:", port_));
+  EXPECT_EQ(interrupted.exit_code, 0) << interrupted.out;
+  EXPECT_THAT(interrupted.out, HasSubstr("\"origin\":\"REVISION_ORIGIN_FIT\""));
+  EXPECT_THAT(interrupted.out, HasSubstr("interrupted"));
+  const Result unknown = Cli("watch nope");
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_THAT(unknown.out, HasSubstr("NOT_FOUND"));
+}
+
+TEST_F(EndToEndTest, CppPitchingExampleRunsWithoutFolds) {
+  const Result run = RunCommand(absl::StrCat(
+      SPLINEGRID_BINARY_DIR, "/splinegrid_pitching --server=127.0.0.1:", port_,
+      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt")));
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_THAT(run.out, HasSubstr("p50       p90       p99       max"));
+  EXPECT_THAT(run.out, HasSubstr("  deform "));
+  EXPECT_THAT(run.out, HasSubstr("  evaluate "));
+  EXPECT_THAT(run.out, HasSubstr("  step "));
+  EXPECT_THAT(run.out, HasSubstr("step  10 "));
+  EXPECT_THAT(run.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused"));
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));  // deleted at the end
+}
+
+TEST_F(EndToEndTest, PythonPitchingExampleRunsWithoutFolds) {
+  const Result python = RunCommand(absl::StrCat(
+      "PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
+      "/python/examples/pitching.py --server=127.0.0.1:", port_,
+      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt")));
+  ASSERT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("p50       p90       p99       max"));
+  EXPECT_THAT(python.out, HasSubstr("  deform "));
+  EXPECT_THAT(python.out, HasSubstr("  evaluate "));
+  EXPECT_THAT(python.out, HasSubstr("step  10 "));
+  EXPECT_THAT(python.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused"));
 }
 
 TEST_F(EndToEndTest, SigtermDrainsAndExitsZeroWithOneLogLinePerCall) {
