@@ -4,6 +4,12 @@
 //   BM_EvaluatePointsUnary   one-point EvaluatePoints calls with 16 in flight: calls/s, p50/p99
 //   BM_FitThroughApi         FitGrid latency for every shared grid, tolerances by boundary kind
 //   BM_IdleServerMemory      resident memory of a started, idle server
+//   BM_DeformThenEvaluate    one coupling step on the pitching NACA 0012 (257 x 129): DeformGrid
+//                            (rigid, reference = the fit) then EvaluateGrid at the original
+//                            resolution, sequential: steps/s, p50/p99 of the step
+//   BM_PitchingRun           100 steps of +-amplitude degrees (DeformGrid with reference = fit
+//                            and base = previous, EvaluateGrid at level 1, client-side fold
+//                            check): p50/p90/p99/max of deform, evaluate and step, folds
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sched.h>
@@ -15,7 +21,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <condition_variable>
+#include <cstdlib>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -100,6 +109,9 @@ ServerProcess& SharedServer() {
 }
 
 std::string SharedData(const std::string& relative) {
+  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
+    return std::string(dir) + "/" + relative;
+  }
   return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
 }
 
@@ -266,6 +278,178 @@ void BM_FitThroughApi(benchmark::State& state) {
   state.counters["compression"] = ratio;
 }
 BENCHMARK(BM_FitThroughApi)->DenseRange(0, 6)->Unit(benchmark::kMillisecond);
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Imports the pitching NACA 0012 as `id` (its 2D view) and fits it to the default tolerances by
+// boundary kind; the fit's revision, or 0 (and the error in `error`).
+int64_t ImportPitchGrid(client::Client& client, const std::string& id, std::string* error) {
+  absl::StatusOr<std::string> bytes = ReadFileToString(SharedData("grids/n0012_pitch_257x129.fmt"));
+  if (!bytes.ok()) {
+    *error = bytes.status().ToString();
+    return 0;
+  }
+  (void)client.Delete(id);
+  if (absl::Status s = client.ImportPlot3d(*bytes, id, "", true).status(); !s.ok()) {
+    *error = s.ToString();
+    return 0;
+  }
+  v1::FitSpec spec;
+  spec.mutable_boundary_tolerances();
+  absl::StatusOr<v1::FitGridResponse> fit = client.Fit(id, spec);
+  if (!fit.ok()) {
+    *error = fit.status().ToString();
+    return 0;
+  }
+  return fit->revision();
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
+  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
+}
+
+double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+v1::DeformGridRequest PitchRequest(const std::string& id, int64_t reference, double degrees) {
+  v1::DeformGridRequest request;
+  request.set_name(id);
+  request.set_reference_revision(reference);
+  request.mutable_rigid()->set_angle_degrees(degrees);
+  request.mutable_rigid()->add_center(0.25);
+  request.mutable_rigid()->add_center(0.0);
+  return request;
+}
+
+// Signed areas of the cells of the evaluated 2D blocks.
+std::vector<double> CellAreas(const client::EvaluatedGrid& grid) {
+  std::vector<double> areas;
+  for (const client::EvaluatedBlock& b : grid.blocks) {
+    const StructuredBlock& p = b.points;
+    for (int j = 0; j + 1 < p.extent(1); ++j) {
+      for (int i = 0; i + 1 < p.extent(0); ++i) {
+        const double *a = p.Point(i, j, 0), *b1 = p.Point(i + 1, j, 0), *c = p.Point(i, j + 1, 0),
+                     *d = p.Point(i + 1, j + 1, 0);
+        areas.push_back(0.5 * ((d[0] - a[0]) * (c[1] - b1[1]) - (d[1] - a[1]) * (c[0] - b1[0])));
+      }
+    }
+  }
+  return areas;
+}
+
+// Sequential coupling steps: DeformGrid (rigid pitch about the quarter chord, reference = the
+// fit, the angle changing every step) then EvaluateGrid of the new revision at the original
+// resolution (257 x 129 points).
+void BM_DeformThenEvaluate(benchmark::State& state) {
+  auto client = client::Client::Connect(SharedServer().target());
+  static int64_t fitted = 0;
+  if (fitted == 0) {
+    std::string error;
+    fitted = ImportPitchGrid(*client, "pitch-step", &error);
+    if (fitted == 0) return state.SkipWithError(error.c_str());
+  }
+  v1::EvaluateGridRequest evaluate;
+  evaluate.set_name("grids/pitch-step");
+  evaluate.set_refinement_level(0);
+  std::vector<double> step_us, deform_us;
+  int64_t n = 0, points = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    const double degrees = 10.0 * std::sin(0.0628 * static_cast<double>(++n));
+    absl::StatusOr<v1::DeformGridResponse> moved =
+        client->Deform(PitchRequest("pitch-step", fitted, degrees));
+    if (!moved.ok()) return state.SkipWithError(moved.status().ToString().c_str());
+    deform_us.push_back(MicrosecondsSince(start));
+    evaluate.set_revision(moved->revision());
+    absl::StatusOr<client::EvaluatedGrid> grid = client->Evaluate(evaluate);
+    if (!grid.ok()) return state.SkipWithError(grid.status().ToString().c_str());
+    points = grid->blocks.front().points.num_points();
+    step_us.push_back(MicrosecondsSince(start));
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["points"] = static_cast<double>(points);
+  state.counters["p50_us"] = Percentile(step_us, 0.5);
+  state.counters["p99_us"] = Percentile(step_us, 0.99);
+  state.counters["deform_p50_us"] = Percentile(deform_us, 0.5);
+  state.counters["deform_p99_us"] = Percentile(deform_us, 0.99);
+}
+BENCHMARK(BM_DeformThenEvaluate)->Iterations(1000)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// The pitching example's loop as a benchmark: `steps` steps of amplitude sin(2 pi n / steps)
+// degrees, each DeformGrid (reference = fit, base = previous revision, time and step set) and
+// EvaluateGrid at level 1, every cell's signed area compared with the fitted grid's.
+void BM_PitchingRun(benchmark::State& state) {
+  const double amplitude = static_cast<double>(state.range(0));
+  constexpr int kSteps = 100;
+  auto client = client::Client::Connect(SharedServer().target());
+  const std::string id = absl::StrCat("pitch-run-", state.range(0));
+  std::string error;
+  const int64_t fitted = ImportPitchGrid(*client, id, &error);
+  if (fitted == 0) return state.SkipWithError(error.c_str());
+  v1::EvaluateGridRequest evaluate;
+  evaluate.set_name(id);
+  evaluate.set_refinement_level(1);
+  evaluate.set_revision(fitted);
+  const std::vector<double> reference = CellAreas(client->Evaluate(evaluate).value());
+  std::vector<double> deform_us, evaluate_us, step_us;
+  int64_t folds = 0, refused = 0;
+  for (auto _ : state) {
+    int64_t previous = fitted;
+    for (int n = 1; n <= kSteps; ++n) {
+      const auto start = std::chrono::steady_clock::now();
+      v1::DeformGridRequest request =
+          PitchRequest(id, fitted, amplitude * std::sin(2.0 * kPi * n / kSteps));
+      request.set_base_revision(previous);
+      request.set_time(0.01 * n);
+      request.set_step(n);
+      absl::StatusOr<v1::DeformGridResponse> moved = client->Deform(request);
+      deform_us.push_back(MicrosecondsSince(start));
+      if (!moved.ok()) {
+        if (!absl::IsFailedPrecondition(moved.status())) {
+          return state.SkipWithError(moved.status().ToString().c_str());
+        }
+        ++refused;
+        continue;
+      }
+      previous = moved->revision();
+      const auto evaluate_start = std::chrono::steady_clock::now();
+      evaluate.set_revision(moved->revision());
+      absl::StatusOr<client::EvaluatedGrid> grid = client->Evaluate(evaluate);
+      if (!grid.ok()) return state.SkipWithError(grid.status().ToString().c_str());
+      evaluate_us.push_back(MicrosecondsSince(evaluate_start));
+      const std::vector<double> areas = CellAreas(*grid);
+      for (size_t c = 0; c < areas.size() && c < reference.size(); ++c) {
+        if (reference[c] != 0.0 && !(areas[c] * reference[c] > 0.0)) ++folds;
+      }
+      step_us.push_back(MicrosecondsSince(start));
+    }
+  }
+  (void)client->Delete(id);
+  state.counters["folds"] = static_cast<double>(folds);
+  state.counters["refused"] = static_cast<double>(refused);
+  for (const auto& [name, values] :
+       {std::pair<const char*, const std::vector<double>*>{"deform", &deform_us},
+        {"evaluate", &evaluate_us},
+        {"step", &step_us}}) {
+    state.counters[absl::StrCat(name, "_p50_us")] = Percentile(*values, 0.5);
+    state.counters[absl::StrCat(name, "_p90_us")] = Percentile(*values, 0.9);
+    state.counters[absl::StrCat(name, "_p99_us")] = Percentile(*values, 0.99);
+    state.counters[absl::StrCat(name, "_max_us")] = Percentile(*values, 1.0);
+  }
+  state.SetLabel(folds > 0 || refused > 0 ? "FOLDS" : "no folds");
+}
+BENCHMARK(BM_PitchingRun)
+    ->Arg(10)
+    ->Arg(20)
+    ->ArgName("amplitude")
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace splinegrid::bench
