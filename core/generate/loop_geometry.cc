@@ -1,0 +1,61 @@
+#include "core/generate/loop_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace splinegrid {
+
+std::vector<double> Flat(const std::vector<Point2>& p) {
+  std::vector<double> xy;
+  xy.reserve(2 * p.size());
+  for (const Point2& q : p) {
+    xy.push_back(q[0]);
+    xy.push_back(q[1]);
+  }
+  return xy;
+}
+
+double SignedArea2(const std::vector<Point2>& p) {
+  double a = 0.0;
+  for (size_t i = 0; i + 1 < p.size(); ++i) a += Cross(p[i], p[i + 1]);
+  return a;
+}
+
+std::vector<Point2> LoopNormals(const std::vector<Point2>& p, double orientation) {
+  const int n = static_cast<int>(p.size());
+  std::vector<Point2> normals(n);
+  for (int i = 0; i < n; ++i) {
+    const int prev = i == 0 ? n - 2 : i - 1;
+    const int next = i == n - 1 ? 1 : i + 1;
+    const double tx = p[next][0] - p[prev][0], ty = p[next][1] - p[prev][1];
+    const double len = std::hypot(tx, ty);
+    normals[i] = {orientation * ty / len, -orientation * tx / len};
+  }
+  return normals;
+}
+
+double TurningDegrees(const std::vector<Point2>& p, int i) {
+  const int n = static_cast<int>(p.size());
+  const int prev = i == 0 ? n - 2 : i - 1;
+  const int next = i == n - 1 ? 1 : i + 1;
+  const Point2 a = {p[i][0] - p[prev][0], p[i][1] - p[prev][1]};
+  const Point2 b = {p[next][0] - p[i][0], p[next][1] - p[i][1]};
+  return std::abs(std::atan2(Cross(a, b), a[0] * b[0] + a[1] * b[1])) * 180.0 /
+         3.14159265358979323846;
+}
+
+StructuredBlock ReversedI(const StructuredBlock& block) {
+  StructuredBlock out(block.extents(), block.spatial_dim());
+  const int ni = block.extent(0), s = block.spatial_dim();
+  for (int k = 0; k < block.extent(2); ++k) {
+    for (int j = 0; j < block.extent(1); ++j) {
+      for (int i = 0; i < ni; ++i) {
+        std::copy(block.Point(ni - 1 - i, j, k), block.Point(ni - 1 - i, j, k) + s,
+                  out.Point(i, j, k));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace splinegrid

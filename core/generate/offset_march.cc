@@ -1,0 +1,267 @@
+#include "core/generate/offset_march.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/fit/tensor_fit.h"
+#include "core/generate/loop_geometry.h"
+#include "core/grid/polyline.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// Samples per point of a refitted piece, for its arc length.
+constexpr int kArcSamples = 8;
+// A corner of the wall stays a corner of a layer while the layer turns there by at least this.
+constexpr double kCornerDegrees = 15.0;
+
+// One Jacobi sweep of normal smoothing: every normal but the corners' becomes the normalised
+// weighted mean (1, 2, 1) of itself and its neighbours along the loop.
+void SmoothNormals(std::vector<Point2>& normals, const std::vector<bool>& corner) {
+  const int n = static_cast<int>(normals.size());
+  std::vector<Point2> next = normals;
+  for (int i = 0; i < n; ++i) {
+    if (corner[i]) continue;
+    const int prev = i == 0 ? n - 2 : i - 1;
+    const int after = i == n - 1 ? 1 : i + 1;
+    Point2 m = {normals[prev][0] + 2 * normals[i][0] + normals[after][0],
+                normals[prev][1] + 2 * normals[i][1] + normals[after][1]};
+    const double len = std::hypot(m[0], m[1]);
+    if (len > 0.0) next[i] = {m[0] / len, m[1] / len};
+  }
+  normals = std::move(next);
+}
+
+// Whether the layer q above p is acceptable: every segment keeps its direction and at least
+// `min_ratio` of its length, every cell keeps the orientation of the wall's, and q does not
+// cross itself. On failure `where` is the first bad segment.
+bool LayerValid(const std::vector<Point2>& p, const std::vector<Point2>& q, double orientation,
+                double min_ratio, int* where) {
+  for (size_t i = 0; i + 1 < p.size(); ++i) {
+    const Point2 a = {p[i + 1][0] - p[i][0], p[i + 1][1] - p[i][1]};
+    const Point2 b = {q[i + 1][0] - q[i][0], q[i + 1][1] - q[i][1]};
+    const double la = std::hypot(a[0], a[1]), lb = std::hypot(b[0], b[1]);
+    // The cell p_i, p_i+1, q_i+1, q_i: twice its signed area (shoelace).
+    const double area = Cross(p[i], p[i + 1]) + Cross(p[i + 1], q[i + 1]) + Cross(q[i + 1], q[i]) +
+                        Cross(q[i], p[i]);
+    if (a[0] * b[0] + a[1] * b[1] <= 0.0 || lb < min_ratio * la || area * orientation >= 0.0) {
+      *where = static_cast<int>(i);
+      return false;
+    }
+  }
+  if (const auto crossing = FindPolylineCrossing(Flat(q), /*closed=*/true)) {
+    *where = crossing->first;
+    return false;
+  }
+  return true;
+}
+
+// The piece q[a..b] refitted (interpolating, faired with `lambda`) and its points slid along
+// it towards even arc-length spacing by the fraction `beta`, but none by more than `slide`;
+// the ends stay.
+absl::Status RefitPiece(std::vector<Point2>& q, int a, int b, double lambda, double beta,
+                        double slide) {
+  const int m = b - a + 1;
+  if (m < 4) return absl::OkStatus();
+  StructuredBlock piece({m, 1, 1}, 2);
+  for (int i = 0; i < m; ++i) std::copy(q[a + i].begin(), q[a + i].end(), piece.Point(i, 0, 0));
+  FitOptions options;
+  options.fairing = lambda;
+  SG_ASSIGN_OR_RETURN(const FittedBlock fit, FitBlock(piece, options));
+  // Arc length along the fitted piece, sampled.
+  const int count = kArcSamples * (m - 1);
+  std::vector<double> u(count + 1), s(count + 1, 0.0);
+  Point3 prev{};
+  for (int t = 0; t <= count; ++t) {
+    u[t] = static_cast<double>(t) / count;
+    const Point3 x = EvaluatePoint(fit.spline, {u[t], 0.0, 0.0});
+    if (t > 0) s[t] = s[t - 1] + std::hypot(x[0] - prev[0], x[1] - prev[1]);
+    prev = x;
+  }
+  auto arc_of = [&](double param) {
+    const size_t t =
+        std::min<size_t>(std::upper_bound(u.begin(), u.end(), param) - u.begin(), u.size() - 1);
+    if (t == 0) return 0.0;
+    const double w = (param - u[t - 1]) / (u[t] - u[t - 1]);
+    return s[t - 1] + std::clamp(w, 0.0, 1.0) * (s[t] - s[t - 1]);
+  };
+  auto param_of = [&](double arc) {
+    const size_t t =
+        std::min<size_t>(std::upper_bound(s.begin(), s.end(), arc) - s.begin(), s.size() - 1);
+    if (t == 0) return 0.0;
+    const double w = (arc - s[t - 1]) / (s[t] - s[t - 1]);
+    return u[t - 1] + std::clamp(w, 0.0, 1.0) * (u[t] - u[t - 1]);
+  };
+  const std::vector<double>& params = fit.distribution.params(0);
+  std::vector<double> now(m), even(m);
+  double mismatch = 0.0;
+  for (int i = 0; i < m; ++i) {
+    now[i] = arc_of(params[i]);
+    even[i] = s.back() * i / (m - 1);
+    mismatch = std::max(mismatch, std::abs(even[i] - now[i]));
+  }
+  if (mismatch > 0.0) beta = std::min(beta, slide / mismatch);
+  for (int i = 1; i + 1 < m; ++i) {
+    const Point3 x =
+        EvaluatePoint(fit.spline, {param_of((1 - beta) * now[i] + beta * even[i]), 0, 0});
+    q[a + i] = {x[0], x[1]};
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+double GrowthRatio(double first, double distance, int layers) {
+  if (distance <= first * layers) return 1.0;
+  auto total = [&](double r) { return first * (std::pow(r, layers) - 1.0) / (r - 1.0); };
+  double lo = 1.0 + 1e-12, hi = 2.0;
+  while (total(hi) < distance) hi *= 2.0;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (total(mid) < distance ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+absl::Status OffsetOptions::Validate() const {
+  if (layers < 1 || layers > 100000) {
+    return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is outside [1, 100000]"));
+  }
+  if (!(first_height > 0.0) || !std::isfinite(first_height)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("first_height = ", first_height, " is not a positive finite number"));
+  }
+  if (!(distance > 0.0) || !std::isfinite(distance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("distance = ", distance, " is not a positive finite number"));
+  }
+  if (distance < first_height * layers * (1.0 - 1e-12)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "distance = ", distance, " is below layers x first_height = ", layers * first_height,
+        "; the layers cannot shrink"));
+  }
+  if (normal_smoothing < 0 || !(fairing >= 0.0) || !std::isfinite(fairing) ||
+      !(uniformity >= 0.0 && uniformity <= 1.0) ||
+      !(min_segment_ratio > 0.0 && min_segment_ratio < 1.0) || max_retries < 0 ||
+      !(wall_tilt_degrees >= 0.0 && wall_tilt_degrees < 90.0) ||
+      !(far_tilt_degrees >= 0.0 && far_tilt_degrees < 90.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("smoothing options out of range: normal_smoothing = ", normal_smoothing,
+                     ", fairing = ", fairing, ", uniformity = ", uniformity,
+                     ", min_segment_ratio = ", min_segment_ratio, ", max_retries = ", max_retries,
+                     ", tilts = ", wall_tilt_degrees, " and ", far_tilt_degrees, " degrees"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  const int n = static_cast<int>(wall.points.size());
+  if (n < 5)
+    return absl::InvalidArgumentError(absl::StrCat("the wall has ", n, " points; 5 at least"));
+  if (wall.points.front() != wall.points.back()) {
+    return absl::InvalidArgumentError(
+        "the wall loop is not closed: its last point is not its first");
+  }
+  for (double v : Flat(wall.points)) {
+    if (!std::isfinite(v))
+      return absl::InvalidArgumentError("the wall has a non-finite coordinate");
+  }
+  if (const auto crossing = FindPolylineCrossing(Flat(wall.points), true)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the wall crosses itself: segment ", crossing->first, " meets segment ", crossing->second));
+  }
+  std::vector<int> corners = wall.corners;
+  corners.push_back(0);
+  corners.push_back(n - 1);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  if (corners.front() < 0 || corners.back() > n - 1) {
+    return absl::InvalidArgumentError("a wall corner index is outside the loop");
+  }
+  const double orientation = SignedArea2(wall.points) > 0.0 ? 1.0 : -1.0;
+
+  OffsetGrid out;
+  out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
+  out.block = StructuredBlock({n, options.layers + 1, 1}, 2);
+  std::vector<Point2> p = wall.points;
+  auto store = [&](int j) {
+    for (int i = 0; i < n; ++i) std::copy(p[i].begin(), p[i].end(), out.block.Point(i, j, 0));
+  };
+  store(0);
+  double covered = 0.0;
+  for (int k = 0; k < options.layers; ++k) {
+    SG_RETURN_IF_ERROR(PollCancel(options.cancel));
+    const double h = options.first_height * std::pow(out.growth_ratio, k);
+    out.steps.push_back(h);
+    // Progress through the layers (not the distance: with geometric growth the last few
+    // layers cover most of it).
+    const double fraction = static_cast<double>(k + 1) / options.layers;
+    // Corners still sharp on this layer keep their normal (the bisector) and split the refit;
+    // once a corner has opened up below kCornerDegrees it is smoothed like any point (the seam
+    // at the loop's ends always splits the refit).
+    std::vector<bool> is_corner(n, false);
+    std::vector<int> pieces = {0};
+    for (int c : corners) {
+      if (c == 0 || c == n - 1) continue;
+      if (TurningDegrees(p, c) >= kCornerDegrees) {
+        is_corner[c] = true;
+        pieces.push_back(c);
+      }
+    }
+    pieces.push_back(n - 1);
+    if (TurningDegrees(p, 0) >= kCornerDegrees) is_corner[0] = is_corner[n - 1] = true;
+    std::vector<Point2> normals = LoopNormals(p, orientation);
+    const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
+    for (int s = 0; s < sweeps; ++s) SmoothNormals(normals, is_corner);
+    std::vector<Point2> q(n);
+    bool valid = false;
+    int where = 0;
+    for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
+      if (attempt > 0) {
+        for (int s = 0; s < 2 * attempt; ++s) SmoothNormals(normals, is_corner);
+        ++out.retries;
+      }
+      for (int i = 0; i < n; ++i) q[i] = {p[i][0] + h * normals[i][0], p[i][1] + h * normals[i][1]};
+      q.back() = q.front();
+      if (LayerValid(p, q, orientation, options.min_segment_ratio, &where)) {
+        valid = true;
+        break;
+      }
+    }
+    if (!valid) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "layer ", k + 1, " folds at wall segment ", where, " even with smoothed normals (step ",
+          h, "); use more layers, a smaller growth or a smoother wall"));
+    }
+    // Refit and fair between corners; slide towards even spacing by the part of the remaining
+    // distance this layer covers (so the unevenness left is the fraction of the distance still
+    // to go).
+    const double lambda = options.fairing * fraction;
+    const double beta = options.uniformity / (options.layers - k);
+    const double tilt = (options.wall_tilt_degrees +
+                         (options.far_tilt_degrees - options.wall_tilt_degrees) * fraction) *
+                        3.14159265358979323846 / 180.0;
+    std::vector<Point2> refitted = q;
+    for (size_t c = 0; c + 1 < pieces.size(); ++c) {
+      SG_RETURN_IF_ERROR(
+          RefitPiece(refitted, pieces[c], pieces[c + 1], lambda, beta, std::tan(tilt) * h));
+    }
+    refitted.back() = refitted.front();
+    // The refit must not spoil the layer; if it does, keep the offsets as they are.
+    if (LayerValid(p, refitted, orientation, options.min_segment_ratio, &where)) {
+      q = std::move(refitted);
+    }
+    p = std::move(q);
+    covered += h;
+    store(k + 1);
+  }
+  // Right-handed: with the layers outward, i must run clockwise for positive cell areas.
+  if (orientation > 0.0) out.block = ReversedI(out.block);
+  return out;
+}
+
+}  // namespace splinegrid

@@ -1,0 +1,96 @@
+// A grid around a profile, from its coordinates: the tool chain of issue 6 in one call.
+//
+//   1. the outline is fitted and faired (airfoil_fit.h): the profile spline, its trailing-edge
+//      corner (sharp) or base corners (blunt) kept as feature points;
+//   2. the wall loop is distributed along it by curvature and corners (wall_loop.h);
+//   3. the layers are built outward from the wall loop, either
+//      - kOffsets: marched by curvature-controlled offsets, each refitted and faired
+//        (offset_march.h), or
+//      - kTransfinite: interpolated between the wall and a circle `distance` out, the lines
+//        optionally bent to leave the wall orthogonally (transfinite.h);
+//   4. the result is measured (MeasureOGrid).
+// The grid is an O-grid, i along the loop (clockwise, the first line repeated as the last: the
+// seam leaves the trailing edge), j outward from the wall, every cell's signed area positive.
+#ifndef SPLINEGRID_CORE_GENERATE_PROFILE_GRID_H_
+#define SPLINEGRID_CORE_GENERATE_PROFILE_GRID_H_
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/fit/airfoil_fit.h"
+#include "core/generate/wall_loop.h"
+#include "core/grid/structured_grid.h"
+#include "core/util/cancellation.h"
+
+namespace splinegrid {
+
+enum class LayerMethod {
+  kOffsets,      // curvature-controlled offset curves (default)
+  kTransfinite,  // transfinite interpolation between the wall and an outer circle
+};
+
+// "offsets" or "transfinite".
+std::string_view LayerMethodName(LayerMethod method);
+
+// The most points a generated grid may have (2^24: 256 MiB of coordinates).
+inline constexpr int64_t kMaxProfileGridPoints = int64_t{1} << 24;
+
+struct ProfileGridOptions {
+  LayerMethod method = LayerMethod::kOffsets;
+  int wall_points = 257;        // points around the loop, the first repeated as the last, >= 9
+  int layers = 128;             // cells across, >= 1 (the grid has layers + 1 lines)
+  double first_height = 1e-5;   // of the first layer, in the profile's unit (chords)
+  double distance = 50.0;       // of the outermost layer from the wall
+  bool orthogonalize = true;    // kTransfinite: lines leave the wall along its normals
+  double fit_tolerance = 1e-4;  // of the profile spline to the coordinates (AirfoilFitOptions)
+  CancelCheck cancel;
+
+  // INVALID_ARGUMENT naming the field and its value.
+  absl::Status Validate() const;
+};
+
+// What a generated O-grid measures (MeasureOGrid).
+struct OGridQuality {
+  int64_t negative_cells = 0;   // cells whose signed area is <= 0
+  double min_cell_area = 0.0;   // smallest signed cell area
+  double first_height_min = 0;  // |X(i, 1) - X(i, 0)| over the wall points
+  double first_height_max = 0;
+  // Largest deviation from 90 degrees of the angle between the first grid line and the wall,
+  // over the wall points that are not corners (a corner has no tangent).
+  double wall_orthogonality_degrees = 0.0;
+  double outer_distance_min = 0.0;  // distance of the outer points from the wall polyline
+  double outer_distance_max = 0.0;
+  int self_intersecting_layers = 0;  // layers j >= 1 whose polyline crosses itself
+  int first_self_intersecting_layer = -1;
+};
+
+// Measures `grid` (ni x nj x 1, spatial_dim 2, periodic in i, j = 0 the wall) whose wall
+// corners are the indices `corners`. O(ni^2 nj) for the self-intersection test.
+OGridQuality MeasureOGrid(const StructuredBlock& grid, const std::vector<int>& corners);
+
+struct ProfileGrid {
+  StructuredBlock block;  // wall_points x (layers + 1), spatial_dim 2
+  AirfoilFit profile;     // the fitted outline
+  WallLoop wall;          // its distributed loop (block's j = 0, reversed: see offset_march.h)
+  double growth_ratio = 1.0;
+  int retries = 0;  // kOffsets: extra normal smoothing rounds over all layers
+  OGridQuality quality;
+  // Seconds of each stage.
+  double fit_seconds = 0.0, wall_seconds = 0.0, layer_seconds = 0.0, measure_seconds = 0.0;
+};
+
+// The grid of the file comment around the outline `coordinates` (n x 1 x 1, spatial_dim 2,
+// Selig order: from the trailing edge over the upper surface to the leading edge and back).
+// Errors: INVALID_ARGUMENT naming the field and value for bad options or coordinates (too few
+// points, non-finite values, an outline that crosses itself: FitAirfoil), or a profile whose
+// fit misses fit_tolerance; FAILED_PRECONDITION when the layers cannot be kept from folding
+// (naming the layer); CANCELLED.
+absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinates,
+                                                const ProfileGridOptions& options);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_CORE_GENERATE_PROFILE_GRID_H_

@@ -1,0 +1,192 @@
+// Grid generation around the shared airfoils: curvature-controlled offsets and transfinite
+// completion (core/generate), checked by the criteria.
+#include "core/generate/profile_grid.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/generate/offset_march.h"
+#include "core/generate/transfinite.h"
+#include "core/generate/wall_loop.h"
+#include "core/io/airfoil.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/core/test_data.h"
+
+namespace splinegrid {
+namespace {
+
+using ::testing::HasSubstr;
+
+StructuredBlock Coordinates(const std::string& name) {
+  return ReadAirfoilFile(SharedDataPath("airfoils/" + name + ".dat")).value().points;
+}
+
+StructuredBlock FromXY(const std::vector<double>& xy) {
+  StructuredBlock b({static_cast<int>(xy.size() / 2), 1, 1}, 2);
+  for (int i = 0; i < b.extent(0); ++i) {
+    b.Point(i, 0, 0)[0] = xy[2 * i];
+    b.Point(i, 0, 0)[1] = xy[2 * i + 1];
+  }
+  return b;
+}
+
+// The acceptance criteria for a grid with first layer `first` and far field `far`.
+void ExpectGoodGrid(const ProfileGrid& grid, double first, double far, const std::string& what) {
+  const OGridQuality& q = grid.quality;
+  EXPECT_EQ(q.negative_cells, 0) << what << ": min area " << q.min_cell_area;
+  EXPECT_GT(q.min_cell_area, 0.0) << what;
+  EXPECT_NEAR(q.first_height_min, first, 0.05 * first) << what;
+  EXPECT_NEAR(q.first_height_max, first, 0.05 * first) << what;
+  EXPECT_LE(q.wall_orthogonality_degrees, 5.0) << what;
+  EXPECT_NEAR(q.outer_distance_min, far, 0.05 * far) << what;
+  EXPECT_NEAR(q.outer_distance_max, far, 0.05 * far) << what;
+  EXPECT_EQ(q.self_intersecting_layers, 0)
+      << what << ": first at layer " << q.first_self_intersecting_layer;
+}
+
+class SharedAirfoilGridTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SharedAirfoilGridTest, OffsetsMeetTheCriteria) {
+  ProfileGridOptions options;  // 257 x 129, first 1e-5, far 50
+  const ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
+  EXPECT_EQ(grid.block.extent(0), 257);
+  EXPECT_EQ(grid.block.extent(1), 129);
+  ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " offsets");
+  // The growth ratio makes the layers add up to the distance.
+  EXPECT_NEAR(1e-5 * (std::pow(grid.growth_ratio, 128) - 1.0) / (grid.growth_ratio - 1.0), 50.0,
+              1e-9);
+}
+
+TEST_P(SharedAirfoilGridTest, OffsetsOfACoarseGridCloseIn) {
+  ProfileGridOptions options;
+  options.wall_points = 129;
+  options.layers = 48;
+  options.first_height = 1e-4;
+  options.distance = 5.0;
+  const ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
+  ExpectGoodGrid(grid, 1e-4, 5.0, GetParam() + " coarse offsets");
+}
+
+TEST_P(SharedAirfoilGridTest, OrthogonalisedTransfiniteMeetsTheCriteria) {
+  ProfileGridOptions options;
+  options.method = LayerMethod::kTransfinite;
+  ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
+  // Within 4 points of a trailing-edge corner (sharp, or either end of a blunt base) the lines
+  // fan out (transfinite.h) instead of leaving orthogonally: measure the orthogonality beyond.
+  const int ni = grid.block.extent(0);
+  const bool reversed = grid.block.Point(1, 0, 0)[0] != grid.wall.points[1][0];
+  std::vector<int> fan;
+  for (int corner : grid.wall.corners) {
+    const int c = reversed ? ni - 1 - corner : corner;
+    for (int d = -4; d <= 4; ++d) fan.push_back(((c + d) % (ni - 1) + (ni - 1)) % (ni - 1));
+  }
+  fan.push_back(ni - 1);
+  grid.quality.wall_orthogonality_degrees =
+      MeasureOGrid(grid.block, fan).wall_orthogonality_degrees;
+  ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " transfinite");
+}
+
+INSTANTIATE_TEST_SUITE_P(Airfoils, SharedAirfoilGridTest,
+                         ::testing::Values("naca0012", "rae2822", "sc20714"));
+
+TEST(ProfileGridTest, StraightTransfiniteLinesAreNotOrthogonal) {
+  // Without the orthogonalisation the lines run straight to the circle: the wall angle is off
+  // by far more than 5 degrees (the criterion above can fail).
+  ProfileGridOptions options;
+  options.method = LayerMethod::kTransfinite;
+  options.orthogonalize = false;
+  options.wall_points = 129;
+  options.layers = 32;
+  options.first_height = 1e-3;
+  options.distance = 10.0;
+  const ProfileGrid grid = GenerateProfileGrid(Coordinates("rae2822"), options).value();
+  EXPECT_GT(grid.quality.wall_orthogonality_degrees, 10.0);
+}
+
+TEST(ProfileGridTest, MeasureFindsFoldsAndCrossingLayers) {
+  ProfileGridOptions options;
+  options.wall_points = 65;
+  options.layers = 8;
+  options.first_height = 1e-3;
+  options.distance = 1.0;
+  ProfileGrid grid = GenerateProfileGrid(Coordinates("naca0012"), options).value();
+  ASSERT_EQ(grid.quality.negative_cells, 0);
+  // Pull one point of layer 4 across its layer and beyond layer 5: folded cells and a layer
+  // that crosses itself.
+  StructuredBlock& b = grid.block;
+  double* p = b.Point(20, 4, 0);
+  const double* wall = b.Point(20, 0, 0);
+  const double* across = b.Point(40, 4, 0);
+  p[0] = across[0] + 2.0 * (across[0] - wall[0]);
+  p[1] = across[1] + 2.0 * (across[1] - wall[1]);
+  const OGridQuality q = MeasureOGrid(b, {});
+  EXPECT_GT(q.negative_cells, 0);
+  EXPECT_LT(q.min_cell_area, 0.0);
+  EXPECT_GE(q.self_intersecting_layers, 1);
+  EXPECT_EQ(q.first_self_intersecting_layer, 4);
+}
+
+TEST(ProfileGridTest, WallLoopKeepsCornersAndClustersAtTheNose) {
+  const ProfileGrid grid =
+      GenerateProfileGrid(Coordinates("rae2822"), ProfileGridOptions()).value();
+  const WallLoop& wall = grid.wall;
+  ASSERT_EQ(wall.points.size(), 257u);
+  EXPECT_EQ(wall.points.front(), wall.points.back());
+  ASSERT_FALSE(wall.corners.empty());
+  EXPECT_EQ(wall.corners.front(), 0);
+  // Spacing near the leading edge (the point of smallest x) is finer than mid-chord.
+  int nose = 0;
+  for (int i = 0; i < 257; ++i) {
+    if (wall.points[i][0] < wall.points[nose][0]) nose = i;
+  }
+  const auto spacing = [&](int i) {
+    return std::hypot(wall.points[i + 1][0] - wall.points[i][0],
+                      wall.points[i + 1][1] - wall.points[i][1]);
+  };
+  int mid = nose / 2;
+  EXPECT_LT(spacing(nose), 0.5 * spacing(mid));
+}
+
+TEST(ProfileGridTest, BadInputNamesTheField) {
+  const StructuredBlock naca = Coordinates("naca0012");
+  const auto error = [&](const StructuredBlock& points, ProfileGridOptions options) {
+    return GenerateProfileGrid(points, options).status();
+  };
+  ProfileGridOptions o;
+  o.first_height = 0.0;
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("first_height = 0"));
+  o = ProfileGridOptions();
+  o.distance = -1.0;
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("distance = -1"));
+  o = ProfileGridOptions();
+  o.distance = std::nan("");
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("distance = nan"));
+  o = ProfileGridOptions();
+  o.layers = 100;
+  o.first_height = 0.1;
+  o.distance = 5.0;
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("below layers * first_height"));
+  o = ProfileGridOptions();
+  o.wall_points = 4;
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("wall_points = 4"));
+  o = ProfileGridOptions();
+  o.wall_points = 100000;
+  o.layers = 1000;
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("exceed the limit"));
+  // Too few points, and a figure eight (an outline that crosses itself).
+  EXPECT_EQ(error(FromXY({1, 0, 0.5, 0.1, 0, 0, 1, 0}), ProfileGridOptions()).code(),
+            absl::StatusCode::kInvalidArgument);
+  const absl::Status eight = error(
+      FromXY({1, 0, 0.75, 0.1, 0.5, 0.0, 0.25, -0.1, 0, 0, 0.25, 0.1, 0.5, 0.0, 0.75, -0.1, 1, 0}),
+      ProfileGridOptions());
+  EXPECT_EQ(eight.code(), absl::StatusCode::kInvalidArgument) << eight;
+  EXPECT_THAT(std::string(eight.message()), HasSubstr("cross"));
+  StructuredBlock nan = naca;
+  nan.Point(7, 0, 0)[1] = std::nan("");
+  EXPECT_EQ(error(nan, ProfileGridOptions()).code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace splinegrid
