@@ -1,0 +1,425 @@
+// OffsetSurface: a tilted plane offset exactly (both sides, and which handedness each gives), the
+// shared sphere blocks outward and inward at the stacked radii, an inward offset past the centre
+// refused or limited short of it, a polar cap whose collapsed edge stays one point on the axis,
+// the shared M6 wing blocks, and every error path. Cells are checked with an independent oracle:
+// the corner Jacobians and grid_quality's hexahedron volume.
+#include "core/generate/surface_offset.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/fit/grid_quality.h"
+#include "core/io/plot3d.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/core/test_data.h"
+
+namespace splinegrid {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kPi = std::numbers::pi;
+// A plane is reproduced exactly by the fits and its normals are constant: rounding only.
+constexpr double kPlaneTol = 1e-12;
+// Layer radii on a sphere, relative to the offset distance (the acceptance bar of the issue).
+constexpr double kRadiusRelTol = 0.01;
+// Height of the first layer, relative to the request.
+constexpr double kFirstHeightRelTol = 0.05;
+
+MultiBlockGrid ReadShared(const std::string& relative) {
+  absl::StatusOr<MultiBlockGrid> grid = ReadPlot3dFile(SharedDataPath(relative));
+  EXPECT_TRUE(grid.ok()) << grid.status();
+  return grid.ok() ? *std::move(grid) : MultiBlockGrid{};
+}
+
+Point3 At(const StructuredBlock& b, int i, int j, int k) {
+  const double* x = b.Point(i, j, k);
+  return {x[0], x[1], x[2]};
+}
+Point3 Sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+double Dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double Norm(const Point3& a) { return std::sqrt(Dot(a, a)); }
+Point3 Cross(const Point3& a, const Point3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+// The cells of a volume block seen with orientation `side`: the smallest side det[e_i, e_j, e_k]
+// / (|e_i| |e_j| |e_k|) over all corners whose three edges are not collapsed (edges leaving the
+// corner, each pointing in +i, +j or +k), how many corners were skipped, and the smallest
+// side * volume of the trilinear hexahedron relative to the cell's longest edge cubed.
+struct CellSigns {
+  double min_scaled_jacobian = 1.0;
+  int skipped_corners = 0;
+  double min_relative_volume = HUGE_VAL;
+};
+
+CellSigns CheckCells(const StructuredBlock& b, int side) {
+  CellSigns out;
+  const Extents n = b.extents();
+  for (int k = 0; k + 1 < n[2]; ++k) {
+    for (int j = 0; j + 1 < n[1]; ++j) {
+      for (int i = 0; i + 1 < n[0]; ++i) {
+        std::array<Point3, 8> x;
+        for (int c = 0; c < 8; ++c) x[c] = At(b, i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1));
+        double longest = 0.0;
+        for (int c = 0; c < 8; ++c) {
+          for (int bit : {1, 2, 4}) longest = std::max(longest, Norm(Sub(x[c | bit], x[c & ~bit])));
+        }
+        for (int c = 0; c < 8; ++c) {
+          const Point3 ei = Sub(x[c | 1], x[c & ~1]), ej = Sub(x[c | 2], x[c & ~2]),
+                       ek = Sub(x[c | 4], x[c & ~4]);
+          const double len = Norm(ei) * Norm(ej) * Norm(ek);
+          if (std::min({Norm(ei), Norm(ej), Norm(ek)}) <= 1e-9 * longest) {
+            ++out.skipped_corners;
+            continue;
+          }
+          out.min_scaled_jacobian =
+              std::min(out.min_scaled_jacobian, side * Dot(ei, Cross(ej, ek)) / len);
+        }
+        out.min_relative_volume = std::min(
+            out.min_relative_volume, side * HexahedronVolume(x) / (longest * longest * longest));
+      }
+    }
+  }
+  return out;
+}
+
+// Largest | |P(i, j, 1) - P(i, j, 0)| / first_height - 1 |.
+double FirstHeightError(const StructuredBlock& b, double first_height) {
+  double worst = 0.0;
+  for (int j = 0; j < b.extent(1); ++j) {
+    for (int i = 0; i < b.extent(0); ++i) {
+      const double h = Norm(Sub(At(b, i, j, 1), At(b, i, j, 0)));
+      worst = std::max(worst, std::abs(h / first_height - 1.0));
+    }
+  }
+  return worst;
+}
+
+// Largest | |P(i, j, k)| - expected[k] | over the block, for a sphere about the origin.
+double RadiusError(const StructuredBlock& b, const std::vector<double>& expected) {
+  double worst = 0.0;
+  for (int k = 0; k < b.extent(2); ++k) {
+    for (int j = 0; j < b.extent(1); ++j) {
+      for (int i = 0; i < b.extent(0); ++i) {
+        worst = std::max(worst, std::abs(Norm(At(b, i, j, k)) - expected[k]));
+      }
+    }
+  }
+  return worst;
+}
+
+// Radius of layer k on a sphere of radius r0 offset by `sign` (+1 out, -1 in) with `steps`.
+std::vector<double> StackedRadii(double r0, const std::vector<double>& steps, int sign) {
+  std::vector<double> radii = {r0};
+  for (double h : steps) radii.push_back(radii.back() + sign * h);
+  return radii;
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// A tilted plane through `origin` spanned by a, b (normal a x b), unevenly spaced.
+StructuredBlock TiltedPlane(const Point3& origin, const Point3& a, const Point3& b) {
+  StructuredBlock plane({9, 7, 1}, 3);
+  for (int j = 0; j < 7; ++j) {
+    for (int i = 0; i < 9; ++i) {
+      const double s = std::pow(i / 8.0, 1.5), t = j / 6.0 + 0.05 * std::sin(3.0 * i);
+      double* x = plane.Point(i, j, 0);
+      for (int c = 0; c < 3; ++c) x[c] = origin[c] + s * a[c] + t * b[c];
+    }
+  }
+  return plane;
+}
+
+class SurfaceOffsetPlaneTest : public testing::TestWithParam<int> {};
+
+TEST_P(SurfaceOffsetPlaneTest, LayersAreExactlyAtTheStackedHeights) {
+  const int side = GetParam();
+  const Point3 origin = {0.3, -1.2, 0.7}, a = {1.0, 0.2, -0.3}, b = {-0.1, 0.8, 0.4};
+  const StructuredBlock plane = TiltedPlane(origin, a, b);
+  const Point3 c = Cross(a, b);
+  const Point3 normal = {c[0] / Norm(c), c[1] / Norm(c), c[2] / Norm(c)};
+  SurfaceOffsetOptions options;
+  options.layers = 12;
+  options.first_height = 0.01;
+  options.distance = 1.5;
+  options.side = side;
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(plane, options);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  ASSERT_EQ(grid->block.extents(), Extents({9, 7, 13}));
+  ASSERT_EQ(grid->steps.size(), 12u);
+  EXPECT_NEAR(grid->steps.front(), 0.01, kPlaneTol);
+  double height = 0.0;
+  for (int k = 0; k <= 12; ++k) {
+    for (int j = 0; j < 7; ++j) {
+      for (int i = 0; i < 9; ++i) {
+        EXPECT_NEAR(Dot(Sub(At(grid->block, i, j, k), origin), normal), side * height, kPlaneTol)
+            << "point (" << i << ", " << j << ", " << k << ")";
+      }
+    }
+    if (k < 12) height += grid->steps[k];
+  }
+  EXPECT_NEAR(height, 1.5, kPlaneTol);
+  EXPECT_EQ(grid->limited_steps, 0);
+  EXPECT_EQ(grid->shortfall, 0.0);
+  // Handedness: det[x_i, x_j, x_k] has the sign of `side` at every corner.
+  const CellSigns signs = CheckCells(grid->block, side);
+  EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+  EXPECT_GT(signs.min_relative_volume, 0.0);
+  EXPECT_EQ(signs.skipped_corners, 0);
+  EXPECT_LT(CheckCells(grid->block, -side).min_scaled_jacobian, 0.0);
+  EXPECT_NEAR(grid->min_scaled_jacobian, signs.min_scaled_jacobian, 1e-12);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothSides, SurfaceOffsetPlaneTest, testing::Values(+1, -1));
+
+TEST(SurfaceOffsetTest, SphereBlocksOutwardStayAtTheStackedRadius) {
+  const MultiBlockGrid sphere = ReadShared("surfaces/even_sphere.fmt");
+  ASSERT_EQ(sphere.blocks.size(), 6u);
+  SurfaceOffsetOptions options;
+  options.layers = 32;
+  options.first_height = 1e-3;
+  options.distance = 0.5;
+  for (size_t n = 0; n < sphere.blocks.size(); ++n) {
+    SCOPED_TRACE(testing::Message() << "block " << n);
+    const auto start = std::chrono::steady_clock::now();
+    const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(sphere.blocks[n], options);
+    const double seconds = Seconds(start);
+    ASSERT_TRUE(grid.ok()) << grid.status();
+    // The shared blocks' normals point outward.
+    const double radius_error = RadiusError(grid->block, StackedRadii(1.0, grid->steps, +1));
+    const double first_error = FirstHeightError(grid->block, options.first_height);
+    const CellSigns signs = CheckCells(grid->block, +1);
+    EXPECT_LT(radius_error, kRadiusRelTol * options.distance);
+    EXPECT_LT(first_error, kFirstHeightRelTol);
+    EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+    EXPECT_GT(signs.min_relative_volume, 0.0);
+    EXPECT_EQ(grid->limited_steps, 0);  // convex: nothing to limit
+    std::cout << "sphere block " << n << " outward: radius error "
+              << radius_error / options.distance << " of the distance, first layer error "
+              << first_error << ", min scaled Jacobian " << signs.min_scaled_jacobian
+              << ", retries " << grid->retries << ", " << seconds << " s\n";
+  }
+}
+
+TEST(SurfaceOffsetTest, SphereBlockInwardWithinReachStaysAtTheStackedRadius) {
+  const MultiBlockGrid sphere = ReadShared("surfaces/even_sphere.fmt");
+  ASSERT_FALSE(sphere.blocks.empty());
+  SurfaceOffsetOptions options;
+  options.layers = 32;
+  options.first_height = 1e-3;
+  options.distance = 0.5;
+  options.side = -1;
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(sphere.blocks[0], options);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  const double radius_error = RadiusError(grid->block, StackedRadii(1.0, grid->steps, -1));
+  EXPECT_LT(radius_error, kRadiusRelTol * options.distance);
+  EXPECT_LT(FirstHeightError(grid->block, options.first_height), kFirstHeightRelTol);
+  const CellSigns signs = CheckCells(grid->block, -1);
+  EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+  EXPECT_GT(signs.min_relative_volume, 0.0);
+  EXPECT_LE(grid->shortfall, options.max_shortfall * options.distance);
+  std::cout << "sphere block 0 inward 0.5: radius error " << radius_error / options.distance
+            << " of the distance, limited steps " << grid->limited_steps << ", min scaled Jacobian "
+            << signs.min_scaled_jacobian << "\n";
+}
+
+// Layer after layer, every point of a sphere block offset inward moves towards the centre
+// and keeps more than 1 - ratio of the radius it had (the curvature limit, with 5% slack for
+// curvature measured on the fitted layer), never reaching the centre.
+void ExpectApproachesTheCentre(const StructuredBlock& b, double ratio) {
+  for (int k = 1; k < b.extent(2); ++k) {
+    for (int j = 0; j < b.extent(1); ++j) {
+      for (int i = 0; i < b.extent(0); ++i) {
+        const double before = Norm(At(b, i, j, k - 1)), now = Norm(At(b, i, j, k));
+        ASSERT_LT(now, before) << "point (" << i << ", " << j << ", " << k << ")";
+        ASSERT_GT(now, (1.0 - 1.05 * ratio) * before)
+            << "point (" << i << ", " << j << ", " << k << ")";
+      }
+    }
+  }
+}
+
+TEST(SurfaceOffsetTest, SphereBlockInwardPastTheCentreIsRefused) {
+  const MultiBlockGrid sphere = ReadShared("surfaces/even_sphere.fmt");
+  ASSERT_FALSE(sphere.blocks.empty());
+  SurfaceOffsetOptions options;
+  options.layers = 24;
+  options.first_height = 0.01;
+  options.distance = 1.5;  // the centre is at 1
+  options.side = -1;
+  const absl::StatusOr<SurfaceOffsetGrid> refused = OffsetSurface(sphere.blocks[0], options);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.status().message(),
+              HasSubstr("distance = 1.5 cannot be reached on the concave side"));
+  EXPECT_THAT(refused.status().message(), HasSubstr("max_curvature_step = 0.5"));
+  EXPECT_THAT(refused.status().message(), HasSubstr("max_shortfall = 0.01"));
+}
+
+TEST(SurfaceOffsetTest, SphereBlockInwardIsCurvatureLimitedNearTheCentre) {
+  const MultiBlockGrid sphere = ReadShared("surfaces/even_sphere.fmt");
+  ASSERT_FALSE(sphere.blocks.empty());
+  SurfaceOffsetOptions options;
+  options.layers = 12;
+  options.first_height = 0.05;
+  options.distance = 0.9;  // the last steps would cross half the radius left
+  options.side = -1;
+  EXPECT_EQ(OffsetSurface(sphere.blocks[0], options).status().code(),
+            absl::StatusCode::kFailedPrecondition);
+  options.max_shortfall = 0.1;
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(sphere.blocks[0], options);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  EXPECT_GT(grid->limited_steps, 0);
+  EXPECT_GT(grid->shortfall, 0.01 * options.distance);
+  EXPECT_LE(grid->shortfall, options.max_shortfall * options.distance);
+  ExpectApproachesTheCentre(grid->block, options.max_curvature_step);
+  const CellSigns signs = CheckCells(grid->block, -1);
+  EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+  EXPECT_GT(signs.min_relative_volume, 0.0);
+  std::cout << "sphere block 0 inward 0.9: shortfall " << grid->shortfall << ", limited steps "
+            << grid->limited_steps << ", innermost radius "
+            << Norm(At(grid->block, 2, 2, options.layers)) << ", min scaled Jacobian "
+            << signs.min_scaled_jacobian << "\n";
+}
+
+TEST(SurfaceOffsetTest, PolarCapKeepsItsCollapsedEdgeOnePointOnTheAxis) {
+  // Latitude-longitude cap of the unit sphere: i = 0 is the pole (the whole edge one point).
+  StructuredBlock cap({9, 7, 1}, 3);
+  for (int j = 0; j < 7; ++j) {
+    for (int i = 0; i < 9; ++i) {
+      const double theta = (kPi / 3.0) * i / 8.0, phi = (kPi / 2.0) * j / 6.0;
+      double* x = cap.Point(i, j, 0);
+      x[0] = std::sin(theta) * std::cos(phi);
+      x[1] = std::sin(theta) * std::sin(phi);
+      x[2] = std::cos(theta);
+    }
+  }
+  SurfaceOffsetOptions options;
+  options.layers = 20;
+  options.first_height = 2e-3;
+  options.distance = 0.4;
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(cap, options);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  const StructuredBlock& b = grid->block;
+  const std::vector<double> radii = StackedRadii(1.0, grid->steps, +1);
+  for (int k = 0; k < b.extent(2); ++k) {
+    for (int j = 1; j < b.extent(1); ++j) {
+      EXPECT_EQ(At(b, 0, j, k), At(b, 0, 0, k)) << "layer " << k << ", pole point " << j;
+    }
+    const Point3 pole = At(b, 0, 0, k);
+    EXPECT_NEAR(pole[2], radii[k], kRadiusRelTol * options.distance) << "layer " << k;
+    EXPECT_NEAR(std::hypot(pole[0], pole[1]), 0.0, kRadiusRelTol * options.distance)
+        << "layer " << k;
+  }
+  EXPECT_LT(RadiusError(b, radii), kRadiusRelTol * options.distance);
+  EXPECT_LT(FirstHeightError(b, options.first_height), kFirstHeightRelTol);
+  const CellSigns signs = CheckCells(b, +1);
+  EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+  EXPECT_GT(signs.min_relative_volume, 0.0);
+  std::cout << "polar cap: radius error " << RadiusError(b, radii) / options.distance
+            << " of the distance, min scaled Jacobian " << signs.min_scaled_jacobian << "\n";
+  // Exactly the corners on the pole are skipped: two per cell touching it.
+  EXPECT_EQ(signs.skipped_corners, 2 * 2 * (b.extent(1) - 1) * (b.extent(2) - 1));
+}
+
+TEST(SurfaceOffsetTest, M6WingBlocksOutward) {
+  const MultiBlockGrid m6 = ReadShared("surfaces/m6_small.fmt");
+  ASSERT_EQ(m6.blocks.size(), 9u);
+  SurfaceOffsetOptions options;
+  options.layers = 32;
+  options.first_height = 1e-4;
+  options.distance = 0.3;
+  // The leading-edge strip (65 x 17, radius of curvature down to ~0.005) and the upper surface
+  // (65 x 73); their normals point away from the wing.
+  for (int n : {0, 3}) {
+    SCOPED_TRACE(testing::Message() << "block " << n);
+    const auto start = std::chrono::steady_clock::now();
+    const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(m6.blocks[n], options);
+    const double seconds = Seconds(start);
+    ASSERT_TRUE(grid.ok()) << grid.status();
+    const double first_error = FirstHeightError(grid->block, options.first_height);
+    const CellSigns signs = CheckCells(grid->block, +1);
+    EXPECT_LT(first_error, kFirstHeightRelTol);
+    EXPECT_GT(signs.min_scaled_jacobian, 0.0);
+    EXPECT_GT(signs.min_relative_volume, 0.0);
+    EXPECT_EQ(signs.skipped_corners, 0);
+    std::cout << "m6 block " << n << " outward: first layer error " << first_error
+              << ", min scaled Jacobian " << signs.min_scaled_jacobian << ", retries "
+              << grid->retries << ", refits dropped " << grid->refits_dropped << ", limited steps "
+              << grid->limited_steps << ", " << seconds << " s\n";
+  }
+}
+
+StructuredBlock SmallPlane() {
+  return TiltedPlane({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+}
+
+struct BadOptionsCase {
+  std::string field;
+  void (*spoil)(SurfaceOffsetOptions&);
+};
+
+TEST(SurfaceOffsetTest, BadOptionsNameTheField) {
+  const std::vector<BadOptionsCase> cases = {
+      {"layers = 0", [](SurfaceOffsetOptions& o) { o.layers = 0; }},
+      {"first_height = 0", [](SurfaceOffsetOptions& o) { o.first_height = 0.0; }},
+      {"first_height = -1", [](SurfaceOffsetOptions& o) { o.first_height = -1.0; }},
+      {"first_height = nan", [](SurfaceOffsetOptions& o) { o.first_height = std::nan(""); }},
+      {"distance = -0.5", [](SurfaceOffsetOptions& o) { o.distance = -0.5; }},
+      {"distance = nan", [](SurfaceOffsetOptions& o) { o.distance = std::nan(""); }},
+      {"distance = 0.01 is below layers x first_height",
+       [](SurfaceOffsetOptions& o) { o.distance = 0.01; }},
+      {"side = 0", [](SurfaceOffsetOptions& o) { o.side = 0; }},
+      {"normal_smoothing = -1", [](SurfaceOffsetOptions& o) { o.normal_smoothing = -1; }},
+      {"fairing = -1", [](SurfaceOffsetOptions& o) { o.fairing = -1.0; }},
+      {"surface_fairing = inf", [](SurfaceOffsetOptions& o) { o.surface_fairing = HUGE_VAL; }},
+      {"max_curvature_step = 1", [](SurfaceOffsetOptions& o) { o.max_curvature_step = 1.0; }},
+      {"max_shortfall = 2", [](SurfaceOffsetOptions& o) { o.max_shortfall = 2.0; }},
+      {"max_retries = -1", [](SurfaceOffsetOptions& o) { o.max_retries = -1; }},
+  };
+  for (const BadOptionsCase& c : cases) {
+    SurfaceOffsetOptions options;
+    c.spoil(options);
+    const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(SmallPlane(), options);
+    EXPECT_EQ(grid.status().code(), absl::StatusCode::kInvalidArgument) << c.field;
+    EXPECT_THAT(grid.status().message(), HasSubstr(c.field));
+  }
+}
+
+TEST(SurfaceOffsetTest, BadSurfacesAreRejected) {
+  StructuredBlock nan_point = SmallPlane();
+  nan_point.Point(2, 3, 0)[1] = std::nan("");
+  StructuredBlock collapsed({5, 5, 1}, 3);  // all points at the origin
+  const std::vector<std::pair<StructuredBlock, std::string>> cases = {
+      {StructuredBlock({3, 8, 1}, 3), "surface: 3 x 8 points; at least 4 x 4"},
+      {StructuredBlock({8, 3, 1}, 3), "surface: 8 x 3 points; at least 4 x 4"},
+      {StructuredBlock({5, 5, 2}, 3), "surface: nk = 2"},
+      {StructuredBlock({5, 5, 1}, 2), "surface: spatial_dim = 2"},
+      {nan_point, "surface: point (2, 3, 0) coordinate y is nan"},
+      {collapsed, "surface: all points coincide"},
+  };
+  for (const auto& [surface, message] : cases) {
+    const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(surface, SurfaceOffsetOptions{});
+    EXPECT_EQ(grid.status().code(), absl::StatusCode::kInvalidArgument) << message;
+    EXPECT_THAT(grid.status().message(), HasSubstr(message));
+  }
+}
+
+TEST(SurfaceOffsetTest, CancelledBetweenLayers) {
+  SurfaceOffsetOptions options;
+  int polls = 0;
+  options.cancel = [&polls] { return ++polls > 5; };
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(SmallPlane(), options);
+  EXPECT_EQ(grid.status().code(), absl::StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace splinegrid
