@@ -2,21 +2,21 @@
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
+#include "server/grid_encoding.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
 
-absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFitOptions& options,
-                                            RevisionOrigin origin, int64_t parent,
-                                            const CancelCheck& cancel,
-                                            v1::FitGridResponse* response) {
-  const MultiBlockGrid& source = grid.source->grid;
-  SG_RETURN_IF_ERROR(options.Validate(source));
+absl::StatusOr<GridRevision> SplineGridService::FitRevision(const SourcePoints& source,
+                                                            const GridFitOptions& options,
+                                                            RevisionOrigin origin, int64_t parent,
+                                                            const CancelCheck& cancel) {
+  SG_RETURN_IF_ERROR(options.Validate(source.grid));
   // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,
-                      state_->budget.Reserve(2 * grid.source->memory.bytes(), "the fit"));
-  SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source, options, cancel));
+                      state_->budget.Reserve(2 * source.memory.bytes(), "the fit"));
+  SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source.grid, options, cancel));
   GridRevision revision;
   revision.create_time = absl::Now();
   revision.origin = origin;
@@ -27,21 +27,18 @@ absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFi
   revision.blocks = std::move(fit.blocks);
   revision.kinds = std::move(fit.kinds);
   revision.report = fit.report;
+  return revision;
+}
+
+absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFitOptions& options,
+                                            RevisionOrigin origin, int64_t parent,
+                                            const CancelCheck& cancel,
+                                            v1::FitGridResponse* response) {
+  SG_ASSIGN_OR_RETURN(GridRevision revision,
+                      FitRevision(*grid.source, options, origin, parent, cancel));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
                       state_->store.AddRevision(grid.id, std::move(revision)));
-  const GridRevision& published = *stored->revisions.back();
-  response->set_revision(published.number);
-  for (const BlockFit& block : published.blocks) {
-    EncodeBlockFit(block, options.tolerance_mode(), response->add_blocks());
-  }
-  const GridFitReport& report = published.report;
-  response->set_num_points(report.num_points);
-  response->set_num_control_points(report.num_control_points);
-  response->set_compression_ratio(static_cast<double>(report.num_points) /
-                                  std::max<int64_t>(report.num_control_points, 1));
-  response->set_max_deviation(report.max_deviation);
-  response->set_seconds(report.seconds);
-  EncodeFitReport(report, published.blocks, response->mutable_report());
+  EncodeFitResponse(*stored->revisions.back(), response);
   return absl::OkStatus();
 }
 

@@ -40,6 +40,21 @@ void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out) 
   }
 }
 
+void EncodeFitResponse(const GridRevision& revision, v1::FitGridResponse* out) {
+  out->set_revision(revision.number);
+  for (const BlockFit& block : revision.blocks) {
+    EncodeBlockFit(block, revision.fit_options.tolerance_mode(), out->add_blocks());
+  }
+  const GridFitReport& report = revision.report;
+  out->set_num_points(report.num_points);
+  out->set_num_control_points(report.num_control_points);
+  out->set_compression_ratio(static_cast<double>(report.num_points) /
+                             std::max<int64_t>(report.num_control_points, 1));
+  out->set_max_deviation(report.max_deviation);
+  out->set_seconds(report.seconds);
+  EncodeFitReport(report, revision.blocks, out->mutable_report());
+}
+
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
   const DeformationCheck& c = deform.check;
   out->set_check_level(c.level);

@@ -22,6 +22,9 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
 // One entry of a grid's revision history (time and step for deformed revisions only).
 void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out);
 
+// A fitted revision as FitGrid reports it: number, per-block summaries, totals, report.
+void EncodeFitResponse(const GridRevision& revision, v1::FitGridResponse* out);
+
 // What a deformation's quality gate measured.
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out);
 

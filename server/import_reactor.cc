@@ -1,9 +1,6 @@
 // SplineGridService::ImportGrid: a client stream of a header and then Plot3D bytes or points.
 // Data are appended on gRPC's thread (copies only); parsing and validation run on the pool.
-#include <random>
-
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "core/util/status_macros.h"
@@ -199,15 +196,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     grid->display_name = header_.display_name();
     grid->create_time = absl::Now();
     grid->source = std::move(source);
-    std::mt19937_64 random(std::random_device{}());
-    for (int attempt = 0;; ++attempt) {
-      grid->id = header_.grid_id().empty()
-                     ? absl::StrFormat("grid-%08x", static_cast<uint32_t>(random()))
-                     : header_.grid_id();
-      const absl::Status created = state_->store.Create(grid);
-      if (created.ok()) break;
-      if (!header_.grid_id().empty() || attempt == 8) return created;
-    }
+    SG_RETURN_IF_ERROR(CreateGrid(state_->store, header_.grid_id(), grid));
     log_.set_grid(absl::StrCat("grids/", grid->id));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }

@@ -1,10 +1,12 @@
 #include "server/service.h"
 
 #include <chrono>
+#include <random>
 #include <thread>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/bspline/evaluation.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
@@ -52,6 +54,17 @@ bool IsValidGridId(const std::string& id) {
     if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
   }
   return true;
+}
+
+absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
+                        const std::shared_ptr<StoredGrid>& grid) {
+  std::mt19937_64 random(std::random_device{}());
+  for (int attempt = 0;; ++attempt) {
+    grid->id = requested_id.empty() ? absl::StrFormat("grid-%08x", static_cast<uint32_t>(random()))
+                                    : requested_id;
+    const absl::Status created = store.Create(grid);
+    if (created.ok() || !requested_id.empty() || attempt == 8) return created;
+  }
 }
 
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field) {

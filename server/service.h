@@ -46,6 +46,12 @@ absl::Status ExplainCancellation(grpc::CallbackServerContext* context, absl::Sta
 // "grids/{id}" -> id, or INVALID_ARGUMENT naming `field` and the value.
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field);
 
+// Adds `grid` to `store` under `requested_id`, or, when that is empty, under a random id
+// "grid-xxxxxxxx" (retrying a few collisions); sets grid->id. ALREADY_EXISTS for a taken
+// requested id.
+absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
+                        const std::shared_ptr<StoredGrid>& grid);
+
 // Whether `id` is a valid grid id: 1-63 characters of [a-z0-9-], starting with a letter.
 bool IsValidGridId(const std::string& id);
 
@@ -77,6 +83,9 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* DeformGrid(grpc::CallbackServerContext* context,
                                        const v1::DeformGridRequest* request,
                                        v1::DeformGridResponse* response) override;
+  grpc::ServerUnaryReactor* GenerateGrid(grpc::CallbackServerContext* context,
+                                         const v1::GenerateGridRequest* request,
+                                         v1::GenerateGridResponse* response) override;
   grpc::ServerWriteReactor<v1::WatchGridResponse>* WatchGrid(
       grpc::CallbackServerContext* context, const v1::WatchGridRequest* request) override;
   grpc::ServerUnaryReactor* GetGrid(grpc::CallbackServerContext* context,
@@ -101,6 +110,16 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   // Runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       const std::function<absl::Status()>& work);
+
+  // Fits `source` with `options` into a revision of `origin` (and `parent`), not yet numbered
+  // or stored; its memory is reserved.
+  absl::StatusOr<GridRevision> FitRevision(const SourcePoints& source,
+                                           const GridFitOptions& options, RevisionOrigin origin,
+                                           int64_t parent, const CancelCheck& cancel);
+
+  // GenerateGrid's work, on the pool.
+  absl::Status Generate(const v1::GenerateGridRequest& request, const CancelCheck& cancel,
+                        v1::GenerateGridResponse* response);
 
   // Fits `grid`'s source with `options`, stores the result as a new revision (origin, parent)
   // and fills `response`.

@@ -70,6 +70,19 @@ class ServiceTest : public ::testing::Test {
   }
 
   // Waits until the memory budget is back to `bytes` (in-flight work released), up to 5 s.
+  // The budget once the calls that just returned have let go of their reservations (a server
+  // releases a call's reservation after the client has seen its status): unchanged for 50 ms.
+  int64_t SettledBudget() {
+    int64_t used = server_->state().budget.used();
+    for (int i = 0; i < 100; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      const int64_t now = server_->state().budget.used();
+      if (now == used) break;
+      used = now;
+    }
+    return used;
+  }
+
   bool WaitForBudget(int64_t bytes) {
     for (int i = 0; i < 500; ++i) {
       if (server_->state().budget.used() == bytes) return true;

@@ -1,0 +1,99 @@
+#include "proto/convert/generate_convert.h"
+
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
+
+namespace splinegrid {
+
+absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGridRequest& request) {
+  ProfileGridOptions options;
+  switch (request.method()) {
+    case v1::LAYER_METHOD_UNSPECIFIED:
+    case v1::LAYER_METHOD_OFFSETS:
+      options.method = LayerMethod::kOffsets;
+      break;
+    case v1::LAYER_METHOD_TRANSFINITE:
+      options.method = LayerMethod::kTransfinite;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("method = ", static_cast<int>(request.method()), " is not a known value"));
+  }
+  if (request.has_wall_points()) options.wall_points = request.wall_points();
+  if (request.has_layers()) options.layers = request.layers();
+  if (request.has_first_height()) options.first_height = request.first_height();
+  if (request.has_distance()) options.distance = request.distance();
+  if (request.has_orthogonalize()) options.orthogonalize = request.orthogonalize();
+  if (request.has_fit_tolerance()) options.fit_tolerance = request.fit_tolerance();
+  SG_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGridRequest* out) {
+  out->set_method(options.method == LayerMethod::kTransfinite ? v1::LAYER_METHOD_TRANSFINITE
+                                                              : v1::LAYER_METHOD_OFFSETS);
+  out->set_wall_points(options.wall_points);
+  out->set_layers(options.layers);
+  out->set_first_height(options.first_height);
+  out->set_distance(options.distance);
+  out->set_orthogonalize(options.orthogonalize);
+  out->set_fit_tolerance(options.fit_tolerance);
+}
+
+absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& points,
+                                                   const std::string& field) {
+  const int values = points.xy_size();
+  if (values % 2 != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".xy has ", values, " values, an odd count: give x, y pairs"));
+  }
+  if (values < 10) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".xy has ", values / 2, " points; a profile needs at least 5"));
+  }
+  for (int q = 0; q < values; ++q) {
+    if (!std::isfinite(points.xy(q))) {
+      return absl::InvalidArgumentError(absl::StrCat(field, ".xy[", q, "] = ", points.xy(q), " (",
+                                                     q % 2 == 0 ? "x" : "y", " of point ", q / 2,
+                                                     ") is not finite"));
+    }
+  }
+  StructuredBlock block({values / 2, 1, 1}, 2);
+  std::copy(points.xy().begin(), points.xy().end(), block.coords().begin());
+  return block;
+}
+
+void EncodeGenerationReport(const ProfileGrid& grid, int64_t profile_points,
+                            v1::GenerationReport* out) {
+  EncodeExtents(grid.block.extents(), out->mutable_extents());
+  v1::ProfileFitReport* profile = out->mutable_profile();
+  profile->set_num_points(static_cast<int32_t>(profile_points));
+  profile->set_num_control_points(grid.profile.num_control_points);
+  profile->set_max_deviation(grid.profile.max_deviation);
+  profile->set_sharp_trailing_edge(grid.profile.sharp_trailing_edge);
+  profile->set_features(static_cast<int32_t>(grid.profile.features.size()));
+  profile->set_fairing_weight(grid.profile.fairing_weight);
+  out->set_growth_ratio(grid.growth_ratio);
+  out->set_retries(grid.retries);
+  const OGridQuality& q = grid.quality;
+  v1::OGridQuality* quality = out->mutable_quality();
+  quality->set_negative_cells(q.negative_cells);
+  quality->set_min_cell_area(q.min_cell_area);
+  quality->set_first_height_min(q.first_height_min);
+  quality->set_first_height_max(q.first_height_max);
+  quality->set_wall_orthogonality_degrees(q.wall_orthogonality_degrees);
+  quality->set_outer_distance_min(q.outer_distance_min);
+  quality->set_outer_distance_max(q.outer_distance_max);
+  quality->set_self_intersecting_layers(q.self_intersecting_layers);
+  quality->set_first_self_intersecting_layer(q.first_self_intersecting_layer);
+  out->set_wall_corners(static_cast<int32_t>(grid.wall.corners.size()));
+  out->set_fit_seconds(grid.fit_seconds);
+  out->set_wall_seconds(grid.wall_seconds);
+  out->set_layer_seconds(grid.layer_seconds);
+  out->set_measure_seconds(grid.measure_seconds);
+}
+
+}  // namespace splinegrid

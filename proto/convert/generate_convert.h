@@ -1,0 +1,34 @@
+// Conversions of GenerateGrid: the request's layer parameters and profile points to the
+// kernel's (core/generate/profile_grid.h), and a ProfileGrid to the GenerationReport.
+#ifndef SPLINEGRID_PROTO_CONVERT_GENERATE_CONVERT_H_
+#define SPLINEGRID_PROTO_CONVERT_GENERATE_CONVERT_H_
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/generate/profile_grid.h"
+#include "core/grid/structured_grid.h"
+#include "splinegrid/v1/splinegrid_service.pb.h"
+
+namespace splinegrid {
+
+// The layer parameters of `request` (method, wall_points, layers, first_height, distance,
+// orthogonalize, fit_tolerance): unset fields keep the kernel's defaults, set ones are taken as
+// given; validated by ProfileGridOptions::Validate (INVALID_ARGUMENT naming the field).
+absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGridRequest& request);
+
+// The parameters actually used, as the request fields (every layer field set).
+void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGridRequest* out);
+
+// ProfilePoints as an n x 1 x 1 curve with spatial_dim 2; INVALID_ARGUMENT naming
+// `field`.xy for an odd count, fewer than 5 points or a non-finite value.
+absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& points,
+                                                   const std::string& field);
+
+// The report of a generated grid, apart from `parameters` and `seconds`.
+void EncodeGenerationReport(const ProfileGrid& grid, int64_t profile_points,
+                            v1::GenerationReport* out);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_PROTO_CONVERT_GENERATE_CONVERT_H_

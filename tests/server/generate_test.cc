@@ -1,0 +1,299 @@
+// GenerateGrid through the service: O-grids around the shared airfoils (from the file text,
+// from points and from a stored C-grid's wall) that are stored, fitted and valid at the
+// original resolution with the right boundary kinds, and every bad input refused by name with
+// nothing stored.
+#include <cmath>
+#include <numbers>
+
+#include "core/io/airfoil.h"
+#include "gmock/gmock.h"
+#include "tests/server/service_fixture.h"
+
+namespace splinegrid::testing {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr int kWallPoints = 129;
+constexpr int kLayers = 33;
+constexpr double kFirstHeight = 1e-4;
+constexpr double kDistance = 20.0;
+constexpr double kFirstLayerTolerance = 0.05;  // relative, of the first layer's height
+
+// A small O-grid request around `profile` (set by the caller) named `id`.
+v1::GenerateGridRequest SmallRequest(const std::string& id) {
+  v1::GenerateGridRequest r;
+  r.set_grid_id(id);
+  r.set_wall_points(kWallPoints);
+  r.set_layers(kLayers);
+  r.set_first_height(kFirstHeight);
+  r.set_distance(kDistance);
+  return r;
+}
+
+std::string AirfoilText(const std::string& file) {
+  return ReadFileToString(SharedData("airfoils/" + file)).value();
+}
+
+// Twice the signed area of cell (i, j) of a 2D block (positive counter-clockwise in (i, j)).
+double CellArea(const StructuredBlock& g, int i, int j) {
+  const double* a = g.Point(i, j, 0);
+  const double* b = g.Point(i + 1, j, 0);
+  const double* c = g.Point(i + 1, j + 1, 0);
+  const double* d = g.Point(i, j + 1, 0);
+  return (c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]);
+}
+
+class GenerateTest : public ServiceTest {
+ protected:
+  // Every grid's name, in order.
+  std::vector<std::string> GridNames() {
+    std::vector<std::string> names;
+    const std::vector<v1::Grid> grids = client_->List().value();
+    for (const v1::Grid& g : grids) names.push_back(g.name());
+    return names;
+  }
+
+  // Checks the stored grid `id`: one fitted 129 x 34 block whose level-0 cells all have a
+  // positive signed area, and whose boundary kinds are wall at j = 0, outer at j = max and
+  // interface on the seam i = 0 / i = max.
+  void ExpectValidOGrid(const std::string& id) {
+    const v1::Grid grid = client_->Get(id).value();
+    EXPECT_EQ(grid.latest_revision(), 1);
+    ASSERT_EQ(grid.source().blocks_size(), 1);
+    EXPECT_EQ(grid.source().blocks(0).i(), kWallPoints);
+    EXPECT_EQ(grid.source().blocks(0).j(), kLayers + 1);
+    EXPECT_EQ(grid.source().blocks(0).k(), 1);
+    EXPECT_GE(grid.source().num_matches(), 1);  // the seam
+    EXPECT_EQ(grid.revision().origin(), v1::REVISION_ORIGIN_FIT);
+
+    v1::EvaluateGridRequest request;
+    request.set_name("grids/" + id);
+    request.set_refinement_level(0);
+    const StructuredBlock points = client_->Evaluate(request).value().blocks.at(0).points;
+    ASSERT_EQ(points.extent(0), kWallPoints);
+    ASSERT_EQ(points.extent(1), kLayers + 1);
+    int64_t non_positive = 0;
+    for (int j = 0; j + 1 < points.extent(1); ++j) {
+      for (int i = 0; i + 1 < points.extent(0); ++i) non_positive += !(CellArea(points, i, j) > 0);
+    }
+    EXPECT_EQ(non_positive, 0) << id;
+
+    const auto stored = server_->state().store.Get(id).value();
+    const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
+    const int ni = kWallPoints, nj = kLayers + 1;
+    const auto has = [&](int i, int j, BoundaryKind kind) {
+      return (kinds[i + ni * j] & static_cast<uint8_t>(kind)) != 0;
+    };
+    for (int i = 0; i < ni; ++i) {
+      EXPECT_TRUE(has(i, 0, BoundaryKind::kWall)) << "i = " << i;
+      EXPECT_FALSE(has(i, 0, BoundaryKind::kOuter)) << "i = " << i;
+      EXPECT_TRUE(has(i, nj - 1, BoundaryKind::kOuter)) << "i = " << i;
+      EXPECT_FALSE(has(i, nj - 1, BoundaryKind::kWall)) << "i = " << i;
+    }
+    for (int j = 0; j < nj; ++j) {
+      EXPECT_TRUE(has(0, j, BoundaryKind::kInterface)) << "j = " << j;
+      EXPECT_TRUE(has(ni - 1, j, BoundaryKind::kInterface)) << "j = " << j;
+    }
+    for (int j = 1; j + 1 < nj; ++j) {
+      for (int i = 1; i + 1 < ni; ++i) EXPECT_EQ(kinds[i + ni * j], 0) << i << ", " << j;
+    }
+  }
+
+  // `request` fails with `code` naming `fragment`, and nothing new is stored.
+  void ExpectRefused(const v1::GenerateGridRequest& request, absl::StatusCode code,
+                     const std::string& fragment) {
+    const std::vector<std::string> before = GridNames();
+    const int64_t budget = SettledBudget();
+    EXPECT_THAT(client_->Generate(request).status(), StatusIs(code, fragment));
+    EXPECT_EQ(GridNames(), before);
+    EXPECT_TRUE(WaitForBudget(budget));
+  }
+};
+
+class GenerateAirfoilTest : public GenerateTest,
+                            public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(GenerateAirfoilTest, StoresAFittedValidOGrid) {
+  const std::string file = GetParam();
+  const std::string id = file.substr(0, file.find('.'));
+  v1::GenerateGridRequest request = SmallRequest(id);
+  request.set_airfoil_file(AirfoilText(file));
+  const v1::GenerateGridResponse r = client_->Generate(request).value();
+  EXPECT_EQ(r.grid().name(), "grids/" + id);
+  EXPECT_EQ(r.grid().latest_revision(), 1);
+  EXPECT_EQ(r.fit().revision(), 1);
+  EXPECT_TRUE(r.fit().report().tolerance_met()) << r.fit().report().unmet_reason();
+  // Without a spec the grid is interpolated: exact at its points (the default tolerances by
+  // kind would fold the wall cells: 1.5e-4 against a 1e-4 first layer). Known limit: the spline
+  // is clamped, not periodic, at the seam, and refinement levels 1-2 fold sub-cells in the
+  // seam's first column near the trailing edge (the report counts them).
+  EXPECT_EQ(r.fit().compression_ratio(), 1.0);
+  EXPECT_LT(r.fit().max_deviation(), 1e-9);
+  ASSERT_EQ(r.fit().blocks_size(), 1);
+  EXPECT_TRUE(r.fit().blocks(0).deviation_by_kind().has_wall());
+  EXPECT_TRUE(r.fit().blocks(0).deviation_by_kind().has_outer());
+  EXPECT_TRUE(r.fit().blocks(0).deviation_by_kind().has_interface());
+
+  const v1::GenerationReport& report = r.report();
+  EXPECT_EQ(report.extents().i(), kWallPoints);
+  EXPECT_EQ(report.extents().j(), kLayers + 1);
+  EXPECT_EQ(report.parameters().method(), v1::LAYER_METHOD_OFFSETS);
+  EXPECT_EQ(report.parameters().layers(), kLayers);
+  EXPECT_TRUE(report.parameters().has_orthogonalize());  // defaults are filled in
+  EXPECT_FALSE(report.profile().name().empty());
+  EXPECT_GT(report.profile().num_control_points(), 4);
+  EXPECT_LE(report.profile().max_deviation(), report.parameters().fit_tolerance());
+  EXPECT_GT(report.growth_ratio(), 1.0);
+  EXPECT_EQ(report.quality().negative_cells(), 0);
+  EXPECT_GT(report.quality().min_cell_area(), 0.0);
+  EXPECT_EQ(report.quality().self_intersecting_layers(), 0);
+  EXPECT_NEAR(report.quality().first_height_min(), kFirstHeight,
+              kFirstLayerTolerance * kFirstHeight);
+  EXPECT_NEAR(report.quality().first_height_max(), kFirstHeight,
+              kFirstLayerTolerance * kFirstHeight);
+  EXPECT_GT(report.quality().outer_distance_min(), 0.9 * kDistance);
+  EXPECT_GT(report.seconds(), 0.0);
+  ExpectValidOGrid(id);
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedAirfoils, GenerateAirfoilTest,
+                         ::testing::Values("naca0012.dat", "rae2822.dat", "sc20714.dat"));
+
+TEST_F(GenerateTest, TransfiniteFromPointsWithAServerPickedId) {
+  const AirfoilCoordinates airfoil = ParseAirfoil(AirfoilText("rae2822.dat"), "rae2822").value();
+  v1::GenerateGridRequest request = SmallRequest("");
+  request.set_method(v1::LAYER_METHOD_TRANSFINITE);
+  for (double v : airfoil.points.coords()) request.mutable_points()->add_xy(v);
+  const v1::GenerateGridResponse r = client_->Generate(request).value();
+  EXPECT_THAT(r.grid().name(), HasSubstr("grids/grid-"));
+  EXPECT_EQ(r.report().parameters().method(), v1::LAYER_METHOD_TRANSFINITE);
+  EXPECT_EQ(r.report().profile().num_points(), airfoil.points.num_points());
+  EXPECT_EQ(r.report().quality().negative_cells(), 0);
+  ExpectValidOGrid(r.grid().name().substr(6));
+}
+
+TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
+  ImportShared("grids/n0012_225-65.p2dfmt", "cgrid");
+  v1::FitSpec spec;
+  spec.mutable_boundary_tolerances();
+  ASSERT_TRUE(client_->Fit("cgrid", spec).ok());
+  // The wall run of the C-grid's j = 0 (its wake cut is an interface).
+  const auto stored = server_->state().store.Get("cgrid").value();
+  const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
+  int wall = 0;
+  for (int i = 0; i < stored->source->grid.blocks[0].extent(0); ++i) {
+    wall += (kinds[i] & static_cast<uint8_t>(BoundaryKind::kWall)) != 0;
+  }
+  ASSERT_GT(wall, 50);
+  ASSERT_LT(wall, 225);
+
+  v1::GenerateGridRequest request = SmallRequest("from-wall");
+  request.mutable_stored_wall()->set_name("grids/cgrid");
+  const v1::GenerateGridResponse r = client_->Generate(request).value();
+  EXPECT_EQ(r.report().profile().num_points(), wall);
+  EXPECT_THAT(r.report().profile().name(), HasSubstr("grids/cgrid revision 1 block 0"));
+  EXPECT_EQ(r.report().quality().negative_cells(), 0);
+  ExpectValidOGrid("from-wall");
+
+  // A wall that is not there, and a block that is not.
+  request.set_grid_id("no-wall");
+  request.mutable_stored_wall()->set_block(1);
+  ExpectRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.block = 1");
+  request.mutable_stored_wall()->set_block(0);
+  request.mutable_stored_wall()->set_name("grids/nothing");
+  ExpectRefused(request, absl::StatusCode::kNotFound, "grids/nothing");
+  request.mutable_stored_wall()->set_name("cgrid");
+  ExpectRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.name = 'cgrid'");
+}
+
+TEST_F(GenerateTest, BadInputIsRefusedByNameAndNothingIsStored) {
+  const std::string naca = AirfoilText("naca0012.dat");
+  auto with_points = [](std::vector<double> xy) {
+    v1::GenerateGridRequest r = SmallRequest("bad");
+    r.mutable_points()->mutable_xy()->Assign(xy.begin(), xy.end());
+    return r;
+  };
+  const std::vector<double> diamond = {1, 0, 0.5, 0.1, 0, 0, 0.5, -0.1, 1, 0};
+  ExpectRefused(with_points({1, 0, 0.5, std::nan(""), 0, 0, 0.5, -0.1, 1, 0}),
+                absl::StatusCode::kInvalidArgument, "points.xy[3] = nan");
+  ExpectRefused(with_points({1, 0, 0, 0, 1, 0}), absl::StatusCode::kInvalidArgument,
+                "points.xy has 3 points");
+  ExpectRefused(with_points({1, 0, 0, 0, 1}), absl::StatusCode::kInvalidArgument, "odd count");
+
+  // A figure eight: the outline crosses itself (the kernel's message, passed through).
+  std::vector<double> eight;
+  for (int q = 0; q <= 80; ++q) {
+    const double t = 2 * std::numbers::pi * q / 80;
+    eight.push_back(0.5 + 0.5 * std::cos(t));
+    eight.push_back(0.2 * std::sin(2 * t));
+  }
+  ExpectRefused(with_points(eight), absl::StatusCode::kInvalidArgument, "crosses itself");
+
+  v1::GenerateGridRequest r = with_points(diamond);
+  r.set_first_height(-1e-4);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = -0.0001");
+  r.set_first_height(0.0);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = 0");
+  r.set_first_height(std::nan(""));
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = nan");
+  r.set_first_height(1.0);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "distance = 20 is below layers");
+  r.set_first_height(kFirstHeight);
+  r.set_wall_points(4);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "wall_points = 4");
+  r.set_wall_points(kWallPoints);
+  r.set_layers(0);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "layers = 0");
+  r.set_layers(kLayers);
+  r.set_method(static_cast<v1::LayerMethod>(7));
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "method = 7");
+  r.set_method(v1::LAYER_METHOD_UNSPECIFIED);
+  r.set_grid_id("Bad_Id");
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "grid_id = 'Bad_Id'");
+  r.set_grid_id("bad");
+  r.mutable_spec()->set_tolerance(-1.0);
+  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "tolerance");
+  r.clear_spec();
+
+  v1::GenerateGridRequest unset = SmallRequest("bad");
+  ExpectRefused(unset, absl::StatusCode::kInvalidArgument, "profile is unset");
+  v1::GenerateGridRequest file = SmallRequest("bad");
+  file.set_airfoil_file("NACA\n1.0 0.0\n0.5 x\n");
+  ExpectRefused(file, absl::StatusCode::kInvalidArgument, "airfoil_file");
+
+  // The name is taken: ALREADY_EXISTS, the existing grid untouched.
+  v1::GenerateGridRequest first = SmallRequest("taken");
+  first.set_airfoil_file(naca);
+  ASSERT_TRUE(client_->Generate(first).ok());
+  const v1::Grid before = client_->Get("taken").value();
+  first.set_method(v1::LAYER_METHOD_TRANSFINITE);
+  ExpectRefused(first, absl::StatusCode::kAlreadyExists, "grids/taken already exists");
+  EXPECT_EQ(client_->Get("taken").value().DebugString(), before.DebugString());
+  EXPECT_EQ(GridNames(), std::vector<std::string>{"grids/taken"});
+}
+
+TEST_F(GenerateTest, SizeOverTheServersCapIsOutOfRange) {
+  options_.max_output_points = 1000;
+  StartServer();
+  v1::GenerateGridRequest r = SmallRequest("big");
+  r.set_airfoil_file(AirfoilText("naca0012.dat"));
+  ExpectRefused(r, absl::StatusCode::kOutOfRange, "wall_points * (layers + 1) = 4386");
+}
+
+TEST_F(GenerateTest, AnExpiredDeadlineStoresNothing) {
+  client::ClientOptions fast;
+  fast.timeout = absl::Milliseconds(5);
+  client::Client impatient(server_->InProcessChannel(), fast);
+  v1::GenerateGridRequest r = SmallRequest("late");
+  r.set_airfoil_file(AirfoilText("rae2822.dat"));
+  r.set_wall_points(1025);
+  r.set_layers(256);
+  r.set_first_height(1e-6);
+  EXPECT_EQ(impatient.Generate(r).status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_TRUE(WaitForBudget(0));
+  EXPECT_TRUE(GridNames().empty());
+}
+
+}  // namespace
+}  // namespace splinegrid::testing
