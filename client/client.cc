@@ -141,6 +141,14 @@ absl::StatusOr<v1::DeformGridResponse> Client::Deform(v1::DeformGridRequest requ
   return response;
 }
 
+absl::StatusOr<v1::GenerateGridResponse> Client::Generate(const v1::GenerateGridRequest& request) {
+  auto context = NewContext();
+  v1::GenerateGridResponse response;
+  const grpc::Status status = stub_->GenerateGrid(context.get(), request, &response);
+  if (!status.ok()) return FromGrpc(status);
+  return response;
+}
+
 void WatchCancel::Cancel() {
   std::lock_guard<std::mutex> lock(mu_);
   cancelled_ = true;

@@ -120,6 +120,10 @@ class Client {
   // Deforms a grid (request.name may be an id); see DeformGridRequest. A deformation that
   // folds cells is FAILED_PRECONDITION with the server's message (nothing was stored).
   absl::StatusOr<v1::DeformGridResponse> Deform(v1::DeformGridRequest request);
+  // Generates a grid around a profile and fits it (GenerateGrid; see GenerateGridRequest):
+  // the new grid with its revision 1, the generation report and the fit's summary. Nothing is
+  // stored on an error.
+  absl::StatusOr<v1::GenerateGridResponse> Generate(const v1::GenerateGridRequest& request);
   // Watches a grid's revisions (WatchGrid): those after `after_revision` (0: every stored one
   // first, -1: only new ones), then each new one as it is stored. The call has no deadline; it
   // lasts until the grid is deleted, the server stops or the call is cancelled (`cancel`, or

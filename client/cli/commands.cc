@@ -105,6 +105,50 @@ std::string IdFromPath(const std::string& path) {
   return id.substr(0, 63);
 }
 
+// OK when `out` ends in .vts, .vtm, .x or .xyz (what WriteEvaluatedGrid writes).
+absl::Status CheckGridOutput(const std::string& out) {
+  const std::string ext = std::filesystem::path(out).extension().string();
+  if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz") {
+    return Usage(absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x or .xyz"));
+  }
+  return absl::OkStatus();
+}
+
+// Writes an evaluation to `out` (VTK .vts for one block or .vtm, binary .x or text .xyz
+// Plot3D); returns the number of points written.
+absl::StatusOr<int64_t> WriteEvaluatedGrid(const std::string& out,
+                                           const client::EvaluatedGrid& result) {
+  const std::string ext = std::filesystem::path(out).extension().string();
+  MultiBlockGrid grid;
+  std::vector<std::vector<VtkPointArray>> arrays;
+  int64_t points = 0;
+  for (const client::EvaluatedBlock& block : result.blocks) {
+    points += block.points.num_points();
+    std::vector<VtkPointArray> fields;
+    if (!block.du.empty()) {
+      const int s = block.points.spatial_dim();
+      fields = {{"dX_du", s, block.du}, {"dX_dv", s, block.dv}, {"dX_dw", s, block.dw}};
+    }
+    arrays.push_back(std::move(fields));
+    grid.blocks.push_back(block.points);
+  }
+  if (ext == ".vts") {
+    if (grid.blocks.size() != 1) {
+      return Usage(
+          absl::StrCat(grid.blocks.size(), " blocks: write .vtm, or choose one with --block"));
+    }
+    SG_RETURN_IF_ERROR(WriteVts(out, grid.blocks[0], arrays[0]));
+  } else if (ext == ".vtm") {
+    SG_RETURN_IF_ERROR(WriteVtm(out, grid, arrays));
+  } else {
+    SG_RETURN_IF_ERROR(
+        WritePlot3dFile(out, grid,
+                        DefaultPlot3dFormat(grid, ext == ".x" ? Plot3dEncoding::kBinaryLittleEndian
+                                                              : Plot3dEncoding::kAscii)));
+  }
+  return points;
+}
+
 }  // namespace
 
 absl::Status Serve(const Args& args) {
@@ -291,41 +335,12 @@ absl::Status Eval(const Args& args) {
   }
   request.set_derivatives(absl::GetFlag(FLAGS_derivs));
   request.set_precision(absl::GetFlag(FLAGS_float32) ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
-  const std::string ext = std::filesystem::path(out).extension().string();
-  if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz") {
-    return Usage(absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x or .xyz"));
-  }
+  SG_RETURN_IF_ERROR(CheckGridOutput(out));
   ProgressLine download("evaluate");
   SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result,
                       Connect()->Evaluate(request, download.callback()));
   download.Done();
-  MultiBlockGrid grid;
-  std::vector<std::vector<VtkPointArray>> arrays;
-  int64_t points = 0;
-  for (client::EvaluatedBlock& block : result.blocks) {
-    points += block.points.num_points();
-    std::vector<VtkPointArray> fields;
-    if (!block.du.empty()) {
-      const int s = block.points.spatial_dim();
-      fields = {{"dX_du", s, block.du}, {"dX_dv", s, block.dv}, {"dX_dw", s, block.dw}};
-    }
-    arrays.push_back(std::move(fields));
-    grid.blocks.push_back(block.points);
-  }
-  if (ext == ".vts") {
-    if (grid.blocks.size() != 1) {
-      return Usage(
-          absl::StrCat(grid.blocks.size(), " blocks: write .vtm, or choose one with --block"));
-    }
-    SG_RETURN_IF_ERROR(WriteVts(out, grid.blocks[0], arrays[0]));
-  } else if (ext == ".vtm") {
-    SG_RETURN_IF_ERROR(WriteVtm(out, grid, arrays));
-  } else {
-    SG_RETURN_IF_ERROR(
-        WritePlot3dFile(out, grid,
-                        DefaultPlot3dFormat(grid, ext == ".x" ? Plot3dEncoding::kBinaryLittleEndian
-                                                              : Plot3dEncoding::kAscii)));
-  }
+  SG_ASSIGN_OR_RETURN(const int64_t points, WriteEvaluatedGrid(out, result));
   v1::EvaluationHeader summary;  // for --json
   summary.set_revision(result.revision);
   summary.set_total_points(points);
@@ -553,6 +568,64 @@ absl::Status Deform(const Args& args) {
                                         [&] { return client->Get(request.name()); }));
   SG_ASSIGN_OR_RETURN(const v1::DeformGridResponse response, client->Deform(request));
   Print(FormatDeform(request.name(), request, response), response);
+  return absl::OkStatus();
+}
+
+absl::Status Offset(const Args& args) {
+  constexpr char kUsage[] =
+      "usage: splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] "
+      "[--points 257] [--method offsets|transfinite] [--orthogonalize=false] [--profile_tol T] "
+      "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,x,xyz}]";
+  if (args.size() != 1) return Usage(kUsage);
+  const std::string& path = args[0];
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (!out.empty()) SG_RETURN_IF_ERROR(CheckGridOutput(out));
+  v1::GenerateGridRequest request;
+  request.set_grid_id(absl::GetFlag(FLAGS_name).empty()
+                          ? IdFromPath(path)
+                          : client::GridName(absl::GetFlag(FLAGS_name)).substr(6));
+  request.set_display_name(std::filesystem::path(path).filename().string());
+  SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(path));
+  const std::string method = absl::AsciiStrToLower(absl::GetFlag(FLAGS_method));
+  if (method == "offsets") {
+    request.set_method(v1::LAYER_METHOD_OFFSETS);
+  } else if (method == "transfinite") {
+    request.set_method(v1::LAYER_METHOD_TRANSFINITE);
+  } else if (!method.empty()) {
+    return Usage(absl::StrCat("--method = '", absl::GetFlag(FLAGS_method),
+                              "': give offsets or transfinite"));
+  }
+  if (const auto v = absl::GetFlag(FLAGS_layers)) request.set_layers(*v);
+  if (const auto v = absl::GetFlag(FLAGS_first)) request.set_first_height(*v);
+  if (const auto v = absl::GetFlag(FLAGS_far)) request.set_distance(*v);
+  if (const auto v = absl::GetFlag(FLAGS_points)) request.set_wall_points(*v);
+  if (const auto v = absl::GetFlag(FLAGS_orthogonalize)) request.set_orthogonalize(*v);
+  if (const auto v = absl::GetFlag(FLAGS_profile_tol)) request.set_fit_tolerance(*v);
+  // The grid fit: the fit flags when given, else the server's default (interpolation).
+  SG_ASSIGN_OR_RETURN(v1::FitSpec spec, SpecFromFlags());
+  if (spec.resolution_case() != v1::FitSpec::RESOLUTION_NOT_SET || spec.has_fairing()) {
+    if (spec.resolution_case() == v1::FitSpec::RESOLUTION_NOT_SET) {
+      spec.mutable_boundary_tolerances();
+    }
+    *request.mutable_spec() = spec;
+  }
+  auto client = Connect();
+  SG_ASSIGN_OR_RETURN(const v1::GenerateGridResponse response, client->Generate(request));
+  std::string human = FormatGenerate(response);
+  if (!out.empty()) {
+    v1::EvaluateGridRequest evaluate;
+    evaluate.set_name(response.grid().name());
+    evaluate.set_revision(response.fit().revision());
+    evaluate.set_refinement_level(0);
+    ProgressLine download("evaluate");
+    SG_ASSIGN_OR_RETURN(const client::EvaluatedGrid result,
+                        client->Evaluate(evaluate, download.callback()));
+    download.Done();
+    SG_ASSIGN_OR_RETURN(const int64_t points, WriteEvaluatedGrid(out, result));
+    absl::StrAppend(&human, "wrote ", out, ": ", points, " points (revision ", result.revision,
+                    ")\n");
+  }
+  Print(human, response);
   return absl::OkStatus();
 }
 

@@ -24,6 +24,9 @@ absl::Status Curvature(const Args& args);
 absl::Status Airfoil(const Args& args);
 // Rigidly moves part of a grid's boundary (DeformGrid) and prints the new revision's report.
 absl::Status Deform(const Args& args);
+// Generates an O-grid around an airfoil file's profile (GenerateGrid), prints the report and
+// with -o writes the new grid at its original resolution.
+absl::Status Offset(const Args& args);
 // Prints one line per new revision of a grid (WatchGrid) until interrupted or it is deleted.
 absl::Status Watch(const Args& args);
 absl::Status Remove(const Args& args);

@@ -7,7 +7,7 @@ ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to 
 ABSL_FLAG(bool, json, false, "print results as JSON");
 ABSL_FLAG(absl::Duration, timeout, absl::Minutes(10), "deadline of each call");
 
-ABSL_FLAG(std::string, name, "", "fit: id of the new grid (default: from the file name)");
+ABSL_FLAG(std::string, name, "", "fit/offset: id of the new grid (default: from the file name)");
 ABSL_FLAG(double, tol, 0.0, "fit: largest allowed deviation, in the grid's length unit");
 ABSL_FLAG(std::string, ctl, "", "fit: control points per direction, e.g. 24,16 or 24,16,8");
 ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
@@ -32,7 +32,7 @@ ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
 ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
 ABSL_FLAG(std::string, o, "",
-          "eval: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv");
+          "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv");
 ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
 
@@ -63,6 +63,21 @@ ABSL_FLAG(double, decay_radius, 0.0,
 ABSL_FLAG(double, rigid_radius, 0.0,
           "deform: controls within it move with the boundary in full (0: none)");
 ABSL_FLAG(int, smoothing, 0, "deform: Laplacian smoothing sweeps of the interior (0: none)");
+
+ABSL_FLAG(std::optional<int>, layers, std::nullopt,
+          "offset: cells outward from the wall (default: the server's, 128)");
+ABSL_FLAG(std::optional<double>, first, std::nullopt,
+          "offset: height of the first layer, in the profile's unit (default 1e-5)");
+ABSL_FLAG(std::optional<double>, far, std::nullopt,
+          "offset: distance of the outermost layer from the wall (default 50)");
+ABSL_FLAG(std::optional<int>, points, std::nullopt,
+          "offset: wall points around the profile, the first repeated as the last (default 257)");
+ABSL_FLAG(std::string, method, "",
+          "offset: how layers are built: offsets (default) or transfinite");
+ABSL_FLAG(std::optional<bool>, orthogonalize, std::nullopt,
+          "offset --method transfinite: grid lines leave the wall normally (default true)");
+ABSL_FLAG(std::optional<double>, profile_tol, std::nullopt,
+          "offset: largest distance of the profile spline from the file's points (default 1e-4)");
 
 ABSL_FLAG(int64_t, after, 0,
           "watch: send the revisions after this one (0: every stored one, -1: only new ones)");

@@ -53,6 +53,14 @@ ABSL_DECLARE_FLAG(std::string, propagation);
 ABSL_DECLARE_FLAG(double, decay_radius);
 ABSL_DECLARE_FLAG(double, rigid_radius);
 ABSL_DECLARE_FLAG(int, smoothing);
+// offset
+ABSL_DECLARE_FLAG(std::optional<int>, layers);
+ABSL_DECLARE_FLAG(std::optional<double>, first);
+ABSL_DECLARE_FLAG(std::optional<double>, far);
+ABSL_DECLARE_FLAG(std::optional<int>, points);
+ABSL_DECLARE_FLAG(std::string, method);
+ABSL_DECLARE_FLAG(std::optional<bool>, orthogonalize);
+ABSL_DECLARE_FLAG(std::optional<double>, profile_tol);
 // watch
 ABSL_DECLARE_FLAG(int64_t, after);
 // health

@@ -8,6 +8,7 @@
 //   splinegrid get NAME [--full]      splinegrid list      splinegrid rm NAME
 //   splinegrid eval NAME (--level L | --res a,b,c) [--step N] [--block b] -o OUT.{vts,...}
 //   splinegrid deform NAME --rotate DEG [--about X,Y[,Z]] [--translate DX,DY[,DZ]] ...
+//   splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] ... [-o OUT]
 //   splinegrid watch NAME [--after R]
 //   splinegrid health
 // Client commands talk to --server (default localhost:50051); --json prints JSON.
@@ -40,6 +41,11 @@ constexpr char kUsage[] =
     "                  [--step N] [--check_level L] [--propagation blend|transfinite]\n"
     "                  [--decay_radius D] [--rigid_radius R] [--smoothing N]\n"
     "      a fold is FAILED_PRECONDITION (exit 1), nothing stored\n"
+    "  splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50]\n"
+    "                  [--points 257] [--method offsets|transfinite] [--orthogonalize=false]\n"
+    "                  [--profile_tol 1e-4] [--tol T | --kinds ... | --ctl a,b,c]\n"
+    "                  [-o OUT.{vts,x,xyz}]   an O-grid around an airfoil file (Selig or\n"
+    "      Lednicer), stored and fitted (default: interpolated); -o writes it at level 0\n"
     "  splinegrid watch NAME [--after R]   one line per new revision until ^C or deletion\n"
     "Client commands use --server host:port (default localhost:50051) and --json.";
 
@@ -59,7 +65,8 @@ int main(int argc, char** argv) {
       {"eval", splinegrid::cli::Eval},       {"rm", splinegrid::cli::Remove},
       {"fair", splinegrid::cli::Fair},       {"curvature", splinegrid::cli::Curvature},
       {"airfoil", splinegrid::cli::Airfoil}, {"health", splinegrid::cli::Health},
-      {"deform", splinegrid::cli::Deform},   {"watch", splinegrid::cli::Watch}};
+      {"deform", splinegrid::cli::Deform},   {"watch", splinegrid::cli::Watch},
+      {"offset", splinegrid::cli::Offset}};
   const auto command = commands.find(positional[1]);
   if (command == commands.end()) {
     std::fprintf(stderr, "unknown command '%s'\n%s\n", positional[1], kUsage);

@@ -155,6 +155,42 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   return out;
 }
 
+std::string FormatGenerate(const v1::GenerateGridResponse& response) {
+  const v1::GenerationReport& r = response.report();
+  const v1::GenerateGridRequest& p = r.parameters();
+  const v1::ProfileFitReport& f = r.profile();
+  const v1::OGridQuality& q = r.quality();
+  const std::string method = p.method() == v1::LAYER_METHOD_TRANSFINITE ? "transfinite" : "offsets";
+  std::string out = absl::StrFormat(
+      "%s: %s O-grid %s around %s, %.1f ms\n", response.grid().name(), method,
+      FormatExtents(r.extents()),
+      f.name().empty() ? "the points" : absl::StrCat("'", f.name(), "'"), 1e3 * r.seconds());
+  absl::StrAppend(&out,
+                  absl::StrFormat("  profile: %d points -> %d control points, max deviation %.3g "
+                                  "(tolerance %.3g), %s trailing edge, %d features, fairing %.3g\n",
+                                  f.num_points(), f.num_control_points(), f.max_deviation(),
+                                  p.fit_tolerance(), f.sharp_trailing_edge() ? "sharp" : "blunt",
+                                  f.features(), f.fairing_weight()));
+  absl::StrAppend(&out, absl::StrFormat("  layers: %d, first height %.3g, distance %.4g, growth "
+                                        "ratio %.5f, %d retries, %d wall corners\n",
+                                        p.layers(), p.first_height(), p.distance(),
+                                        r.growth_ratio(), r.retries(), r.wall_corners()));
+  absl::StrAppend(
+      &out,
+      absl::StrFormat("  quality: %d negative cells (min area %.3g), first layer %.4g .. %.4g, "
+                      "wall orthogonality %.3g degrees, outer distance %.4g .. %.4g, %d "
+                      "self-intersecting layers\n",
+                      q.negative_cells(), q.min_cell_area(), q.first_height_min(),
+                      q.first_height_max(), q.wall_orthogonality_degrees(), q.outer_distance_min(),
+                      q.outer_distance_max(), q.self_intersecting_layers()));
+  absl::StrAppend(&out, absl::StrFormat("  stages: profile fit %.1f ms, wall %.1f ms, layers %.1f "
+                                        "ms, measure %.1f ms\n",
+                                        1e3 * r.fit_seconds(), 1e3 * r.wall_seconds(),
+                                        1e3 * r.layer_seconds(), 1e3 * r.measure_seconds()));
+  absl::StrAppend(&out, FormatFit(response.grid().name(), response.fit()));
+  return out;
+}
+
 std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureResponse& curvature,
                             const std::string& csv_path) {
   std::string out = absl::StrFormat("%s revision %d wall curvature\n", name, curvature.revision());

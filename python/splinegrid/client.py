@@ -96,6 +96,10 @@ _PROPAGATIONS = {
     "blend": service_pb2.PROPAGATION_BLEND,
     "transfinite": service_pb2.PROPAGATION_TRANSFINITE,
 }
+_LAYER_METHODS = {
+    "offsets": service_pb2.LAYER_METHOD_OFFSETS,
+    "transfinite": service_pb2.LAYER_METHOD_TRANSFINITE,
+}
 MAX_CHECK_LEVEL = 4  # the server's highest fold-check level
 
 # A face range: a grid_pb2.FaceRange, a (block, face, begin, end) tuple or a dict with those
@@ -398,24 +402,8 @@ class Client:
         validity at refinement levels 0-2, connectivity and gaps, fairing weight, wall
         curvature before and after fairing).
         """
-        given = [control_counts is not None, tolerance is not None,
-                 boundary_tolerances is not None]
-        if sum(given) > 1:
-            raise ValueError("give one of control_counts, tolerance and boundary_tolerances")
-        spec = grid_pb2.FitSpec(order=order, max_controls_per_direction=max_controls)
-        if tolerance is not None:
-            spec.tolerance = tolerance
-        elif boundary_tolerances is not None:
-            unknown = set(boundary_tolerances) - {"wall", "interface", "outer", "interior", "edge"}
-            if unknown:
-                raise ValueError(f"boundary_tolerances: unknown kinds {sorted(unknown)}")
-            spec.boundary_tolerances.SetInParent()
-            for kind, value in boundary_tolerances.items():
-                setattr(spec.boundary_tolerances, kind, float(value))
-        elif control_counts is not None:
-            spec.control_counts.CopyFrom(_extents(control_counts, "control_counts", fill=0))
-        if fairing is not None:
-            spec.fairing.CopyFrom(_fairing(fairing))
+        spec = _fit_spec(control_counts, tolerance, order, max_controls, boundary_tolerances,
+                         fairing)
         request = service_pb2.FitGridRequest(name=grid_name(name), spec=spec)
         with _translated_errors():
             return self.stub.FitGrid(request, timeout=self.timeout)
@@ -433,6 +421,90 @@ class Client:
             request.fairing.CopyFrom(_fairing(fairing))
         with _translated_errors():
             return self.stub.FairGrid(request, timeout=self.timeout)
+
+    def generate(self, name: str = "", airfoil: Union[None, str, bytes,
+                                                      "os.PathLike[str]"] = None,
+                 points: Optional[npt.ArrayLike] = None,
+                 stored_wall: Union[None, str, tuple] = None,
+                 display_name: str = "", method: Optional[str] = None,
+                 wall_points: Optional[int] = None, layers: Optional[int] = None,
+                 first_height: Optional[float] = None, distance: Optional[float] = None,
+                 orthogonalize: Optional[bool] = None,
+                 fit_tolerance: Optional[float] = None,
+                 control_counts: Optional[Triple] = None, tolerance: Optional[float] = None,
+                 order: int = 4, max_controls: int = 0,
+                 boundary_tolerances: Optional[dict[str, float]] = None,
+                 fairing: Union[None, str, float] = None
+                 ) -> service_pb2.GenerateGridResponse:
+        """Generates an O-grid around a profile, stores it as the new grid ``name`` ("" lets the
+        server pick an id; ALREADY_EXISTS if taken) and fits it as revision 1. Nothing is
+        stored on an error.
+
+        The profile is one of ``airfoil`` (a Selig or Lednicer file: its path, or its text as a
+        str with line breaks, or bytes), ``points`` (an ``(n, 2)`` array in Selig order:
+        trailing edge, upper surface, leading edge, lower surface, trailing edge) or
+        ``stored_wall``: a grid's name, or ``(name, block)`` or ``(name, block, revision)``
+        (the wall points of that 2-D block's j = 0 edge, revision 0 = latest).
+
+        Layers (None: the server's defaults, core/generate/profile_grid.h): ``method``
+        ``"offsets"`` (curvature-controlled offsets, default) or ``"transfinite"``,
+        ``wall_points`` (257; the first repeated as the last), ``layers`` (128 cells outward),
+        ``first_height`` (1e-5, the profile's unit), ``distance`` (50, of the outer boundary
+        from the wall), ``orthogonalize`` (transfinite: lines leave the wall normally; True),
+        ``fit_tolerance`` (1e-4, of the profile spline to the points).
+
+        The fit of revision 1 takes :meth:`fit`'s arguments; with none of ``control_counts``,
+        ``tolerance``, ``boundary_tolerances`` and ``fairing`` the server interpolates the grid
+        (exact; wall j = 0, outer j = max, the seam an interface).
+
+        Returns the GenerateGridResponse proto: ``grid`` (BASIC view, revision 1), ``report``
+        (GenerationReport: ``parameters`` used, ``extents``, ``profile`` fit, ``growth_ratio``,
+        ``retries``, ``quality`` with ``negative_cells``, ``first_height_min``/``max``,
+        ``wall_orthogonality_degrees``, ...; stage seconds) and ``fit`` (as :meth:`fit`
+        returns it).
+        """
+        given = [airfoil is not None, points is not None, stored_wall is not None]
+        if sum(given) != 1:
+            raise ValueError("give exactly one of airfoil, points and stored_wall")
+        request = service_pb2.GenerateGridRequest(grid_id=_grid_id(name),
+                                                  display_name=display_name)
+        if airfoil is not None:
+            request.airfoil_file = _airfoil_text(airfoil)
+        elif points is not None:
+            xy = np.ascontiguousarray(points, dtype=np.float64)
+            if xy.ndim != 2 or xy.shape[1] != 2:
+                raise ValueError(f"points has shape {xy.shape}; give an (n, 2) array")
+            request.points.xy.extend(xy.reshape(-1).tolist())
+        else:
+            wall = (stored_wall,) if isinstance(stored_wall, str) else tuple(stored_wall)
+            if not 1 <= len(wall) <= 3:
+                raise ValueError(f"stored_wall = {stored_wall!r}; give name, (name, block) or "
+                                 "(name, block, revision)")
+            request.stored_wall.name = grid_name(wall[0])
+            if len(wall) > 1:
+                request.stored_wall.block = _non_negative_int(wall[1], "stored_wall block")
+            if len(wall) > 2:
+                request.stored_wall.revision = _non_negative_int(wall[2], "stored_wall revision")
+        if method is not None:
+            if method not in _LAYER_METHODS:
+                raise ValueError(f"method = {method!r}; give one of {sorted(_LAYER_METHODS)}")
+            request.method = _LAYER_METHODS[method]
+        for field, value in (("wall_points", wall_points), ("layers", layers)):
+            if value is not None:
+                setattr(request, field, _integer(value, field))
+        for field, value in (("first_height", first_height), ("distance", distance),
+                             ("fit_tolerance", fit_tolerance)):
+            if value is not None:  # NaN and non-positive values: the server names them
+                setattr(request, field, float(value))
+        if orthogonalize is not None:
+            request.orthogonalize = bool(orthogonalize)
+        if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
+            request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
+                                            boundary_tolerances, fairing))
+            if not request.spec.HasField("resolution"):
+                request.spec.boundary_tolerances.SetInParent()
+        with _translated_errors():
+            return self.stub.GenerateGrid(request, timeout=self.timeout)
 
     def wall_curvature(self, name: str, revision: int = 0, level: int = 2,
                        blocks: Blocks = None) -> list[WallCurvatureLine]:
@@ -794,6 +866,41 @@ def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
         raise ValueError(f"{what} = {values}; give 1 to 3 integers (i, j, k)")
     i, j, k = values + [fill] * (3 - len(values))
     return grid_pb2.Extents(i=i, j=j, k=k)
+
+
+def _fit_spec(control_counts: Optional[Triple], tolerance: Optional[float], order: int,
+              max_controls: int, boundary_tolerances: Optional[dict[str, float]],
+              fairing: Union[None, str, float]) -> grid_pb2.FitSpec:
+    """The FitSpec of :meth:`Client.fit`'s arguments."""
+    given = [control_counts is not None, tolerance is not None,
+             boundary_tolerances is not None]
+    if sum(given) > 1:
+        raise ValueError("give one of control_counts, tolerance and boundary_tolerances")
+    spec = grid_pb2.FitSpec(order=order, max_controls_per_direction=max_controls)
+    if tolerance is not None:
+        spec.tolerance = tolerance
+    elif boundary_tolerances is not None:
+        unknown = set(boundary_tolerances) - {"wall", "interface", "outer", "interior", "edge"}
+        if unknown:
+            raise ValueError(f"boundary_tolerances: unknown kinds {sorted(unknown)}")
+        spec.boundary_tolerances.SetInParent()
+        for kind, value in boundary_tolerances.items():
+            setattr(spec.boundary_tolerances, kind, float(value))
+    elif control_counts is not None:
+        spec.control_counts.CopyFrom(_extents(control_counts, "control_counts", fill=0))
+    if fairing is not None:
+        spec.fairing.CopyFrom(_fairing(fairing))
+    return spec
+
+
+def _airfoil_text(airfoil: Union[str, bytes, "os.PathLike[str]"]) -> str:
+    """An airfoil file's text from its path, or the text itself (a str with a line break)."""
+    if isinstance(airfoil, (bytes, bytearray)):
+        return bytes(airfoil).decode()
+    if isinstance(airfoil, str) and "\n" in airfoil:
+        return airfoil
+    with open(airfoil, encoding="utf-8", errors="replace") as file:
+        return file.read()
 
 
 def _fairing(fairing: Union[str, float]) -> grid_pb2.Fairing:

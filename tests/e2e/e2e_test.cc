@@ -219,6 +219,95 @@ TEST_F(EndToEndTest, CliFitsAnAirfoilLocally) {
   EXPECT_NE(Cli(absl::StrCat("airfoil ", SharedData("grids/n0012_113-33.p2dfmt"))).exit_code, 0);
 }
 
+TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
+  const std::string vts = (dir_ / "grid.vts").string();
+  const Result offset =
+      Cli(absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"),
+                       " --name=naca-og --layers=32 --first=1e-4 --far=20 --points=129 -o ", vts));
+  ASSERT_EQ(offset.exit_code, 0) << offset.out;
+  EXPECT_THAT(offset.out, HasSubstr("grids/naca-og: offsets O-grid 129x33x1 around 'Naca 0012"));
+  EXPECT_THAT(offset.out, HasSubstr("quality: 0 negative cells"));
+  EXPECT_THAT(offset.out, HasSubstr("grids/naca-og revision 1: 4257 points"));
+  EXPECT_THAT(offset.out, HasSubstr(absl::StrCat("wrote ", vts, ": 4257 points (revision 1)")));
+  EXPECT_THAT(ReadFileToString(vts).value(), HasSubstr("WholeExtent=\"0 128 0 32 0 0\""));
+
+  // Transfinite, as binary Plot3D: every cell of the written grid has a positive area.
+  const std::string x = (dir_ / "grid.x").string();
+  const Result transfinite = Cli(absl::StrCat(
+      "offset ", SharedData("airfoils/rae2822.dat"),
+      " --name=rae-og --method=transfinite --layers=24 --first=1e-3 --far=10 --points=97 --json "
+      "-o ",
+      x));
+  ASSERT_EQ(transfinite.exit_code, 0) << transfinite.out;
+  EXPECT_THAT(transfinite.out, HasSubstr("\"method\": \"LAYER_METHOD_TRANSFINITE\""));
+  EXPECT_THAT(transfinite.out, HasSubstr("\"growth_ratio\""));
+  const MultiBlockGrid grid = ReadPlot3dFile(x).value();
+  ASSERT_EQ(grid.blocks.size(), 1u);
+  const StructuredBlock& g = grid.blocks[0];
+  ASSERT_EQ(g.extent(0), 97);
+  ASSERT_EQ(g.extent(1), 25);
+  int non_positive = 0;
+  for (int j = 0; j + 1 < g.extent(1); ++j) {
+    for (int i = 0; i + 1 < g.extent(0); ++i) {
+      const double* a = g.Point(i, j, 0);
+      const double* b = g.Point(i + 1, j, 0);
+      const double* c = g.Point(i + 1, j + 1, 0);
+      const double* d = g.Point(i, j + 1, 0);
+      non_positive += !((c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]) > 0);
+    }
+  }
+  EXPECT_EQ(non_positive, 0);
+
+  // Taken names and bad layers are refused, naming the field (usage errors exit 2).
+  const Result taken = Cli(absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"),
+                                        " --name=naca-og --layers=8 --points=65"));
+  EXPECT_EQ(taken.exit_code, 1);
+  EXPECT_THAT(taken.out, HasSubstr("ALREADY_EXISTS"));
+  const Result bad = Cli(
+      absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"), " --name=bad --first=-1e-5"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.out, HasSubstr("first_height = -1e-05"));
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/bad")));
+}
+
+TEST_F(EndToEndTest, PythonGeneratesOGrids) {
+  const std::string script = (dir_ / "generate.py").string();
+  ASSERT_TRUE(WriteFileAtomically(script, R"(
+import sys
+import numpy as np
+from splinegrid import Client, SplinegridError
+
+with Client(sys.argv[1]) as client:
+    r = client.generate("py-sc2", airfoil=sys.argv[2], wall_points=129, layers=32,
+                        first_height=1e-4, distance=20)
+    g = client.evaluate(r.grid.name, level=0)[0].points[0]  # (nj, ni, 2)
+    a, b, c, d = g[:-1, :-1], g[:-1, 1:], g[1:, 1:], g[1:, :-1]
+    area = ((c[..., 0] - a[..., 0]) * (d[..., 1] - b[..., 1])
+            - (c[..., 1] - a[..., 1]) * (d[..., 0] - b[..., 0]))
+    print("generated", r.grid.name, g.shape, "negative", r.report.quality.negative_cells,
+          "positive", bool(area.min() > 0), "revision", r.fit.revision)
+    points = np.loadtxt(sys.argv[2], skiprows=1)
+    t = client.generate("py-points", points=points, method="offsets", wall_points=65,
+                        layers=16, first_height=1e-3, distance=10)
+    print("points", t.report.extents.i, t.report.extents.j, t.report.profile.num_points)
+    try:
+        client.generate("py-bad", points=points, first_height=-1.0)
+    except SplinegridError as error:
+        print("refused", error.code, "first_height" in error.message)
+    print("grids", " ".join(sorted(grid.name for grid in client.list())))
+)")
+                  .ok());
+  const Result python = RunCommand(
+      absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", script,
+                   " 127.0.0.1:", port_, " ", SharedData("airfoils/sc20714.dat")));
+  ASSERT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out,
+              HasSubstr("generated grids/py-sc2 (33, 129, 2) negative 0 positive True revision 1"));
+  EXPECT_THAT(python.out, HasSubstr("points 65 17 "));
+  EXPECT_THAT(python.out, HasSubstr("refused INVALID_ARGUMENT True"));
+  EXPECT_THAT(python.out, HasSubstr("grids grids/py-points grids/py-sc2\n"));
+}
+
 TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
   const std::string png = (dir_ / "curvature.png").string();
   const Result python = RunCommand(
