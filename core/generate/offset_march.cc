@@ -126,7 +126,7 @@ double GrowthRatio(double first, double distance, int layers) {
   return 0.5 * (lo + hi);
 }
 
-absl::Status OffsetOptions::Validate() const {
+absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
   if (layers < 1 || layers > 100000) {
     return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is outside [1, 100000]"));
   }
@@ -143,6 +143,11 @@ absl::Status OffsetOptions::Validate() const {
         "distance = ", distance, " is below layers x first_height = ", layers * first_height,
         "; the layers cannot shrink"));
   }
+  return absl::OkStatus();
+}
+
+absl::Status OffsetOptions::Validate() const {
+  SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
   if (normal_smoothing < 0 || !(fairing >= 0.0) || !std::isfinite(fairing) ||
       !(uniformity >= 0.0 && uniformity <= 1.0) ||
       !(min_segment_ratio > 0.0 && min_segment_ratio < 1.0) || max_retries < 0 ||

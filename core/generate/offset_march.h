@@ -70,6 +70,10 @@ struct OffsetGrid {
 // message names the layer); CANCELLED.
 absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOptions& options);
 
+// OK for a stack of 1 .. 100000 layers growing from first_height to add up to distance (both
+// positive, finite, distance >= layers * first_height); INVALID_ARGUMENT naming the field.
+absl::Status ValidateLayerStack(int layers, double first_height, double distance);
+
 // r with first (r^layers - 1) / (r - 1) = distance (1 when distance = layers * first).
 double GrowthRatio(double first, double distance, int layers);
 

@@ -102,22 +102,13 @@ absl::Status ProfileGridOptions::Validate() const {
   if (wall_points < 9) {
     return absl::InvalidArgumentError(absl::StrCat("wall_points = ", wall_points, " is below 9"));
   }
-  if (layers < 1) {
-    return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is below 1"));
-  }
+  SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
   if (static_cast<int64_t>(wall_points) * (layers + 1) > kMaxProfileGridPoints) {
     return absl::InvalidArgumentError(absl::StrCat(
         "wall_points * (layers + 1) = ", static_cast<int64_t>(wall_points) * (layers + 1),
         " points exceed the limit of ", kMaxProfileGridPoints));
   }
-  SG_RETURN_IF_ERROR(CheckFinitePositive(first_height, "first_height"));
-  SG_RETURN_IF_ERROR(CheckFinitePositive(distance, "distance"));
   SG_RETURN_IF_ERROR(CheckFinitePositive(fit_tolerance, "fit_tolerance"));
-  if (distance < layers * first_height) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "distance = ", distance, " is below layers * first_height = ", layers * first_height,
-        ": the layers cannot grow outward"));
-  }
   return absl::OkStatus();
 }
 

@@ -290,22 +290,7 @@ absl::StatusOr<TensorSpline> AddSplines(const TensorSpline& a, const TensorSplin
 }  // namespace
 
 absl::Status SurfaceOffsetOptions::Validate() const {
-  if (layers < 1 || layers > 100000) {
-    return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is outside [1, 100000]"));
-  }
-  if (!(first_height > 0.0) || !std::isfinite(first_height)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("first_height = ", first_height, " is not a positive finite number"));
-  }
-  if (!(distance > 0.0) || !std::isfinite(distance)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("distance = ", distance, " is not a positive finite number"));
-  }
-  if (distance < first_height * layers * (1.0 - 1e-12)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "distance = ", distance, " is below layers x first_height = ", layers * first_height,
-        "; the layers cannot shrink"));
-  }
+  SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
   if (side != 1 && side != -1) {
     return absl::InvalidArgumentError(absl::StrCat("side = ", side, " is neither +1 nor -1"));
   }

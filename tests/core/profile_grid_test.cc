@@ -167,7 +167,7 @@ TEST(ProfileGridTest, BadInputNamesTheField) {
   o.layers = 100;
   o.first_height = 0.1;
   o.distance = 5.0;
-  EXPECT_THAT(error(naca, o).message(), HasSubstr("below layers * first_height"));
+  EXPECT_THAT(error(naca, o).message(), HasSubstr("below layers x first_height"));
   o = ProfileGridOptions();
   o.wall_points = 4;
   EXPECT_THAT(error(naca, o).message(), HasSubstr("wall_points = 4"));
