@@ -109,44 +109,28 @@ absl::StatusOr<v1::Grid> Client::ImportPoints(const MultiBlockGrid& source,
 }
 
 absl::StatusOr<v1::FitGridResponse> Client::Fit(const std::string& name, const v1::FitSpec& spec) {
-  auto context = NewContext();
   v1::FitGridRequest request;
   request.set_name(GridName(name));
   *request.mutable_spec() = spec;
-  v1::FitGridResponse response;
-  const grpc::Status status = stub_->FitGrid(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::FitGrid, request);
 }
 
 absl::StatusOr<v1::FitGridResponse> Client::Fair(const std::string& name, int64_t revision,
                                                  const v1::Fairing* fairing) {
-  auto context = NewContext();
   v1::FairGridRequest request;
   request.set_name(GridName(name));
   request.set_revision(revision);
   if (fairing != nullptr) *request.mutable_fairing() = *fairing;
-  v1::FitGridResponse response;
-  const grpc::Status status = stub_->FairGrid(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::FairGrid, request);
 }
 
 absl::StatusOr<v1::DeformGridResponse> Client::Deform(v1::DeformGridRequest request) {
-  auto context = NewContext();
   request.set_name(GridName(request.name()));
-  v1::DeformGridResponse response;
-  const grpc::Status status = stub_->DeformGrid(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::DeformGrid, request);
 }
 
 absl::StatusOr<v1::GenerateGridResponse> Client::Generate(const v1::GenerateGridRequest& request) {
-  auto context = NewContext();
-  v1::GenerateGridResponse response;
-  const grpc::Status status = stub_->GenerateGrid(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::GenerateGrid, request);
 }
 
 void WatchCancel::Cancel() {
@@ -204,39 +188,27 @@ absl::StatusOr<v1::GetWallCurvatureResponse> Client::WallCurvature(const std::st
                                                                    int64_t revision,
                                                                    int refinement_level,
                                                                    const std::vector<int>& blocks) {
-  auto context = NewContext();
   v1::GetWallCurvatureRequest request;
   request.set_name(GridName(name));
   request.set_revision(revision);
   request.set_refinement_level(refinement_level);
   for (int b : blocks) request.add_blocks(b);
-  v1::GetWallCurvatureResponse response;
-  const grpc::Status status = stub_->GetWallCurvature(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::GetWallCurvature, request);
 }
 
 absl::StatusOr<v1::Grid> Client::Get(const std::string& name, int64_t revision, v1::GridView view,
                                      const std::vector<int>& blocks) {
-  auto context = NewContext();
   v1::GetGridRequest request;
   request.set_name(GridName(name));
   request.set_revision(revision);
   request.set_view(view);
   for (int b : blocks) request.add_blocks(b);
-  v1::Grid grid;
-  const grpc::Status status = stub_->GetGrid(context.get(), request, &grid);
-  if (!status.ok()) return FromGrpc(status);
-  return grid;
+  return Unary(&v1::SplineGrid::Stub::GetGrid, request);
 }
 
 absl::StatusOr<v1::Grid> Client::Get(v1::GetGridRequest request) {
-  auto context = NewContext();
   request.set_name(GridName(request.name()));
-  v1::Grid grid;
-  const grpc::Status status = stub_->GetGrid(context.get(), request, &grid);
-  if (!status.ok()) return FromGrpc(status);
-  return grid;
+  return Unary(&v1::SplineGrid::Stub::GetGrid, request);
 }
 
 absl::StatusOr<std::vector<v1::Grid>> Client::List() {
@@ -244,22 +216,18 @@ absl::StatusOr<std::vector<v1::Grid>> Client::List() {
   v1::ListGridsRequest request;
   request.set_page_size(500);
   for (;;) {
-    auto context = NewContext();
-    v1::ListGridsResponse response;
-    const grpc::Status status = stub_->ListGrids(context.get(), request, &response);
-    if (!status.ok()) return FromGrpc(status);
-    for (v1::Grid& grid : *response.mutable_grids()) grids.push_back(std::move(grid));
-    if (response.next_page_token().empty()) return grids;
-    request.set_page_token(response.next_page_token());
+    absl::StatusOr<v1::ListGridsResponse> page = Unary(&v1::SplineGrid::Stub::ListGrids, request);
+    if (!page.ok()) return page.status();
+    for (v1::Grid& grid : *page->mutable_grids()) grids.push_back(std::move(grid));
+    if (page->next_page_token().empty()) return grids;
+    request.set_page_token(page->next_page_token());
   }
 }
 
 absl::Status Client::Delete(const std::string& name) {
-  auto context = NewContext();
   v1::DeleteGridRequest request;
   request.set_name(GridName(name));
-  google::protobuf::Empty empty;
-  return FromGrpc(stub_->DeleteGrid(context.get(), request, &empty));
+  return Unary(&v1::SplineGrid::Stub::DeleteGrid, request).status();
 }
 
 absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
@@ -373,11 +341,7 @@ absl::Status Client::Watch(const std::string& name, int64_t after_revision,
 absl::StatusOr<v1::EvaluatePointsResponse> Client::EvaluatePoints(
     v1::EvaluatePointsRequest request) {
   request.set_name(GridName(request.name()));
-  auto context = NewContext();
-  v1::EvaluatePointsResponse response;
-  const grpc::Status status = stub_->EvaluatePoints(context.get(), request, &response);
-  if (!status.ok()) return FromGrpc(status);
-  return response;
+  return Unary(&v1::SplineGrid::Stub::EvaluatePoints, request);
 }
 
 absl::StatusOr<std::string> Client::Health(const std::string& service) {

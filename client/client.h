@@ -99,6 +99,9 @@ class RevisionStream {
   std::optional<absl::Status> status_;
 };
 
+// grpc::Status -> absl::Status.
+absl::Status FromGrpc(const grpc::Status& status);
+
 class Client {
  public:
   Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
@@ -161,13 +164,23 @@ class Client {
   // A context whose deadline is options_.timeout from now.
   std::unique_ptr<grpc::ClientContext> NewContext() const;
 
+  // One unary call of `method` with a fresh deadline: the response, or the call's status.
+  template <typename Request, typename Response>
+  absl::StatusOr<Response> Unary(grpc::Status (v1::SplineGrid::Stub::*method)(grpc::ClientContext*,
+                                                                              const Request&,
+                                                                              Response*),
+                                 const Request& request) const {
+    auto context = NewContext();
+    Response response;
+    const grpc::Status status = (stub_.get()->*method)(context.get(), request, &response);
+    if (!status.ok()) return FromGrpc(status);
+    return response;
+  }
+
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::SplineGrid::Stub> stub_;
   ClientOptions options_;
 };
-
-// grpc::Status -> absl::Status.
-absl::Status FromGrpc(const grpc::Status& status);
 
 }  // namespace splinegrid::client
 

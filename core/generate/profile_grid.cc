@@ -36,11 +36,11 @@ double SegmentDistance(const Point2& p, const Point2& a, const Point2& b) {
 
 // Whether the segments [a, b] and [c, d] cross (each one's ends strictly on either side of the
 // other's line): touching ends of neighbouring segments do not count.
-bool Cross(const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
-  const double d1 = splinegrid::Cross(Minus(b, a), Minus(c, a));
-  const double d2 = splinegrid::Cross(Minus(b, a), Minus(d, a));
-  const double d3 = splinegrid::Cross(Minus(d, c), Minus(a, c));
-  const double d4 = splinegrid::Cross(Minus(d, c), Minus(b, c));
+bool SegmentsCross(const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
+  const double d1 = Cross(Minus(b, a), Minus(c, a));
+  const double d2 = Cross(Minus(b, a), Minus(d, a));
+  const double d3 = Cross(Minus(d, c), Minus(a, c));
+  const double d4 = Cross(Minus(d, c), Minus(b, c));
   return ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) &&
          ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0));
 }
@@ -72,7 +72,8 @@ bool SelfIntersects(const StructuredBlock& g, int j) {
       for (int s = static_cast<int>(r) * kRun; s < s_end; ++s) {
         for (int t = std::max(static_cast<int>(q) * kRun, s + 2); t < t_end; ++t) {
           if (s == 0 && t == segments - 1) continue;  // neighbours across the seam
-          if (Cross(At(g, s, j), At(g, s + 1, j), At(g, t, j), At(g, t + 1, j))) return true;
+          if (SegmentsCross(At(g, s, j), At(g, s + 1, j), At(g, t, j), At(g, t + 1, j)))
+            return true;
         }
       }
     }
@@ -214,9 +215,8 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
   start = std::chrono::steady_clock::now();
   const int ni = out.block.extent(0);
   const bool reversed = At(out.block, 1, 0) != out.wall.points[1];
-  std::vector<int> corners;
-  for (int c : out.wall.corners) corners.push_back(reversed ? ni - 1 - c : c);
-  out.quality = MeasureOGrid(out.block, corners);
+  for (int c : out.wall.corners) out.corners.push_back(reversed ? ni - 1 - c : c);
+  out.quality = MeasureOGrid(out.block, out.corners);
   out.measure_seconds = SecondsSince(start);
   return out;
 }

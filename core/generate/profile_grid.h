@@ -72,9 +72,10 @@ struct OGridQuality {
 OGridQuality MeasureOGrid(const StructuredBlock& grid, const std::vector<int>& corners);
 
 struct ProfileGrid {
-  StructuredBlock block;  // wall_points x (layers + 1), spatial_dim 2
-  AirfoilFit profile;     // the fitted outline
-  WallLoop wall;          // its distributed loop (block's j = 0, reversed: see offset_march.h)
+  StructuredBlock block;     // wall_points x (layers + 1), spatial_dim 2
+  AirfoilFit profile;        // the fitted outline
+  WallLoop wall;             // its distributed loop (block's j = 0, maybe reversed: offset_march.h)
+  std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;
   int retries = 0;  // kOffsets: extra normal smoothing rounds over all layers
   OGridQuality quality;

@@ -12,7 +12,8 @@ The generated stubs live in ``splinegrid.v1`` (built next to this package by the
 the conventions (names, array layout, deadlines, errors).
 """
 
-from splinegrid.client import (
+from splinegrid.client import (  # __all__: the public names, listed once in client.py
+    __all__,
     SERVICE,
     BoundaryPoints,
     Client,
@@ -24,16 +25,3 @@ from splinegrid.client import (
     WallCurvatureLine,
     grid_name,
 )
-
-__all__ = [
-    "SERVICE",
-    "BoundaryPoints",
-    "Client",
-    "EvaluatedBlock",
-    "EvaluatedGrid",
-    "EvaluatedPoints",
-    "RevisionWatch",
-    "SplinegridError",
-    "WallCurvatureLine",
-    "grid_name",
-]

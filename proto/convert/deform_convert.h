@@ -1,0 +1,28 @@
+// Conversions of DeformGrid: the request's boundary selection and propagation options, and its
+// control and boundary-point motions, to the kernel's (core/deform/deformer.h).
+#ifndef SPLINEGRID_PROTO_CONVERT_DEFORM_CONVERT_H_
+#define SPLINEGRID_PROTO_CONVERT_DEFORM_CONVERT_H_
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/deform/deformer.h"
+#include "splinegrid/v1/splinegrid_service.pb.h"
+
+namespace splinegrid {
+
+// The deformer's options (moved boundary, propagation, radii, smoothing), validated by
+// DeformOptions::Validate (INVALID_ARGUMENT naming the field).
+absl::StatusOr<DeformOptions> ParseDeformOptions(const v1::DeformGridRequest& request);
+
+// The moved controls' displacements of a ControlMotion, in `deformer`'s order (controls not
+// given stay); INVALID_ARGUMENT naming controls.blocks[e] for a bad block, count or control.
+absl::StatusOr<std::vector<double>> ParseControlDisplacements(const Deformer& deformer,
+                                                              const v1::ControlMotion& motion);
+
+// The ranges of a BoundaryPointsMotion (positions or displacements at a refinement level).
+absl::StatusOr<std::vector<BoundaryPoints>> ParseBoundaryPoints(const v1::BoundaryPointsMotion& m);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_PROTO_CONVERT_DEFORM_CONVERT_H_
