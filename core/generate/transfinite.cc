@@ -40,7 +40,7 @@ absl::Status CompletionOptions::Validate() const {
   return absl::OkStatus();
 }
 
-std::vector<Point2> OuterCircle(const WallLoop& wall, double distance) {
+std::vector<Point2> OuterCircle(const WallLoop& wall, double distance, OuterSpacing spacing) {
   const std::vector<Point2>& w = wall.points;
   const int n = static_cast<int>(w.size());
   Point2 c = {0.0, 0.0};
@@ -59,7 +59,9 @@ std::vector<Point2> OuterCircle(const WallLoop& wall, double distance) {
   }
   std::vector<Point2> out(n);
   for (int i = 0; i < n; ++i) {
-    const double angle = start + orientation * 2.0 * kPi * arc[i] / arc.back();
+    const double fraction =
+        spacing == OuterSpacing::kEven ? static_cast<double>(i) / (n - 1) : arc[i] / arc.back();
+    const double angle = start + orientation * 2.0 * kPi * fraction;
     out[i] = {c[0] + radius * std::cos(angle), c[1] + radius * std::sin(angle)};
   }
   out.back() = out.front();

@@ -40,9 +40,15 @@ struct CompletionOptions {
   absl::Status Validate() const;
 };
 
+// How the outer circle's points are spaced: at the angles of the wall points' arc length (the
+// wall's clustering carried out), or evenly (for elliptic smoothing, elliptic.h: the clustering
+// at a trailing edge would leave far-field cells a thousandth as wide as they are long).
+enum class OuterSpacing { kFollowWall, kEven };
+
 // The circle of the file comment with as many points as `wall` (first repeated as last),
 // running the same way round.
-std::vector<std::array<double, 2>> OuterCircle(const WallLoop& wall, double distance);
+std::vector<std::array<double, 2>> OuterCircle(const WallLoop& wall, double distance,
+                                               OuterSpacing spacing = OuterSpacing::kFollowWall);
 
 // The O-grid between `wall` and `outer` (same point count, both closed, outer enclosing wall):
 // points x (layers + 1), spatial_dim 2, with i running as in offset_march.h (clockwise, cell

@@ -1,0 +1,397 @@
+#include "core/generate/elliptic.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/bspline/evaluation.h"
+#include "core/fit/tensor_fit.h"
+#include "core/generate/offset_march.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid {
+namespace {
+
+// |phi|, |psi| at most this (neighbour weights e^3 = 20 apart); reached only at a few points by
+// the seam, where the algebraic grid's lines fan out from a trailing-edge corner.
+constexpr double kMaxControl = 3.0;
+
+// B(z) = z / (e^z - 1), B(0) = 1: the weights of the exponentially fitted (Allen-Southwell,
+// Il'in) difference of x'' + c x': B(c) x_{i-1} + B(-c) x_{i+1} - (B(c) + B(-c)) x_i, exact
+// for constant c, positive for every c.
+double Bernoulli(double z) {
+  if (std::abs(z) < 1e-4) return 1.0 - 0.5 * z + z * z / 12.0;
+  return z / std::expm1(z);
+}
+
+struct Vec {
+  double x, y;
+};
+
+Vec At(const StructuredBlock& g, int i, int j) {
+  const double* p = g.Point(i, j, 0);
+  return {p[0], p[1]};
+}
+
+absl::Status CheckOGrid(const StructuredBlock& grid) {
+  const int ni = grid.extent(0), nj = grid.extent(1);
+  if (grid.spatial_dim() != 2 || grid.extent(2) != 1 || ni < 5 || nj < 3) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "elliptic smoothing needs a planar O-grid of at least 5 x 3 points, not ", ni, " x ", nj,
+        " x ", grid.extent(2), " with ", grid.spatial_dim(), " coordinates"));
+  }
+  for (int j = 0; j < nj; ++j) {
+    const double* a = grid.Point(0, j, 0);
+    const double* b = grid.Point(ni - 1, j, 0);
+    if (a[0] != b[0] || a[1] != b[1]) {
+      return absl::InvalidArgumentError(absl::StrCat("the grid is not periodic in i: point (0, ", j,
+                                                     ") differs from (", ni - 1, ", ", j, ")"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// A tridiagonal system lower[r] x[r-1] + diag[r] x[r] + upper[r] x[r+1] = b[r] with two
+// right-hand sides (x and y), solved in place into bx, by.
+struct LineSystem {
+  std::vector<double> lower, diag, upper, bx, by, scratch, zx, zy;
+
+  void Resize(int n) {
+    for (auto* v : {&lower, &diag, &upper, &bx, &by, &scratch, &zx, &zy}) v->resize(n);
+  }
+
+  // Thomas algorithm on rows [0, n) (no pivoting: the matrices here are diagonally dominant,
+  // the exponentially fitted weights being positive), for the right-hand sides in `x` and `y`.
+  void Thomas(int n, double* x, double* y) {
+    for (int r = 0; r < n; ++r) {
+      const double m = diag[r] - (r > 0 ? lower[r] * scratch[r - 1] : 0.0);
+      scratch[r] = upper[r] / m;
+      x[r] = (x[r] - (r > 0 ? lower[r] * x[r - 1] : 0.0)) / m;
+      if (y != nullptr) y[r] = (y[r] - (r > 0 ? lower[r] * y[r - 1] : 0.0)) / m;
+    }
+    for (int r = n - 2; r >= 0; --r) {
+      x[r] -= scratch[r] * x[r + 1];
+      if (y != nullptr) y[r] -= scratch[r] * y[r + 1];
+    }
+  }
+
+  void Solve() { Thomas(static_cast<int>(diag.size()), bx.data(), by.data()); }
+
+  // Periodic: lower[0] couples row 0 to row n-1 and upper[n-1] row n-1 to row 0. Sherman-
+  // Morrison: A = T + u v^T with u = (g, 0, .., 0, c), v = (1, 0, .., 0, a / g), g = -diag[0],
+  // c = upper[n-1], a = lower[0]; x = T^-1 b - (v . T^-1 b) / (1 + v . T^-1 u) T^-1 u.
+  void SolveCyclic() {
+    const int n = static_cast<int>(diag.size());
+    const double a = lower[0], c = upper[n - 1], gg = -diag[0];
+    const double d0 = diag[0], dn = diag[n - 1];
+    diag[0] -= gg;
+    diag[n - 1] -= a * c / gg;
+    std::fill(zx.begin(), zx.end(), 0.0);
+    zx[0] = gg;
+    zx[n - 1] = c;
+    Thomas(n, bx.data(), by.data());
+    Thomas(n, zx.data(), nullptr);
+    const double vz = zx[0] + a / gg * zx[n - 1];
+    const double fx = (bx[0] + a / gg * bx[n - 1]) / (1.0 + vz);
+    const double fy = (by[0] + a / gg * by[n - 1]) / (1.0 + vz);
+    for (int r = 0; r < n; ++r) {
+      bx[r] -= fx * zx[r];
+      by[r] -= fy * zx[r];
+    }
+    diag[0] = d0;
+    diag[n - 1] = dn;
+  }
+};
+
+// Every second wall and outer point.
+WallLoop EverySecond(const WallLoop& wall) {
+  WallLoop out;
+  for (size_t i = 0; i < wall.points.size(); i += 2) out.points.push_back(wall.points[i]);
+  for (int c : wall.corners) out.corners.push_back(c / 2);
+  return out;
+}
+
+}  // namespace
+
+ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
+  const int ni = grid.extent(0), nj = grid.extent(1);
+  inner = std::clamp(inner, 0, nj - 2);
+  ControlFunctions c;
+  c.phi.assign(grid.num_points(), 0.0);
+  c.psi.assign(grid.num_points(), 0.0);
+  // phi on the inner and outer loops: the fitted difference reproduces their distributions.
+  std::vector<double> inner_phi(ni), outer_phi(ni);
+  for (int side = 0; side < 2; ++side) {
+    const int j = side == 0 ? inner : nj - 1;
+    std::vector<double>& phi = side == 0 ? inner_phi : outer_phi;
+    for (int i = 0; i < ni; ++i) {
+      const int im = i == 0 ? ni - 2 : i - 1, ip = i == ni - 1 ? 1 : i + 1;
+      const Vec a = At(grid, im, j), b = At(grid, i, j), d = At(grid, ip, j);
+      const double west = std::hypot(b.x - a.x, b.y - a.y);
+      const double east = std::hypot(d.x - b.x, d.y - b.y);
+      phi[i] = west > 0.0 && east > 0.0
+                   ? std::clamp(std::log(west / east), -kMaxControl, kMaxControl)
+                   : 0.0;
+    }
+  }
+  for (int j = 0; j < nj; ++j) {
+    const double t = std::max(0.0, static_cast<double>(j - inner) / (nj - 1 - inner));
+    for (int i = 0; i < ni; ++i) {
+      const int64_t p = grid.Index(i, j, 0);
+      const double phi = (1.0 - t) * inner_phi[i] + t * outer_phi[i];
+      c.phi[p] = phi;
+      if (j == 0 || j == nj - 1) continue;
+      // psi: the discrete equation's component along the layer normal n vanishes on `grid`,
+      //   B(-psi) up + B(psi) down = -r0,  up = (x_n - x) . n > 0,  down = (x_s - x) . n < 0,
+      // r0 the rest of the equation along n over gamma. The left side increases monotonically
+      // from -inf to inf with psi: bisection.
+      const int im = i == 0 ? ni - 2 : i - 1, ip = i == ni - 1 ? 1 : i + 1;
+      const Vec b = At(grid, i, j);
+      const Vec e = At(grid, ip, j), w = At(grid, im, j), n = At(grid, i, j + 1),
+                s = At(grid, i, j - 1);
+      const Vec ne = At(grid, ip, j + 1), se = At(grid, ip, j - 1), nw = At(grid, im, j + 1),
+                sw = At(grid, im, j - 1);
+      const Vec xi = {0.5 * (e.x - w.x), 0.5 * (e.y - w.y)};
+      const Vec eta = {0.5 * (n.x - s.x), 0.5 * (n.y - s.y)};
+      const Vec cross = {0.25 * (ne.x - se.x - nw.x + sw.x), 0.25 * (ne.y - se.y - nw.y + sw.y)};
+      const double alpha = eta.x * eta.x + eta.y * eta.y;
+      const double beta = xi.x * eta.x + xi.y * eta.y;
+      const double gamma = xi.x * xi.x + xi.y * xi.y;
+      if (!(gamma > 0.0)) continue;
+      const double ae = Bernoulli(-phi), aw = Bernoulli(phi);
+      const Vec rest = {alpha * (ae * (e.x - b.x) + aw * (w.x - b.x)) - 2.0 * beta * cross.x,
+                        alpha * (ae * (e.y - b.y) + aw * (w.y - b.y)) - 2.0 * beta * cross.y};
+      const double length = std::sqrt(gamma);
+      Vec normal = {-xi.y / length, xi.x / length};
+      if (normal.x * eta.x + normal.y * eta.y < 0.0) normal = {-normal.x, -normal.y};
+      const double r0 = (rest.x * normal.x + rest.y * normal.y) / gamma;
+      const double up = (n.x - b.x) * normal.x + (n.y - b.y) * normal.y;
+      const double down = (s.x - b.x) * normal.x + (s.y - b.y) * normal.y;
+      if (!(up > 0.0) || !(down < 0.0)) continue;
+      double lo = -kMaxControl, hi = kMaxControl;
+      for (int k = 0; k < 50; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (Bernoulli(-mid) * up + Bernoulli(mid) * down + r0 < 0.0 ? lo : hi) = mid;
+      }
+      c.psi[p] = 0.5 * (lo + hi);
+    }
+  }
+  return c;
+}
+
+absl::Status EllipticOptions::Validate() const {
+  if (max_sweeps < 0) {
+    return absl::InvalidArgumentError(absl::StrCat("max_sweeps = ", max_sweeps, " is negative"));
+  }
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("tolerance = ", tolerance, " is not a positive finite number"));
+  }
+  if (!(hold_distance >= 0.0) || !std::isfinite(hold_distance)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("hold_distance = ", hold_distance, " is not a finite number >= 0"));
+  }
+  if (!(relaxation > 0.0 && relaxation < 2.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("relaxation = ", relaxation, " is outside (0, 2)"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
+                                              const ControlFunctions& control, int held_layers,
+                                              const EllipticOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(CheckOGrid(initial));
+  if (static_cast<int64_t>(control.phi.size()) != initial.num_points() ||
+      control.psi.size() != control.phi.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("control functions for ", control.phi.size(),
+                                                   " points; the grid has ", initial.num_points()));
+  }
+  const int ni = initial.extent(0), nj = initial.extent(1);
+  EllipticResult result;
+  result.grid = initial;
+  StructuredBlock& g = result.grid;
+  const int first = std::clamp(held_layers, 1, nj - 1);
+  const double omega = options.relaxation;
+  // Alternating line relaxation: every line of constant i solved at once (tridiagonal in j),
+  // then every line of constant j (cyclic tridiagonal in i), each with its neighbouring lines as
+  // they are, and relaxed by omega. Near the wall the flat cells couple strongly in j, far out
+  // the stretched ones in i; point relaxation would carry either a point per sweep.
+  const int rows = nj - 1 - first;  // unknowns j = first .. nj - 2
+  const int cols = ni - 1;          // unknowns i = 0 .. ni - 2 (periodic)
+  LineSystem line;
+  // The fitted differences' weights B(-phi), B(phi), B(-psi), B(psi) at every point.
+  std::vector<double> weights(4 * g.num_points());
+  for (int64_t p = 0; p < g.num_points(); ++p) {
+    weights[4 * p] = Bernoulli(-control.phi[p]);
+    weights[4 * p + 1] = Bernoulli(control.phi[p]);
+    weights[4 * p + 2] = Bernoulli(-control.psi[p]);
+    weights[4 * p + 3] = Bernoulli(control.psi[p]);
+  }
+  // The discrete equation at (i, j), split into the neighbours along the line and the rest.
+  const auto stencil = [&](int i, int j, bool along_j, double* lower, double* diag, double* upper,
+                           Vec* rest) {
+    const int im = i == 0 ? ni - 2 : i - 1, ip = i + 1;
+    const Vec e = At(g, ip, j), w = At(g, im, j), n = At(g, i, j + 1), s = At(g, i, j - 1);
+    const Vec ne = At(g, ip, j + 1), se = At(g, ip, j - 1), nw = At(g, im, j + 1),
+              sw = At(g, im, j - 1);
+    const Vec xi = {0.5 * (e.x - w.x), 0.5 * (e.y - w.y)};
+    const Vec eta = {0.5 * (n.x - s.x), 0.5 * (n.y - s.y)};
+    const Vec cross = {0.25 * (ne.x - se.x - nw.x + sw.x), 0.25 * (ne.y - se.y - nw.y + sw.y)};
+    const double alpha = eta.x * eta.x + eta.y * eta.y;
+    const double beta = xi.x * eta.x + xi.y * eta.y;
+    const double gamma = xi.x * xi.x + xi.y * xi.y;
+    const int64_t p = g.Index(i, j, 0);
+    // 2 (alpha + gamma) x = alpha ((1 + phi / 2) x_e + (1 - phi / 2) x_w)
+    //                     + gamma ((1 + psi / 2) x_n + (1 - psi / 2) x_s) - 2 beta x_xieta.
+    const double we = alpha * weights[4 * p], ww = alpha * weights[4 * p + 1];
+    const double wn = gamma * weights[4 * p + 2], ws = gamma * weights[4 * p + 3];
+    *diag = we + ww + wn + ws;
+    rest->x = -2.0 * beta * cross.x;
+    rest->y = -2.0 * beta * cross.y;
+    if (along_j) {
+      *lower = -ws;
+      *upper = -wn;
+      rest->x += we * e.x + ww * w.x;
+      rest->y += we * e.y + ww * w.y;
+    } else {
+      *lower = -ww;
+      *upper = -we;
+      rest->x += wn * n.x + ws * s.x;
+      rest->y += wn * n.y + ws * s.y;
+    }
+  };
+  double largest = 0.0;
+  // Moves point (i, j) by omega towards (x, y), tracking the largest move relative to the
+  // point's smallest spacing to its neighbours.
+  const auto relax = [&](int i, int j, double x, double y) {
+    double* p = g.Point(i, j, 0);
+    const double dx = omega * (x - p[0]), dy = omega * (y - p[1]);
+    if (!std::isfinite(dx) || !std::isfinite(dy)) {
+      largest = std::numeric_limits<double>::infinity();
+      return;
+    }
+    const Vec b = {p[0], p[1]}, e = At(g, i + 1, j), n = At(g, i, j + 1), s = At(g, i, j - 1);
+    const double h = std::min({std::hypot(e.x - b.x, e.y - b.y), std::hypot(n.x - b.x, n.y - b.y),
+                               std::hypot(s.x - b.x, s.y - b.y)});
+    p[0] += dx;
+    p[1] += dy;
+    if (h > 0.0) largest = std::max(largest, std::hypot(dx, dy) / h);
+    if (i == 0) std::copy(p, p + 2, g.Point(ni - 1, j, 0));
+  };
+  for (result.sweeps = 0; result.sweeps < options.max_sweeps && rows > 0;) {
+    SG_RETURN_IF_ERROR(PollCancel(options.cancel));
+    ++result.sweeps;
+    largest = 0.0;
+    line.Resize(rows);
+    for (int i = 0; i < cols; ++i) {
+      for (int r = 0; r < rows; ++r) {
+        Vec rest;
+        stencil(i, first + r, true, &line.lower[r], &line.diag[r], &line.upper[r], &rest);
+        line.bx[r] = rest.x;
+        line.by[r] = rest.y;
+      }
+      // The held layer below and the outer loop above are fixed: move them to the right.
+      line.bx[0] -= line.lower[0] * At(g, i, first - 1).x;
+      line.by[0] -= line.lower[0] * At(g, i, first - 1).y;
+      line.bx[rows - 1] -= line.upper[rows - 1] * At(g, i, nj - 1).x;
+      line.by[rows - 1] -= line.upper[rows - 1] * At(g, i, nj - 1).y;
+      line.Solve();
+      for (int r = 0; r < rows; ++r) relax(i, first + r, line.bx[r], line.by[r]);
+    }
+    line.Resize(cols);
+    for (int j = first; j + 1 < nj; ++j) {
+      for (int i = 0; i < cols; ++i) {
+        Vec rest;
+        stencil(i, j, false, &line.lower[i], &line.diag[i], &line.upper[i], &rest);
+        line.bx[i] = rest.x;
+        line.by[i] = rest.y;
+      }
+      line.SolveCyclic();
+      for (int i = 0; i < cols; ++i) relax(i, j, line.bx[i], line.by[i]);
+    }
+    if (!std::isfinite(largest)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("elliptic smoothing diverged in sweep ", result.sweeps));
+    }
+    if (largest < options.tolerance) {
+      result.converged = true;
+      break;
+    }
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
+                                                const CompletionOptions& completion,
+                                                const EllipticOptions& options, bool compare) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  const int n = static_cast<int>(wall.points.size());
+  if (n % 2 == 0 || completion.layers % 2 != 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "coarse to fine needs an odd number of wall points (the first repeated) and an even "
+        "number of layers, not wall_points = ",
+        n, " and layers = ", completion.layers));
+  }
+  CoarseToFine out;
+  const std::vector<std::array<double, 2>> outer =
+      OuterCircle(wall, completion.distance, OuterSpacing::kEven);
+  SG_ASSIGN_OR_RETURN(const StructuredBlock fine_tfi, TransfiniteGrid(wall, outer, completion));
+  // Coarse level: every second point and layer (the layer heights d_{2j}: first height
+  // h0 (1 + r) and growth r^2 add up to the same distance), so the coarse transfinite grid is
+  // the fine one at every second point and layer.
+  const double r = GrowthRatio(completion.first_height, completion.distance, completion.layers);
+  CompletionOptions coarse_completion = completion;
+  coarse_completion.layers = completion.layers / 2;
+  coarse_completion.first_height = completion.first_height * (1.0 + r);
+  std::vector<std::array<double, 2>> coarse_outer;
+  for (size_t i = 0; i < outer.size(); i += 2) coarse_outer.push_back(outer[i]);
+  SG_ASSIGN_OR_RETURN(const StructuredBlock coarse_tfi,
+                      TransfiniteGrid(EverySecond(wall), coarse_outer, coarse_completion));
+  // Held: the layers within hold_distance, rounded so that the last held fine layer is a coarse
+  // one (fine held = 2 coarse held - 1).
+  int within = 1;  // layers 0 .. within - 1 are within hold_distance
+  double height = completion.first_height;
+  while (within < completion.layers && height <= options.hold_distance) {
+    height += completion.first_height * std::pow(r, within);
+    ++within;
+  }
+  const int coarse_held = std::clamp((within + 1) / 2, 1, coarse_completion.layers - 1);
+  out.held_layers = 2 * coarse_held - 1;
+  const ControlFunctions coarse_control = TrackingControls(coarse_tfi, coarse_held - 1);
+  const ControlFunctions fine_control = TrackingControls(fine_tfi, out.held_layers - 1);
+  SG_ASSIGN_OR_RETURN(out.coarse, SmoothElliptic(coarse_tfi, coarse_control, coarse_held, options));
+  // The coarse solution's spline at level 1 of its point distribution, with the fine level's
+  // held layers and outer loop put back.
+  FitOptions interpolation;
+  interpolation.cancel = options.cancel;
+  SG_ASSIGN_OR_RETURN(const FittedBlock spline, FitBlock(out.coarse.grid, interpolation));
+  std::array<std::vector<double>, 3> params;
+  for (int d = 0; d < 3; ++d) {
+    params[d] =
+        spline.distribution.Refined(d, 0, spline.distribution.num_points(d) - 1, d < 2 ? 1 : 0);
+  }
+  StructuredBlock guess = EvaluateGrid(spline.spline, params);
+  const int ni = guess.extent(0), nj = guess.extent(1);
+  for (int j = 0; j < nj; ++j) {
+    const bool held = j < out.held_layers || j == nj - 1;
+    for (int i = 0; i < ni; ++i) {
+      const double* from = held ? fine_tfi.Point(i, j, 0) : guess.Point(i == ni - 1 ? 0 : i, j, 0);
+      std::copy(from, from + 2, guess.Point(i, j, 0));  // periodic: the last line is the first
+    }
+  }
+  SG_ASSIGN_OR_RETURN(out.fine, SmoothElliptic(guess, fine_control, out.held_layers, options));
+  if (compare) {
+    SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,
+                        SmoothElliptic(fine_tfi, fine_control, out.held_layers, options));
+  }
+  return out;
+}
+
+}  // namespace splinegrid

@@ -1,0 +1,106 @@
+// Elliptic smoothing of planar O-grids, solved coarse to fine with a B-spline of the coarse
+// grid as the initial guess of the fine one (the QUADFLOW use of splines for grid generation).
+//
+// The grid x(xi, eta) (xi = i along the loops, periodic; eta = j from the wall) solves the
+// Thompson-Thames-Mastin equations
+//   alpha (x_xixi + phi x_xi) - 2 beta x_xieta + gamma (x_etaeta + psi x_eta) = 0,
+//   alpha = |x_eta|^2,  beta = x_xi . x_eta,  gamma = |x_xi|^2
+// (J. F. Thompson, F. C. Thames, C. W. Mastin, J. Comput. Phys. 15, 1974), with control
+// functions in the form of P. D. Thomas and J. F. Middlecoff (AIAA J. 18(6), 1980), computed from
+// an algebraic grid (the transfinite grid of transfinite.h):
+//  - phi from the point distributions of the two loops that bound the smoothed region (the
+//    innermost free layer and the outer loop), blended linearly in eta, so the points slide
+//    along the layers from the one distribution towards the other;
+//  - psi at every point such that the algebraic grid satisfies the component of the discrete
+//    equations normal to its layer, so every layer keeps its distance from the wall and with it
+//    the boundary layer's growth. (With psi = 0, Winslow, the layers would spread evenly; with
+//    psi from the layer distribution alone, -(x_eta . x_etaeta) / |x_eta|^2, the layers'
+//    curvature pulls them in and a 1e-5 first layer shrinks a hundredfold.)
+// The layers within hold_distance of the wall are held as the algebraic grid has them
+// (orthogonalised there, with the requested heights), and so are the wall and the outer loop.
+//
+// Discretisation: central differences on the unit index grid, except that x_xixi + phi x_xi
+// (and likewise in eta) is exponentially fitted (D. N. de G. Allen and R. V. Southwell 1955,
+// A. M. Il'in 1969): B(phi) x_{i-1} + B(-phi) x_{i+1} - (B(phi) + B(-phi)) x_i with
+// B(z) = z / (e^z - 1). That is exact for geometric point distributions on every level, so the
+// coarse and fine levels solve the same problem, and its weights are positive for any phi (no
+// clipping of the controls). Phi from a loop is then ln(|x_i - x_{i-1}| / |x_{i+1} - x_i|).
+// Solver: alternating line relaxation, every line of constant i solved at once (tridiagonal in
+// j: the flat cells near the wall couple strongly in j) then every line of constant j (cyclic
+// tridiagonal in i: the long far-field cells couple in i), each relaxed by omega, until no point
+// moves by more than `tolerance` times its smallest neighbouring spacing in a sweep.
+//
+// Coarse to fine: the coarse grid takes every second wall and outer point and layer; it is
+// smoothed from its own transfinite grid, interpolated by a B-spline surface (tensor_fit.h) and
+// evaluated at refinement level 1 of its point distribution, which gives as many points as the
+// fine grid; with the fine held layers and outer loop put back, that is the fine level's initial
+// guess.
+#ifndef SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
+#define SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
+
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/generate/transfinite.h"
+#include "core/grid/structured_grid.h"
+#include "core/util/cancellation.h"
+
+namespace splinegrid {
+
+// Per grid point (point order).
+struct ControlFunctions {
+  std::vector<double> phi, psi;
+};
+
+// The control functions of the file comment from the algebraic grid `grid` (ni x nj x 1,
+// spatial_dim 2, i periodic: the first line repeated as the last), phi blended from layer
+// `inner` (the innermost free layer's neighbour below) to the outer loop.
+ControlFunctions TrackingControls(const StructuredBlock& grid, int inner);
+
+struct EllipticOptions {
+  // Layers within this distance of the wall (in the wall's unit) are held; at least the wall.
+  double hold_distance = 0.01;
+  int max_sweeps = 20000;
+  // Converged when no point moves by more than this fraction of its smallest neighbouring
+  // spacing in a sweep.
+  double tolerance = 1e-3;
+  double relaxation = 1.3;  // omega, in (0, 2)
+  CancelCheck cancel;
+
+  absl::Status Validate() const;
+};
+
+struct EllipticResult {
+  StructuredBlock grid;
+  int sweeps = 0;
+  bool converged = false;
+  double seconds = 0.0;
+};
+
+// Smooths `initial` with `control` (same points), holding layers 0 .. held_layers - 1 and the
+// outer loop. Not converging within max_sweeps is reported (converged = false), not an error.
+// Errors: INVALID_ARGUMENT for bad options or a grid that is not a periodic planar O-grid of at
+// least 5 x 3 points; FAILED_PRECONDITION if the iteration diverges; CANCELLED.
+absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
+                                              const ControlFunctions& control, int held_layers,
+                                              const EllipticOptions& options);
+
+struct CoarseToFine {
+  EllipticResult coarse;  // the coarse level from its transfinite grid
+  EllipticResult fine;    // the fine level from the coarse grid's spline
+  // The fine level from its own transfinite grid (with `compare`): the sweeps saved.
+  EllipticResult fine_from_transfinite;
+  int held_layers = 1;  // of the fine level
+};
+
+// The transfinite O-grid between `wall` and an evenly spaced outer circle (completion options
+// as in transfinite.h) smoothed coarse to fine; with `compare`, also smoothed from its own
+// transfinite grid. Errors: INVALID_ARGUMENT unless the wall has an odd number of points (with
+// the first repeated) and completion.layers is even, and as TransfiniteGrid and SmoothElliptic.
+absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
+                                                const CompletionOptions& completion,
+                                                const EllipticOptions& options, bool compare);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
