@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
+#include "core/generate/elliptic.h"
 #include "core/generate/loop_geometry.h"
 #include "core/generate/offset_march.h"
 #include "core/generate/transfinite.h"
@@ -96,7 +97,15 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 std::string_view LayerMethodName(LayerMethod method) {
-  return method == LayerMethod::kOffsets ? "offsets" : "transfinite";
+  switch (method) {
+    case LayerMethod::kOffsets:
+      return "offsets";
+    case LayerMethod::kTransfinite:
+      return "transfinite";
+    case LayerMethod::kElliptic:
+      return "elliptic";
+  }
+  return "unknown";
 }
 
 absl::Status ProfileGridOptions::Validate() const {
@@ -110,6 +119,11 @@ absl::Status ProfileGridOptions::Validate() const {
         " points exceed the limit of ", kMaxProfileGridPoints));
   }
   SG_RETURN_IF_ERROR(CheckFinitePositive(fit_tolerance, "fit_tolerance"));
+  if (method == LayerMethod::kElliptic && (wall_points % 2 == 0 || layers % 2 != 0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the elliptic method solves on every second point and layer first: wall_points = ",
+        wall_points, " must be odd and layers = ", layers, " even"));
+  }
   return absl::OkStatus();
 }
 
@@ -205,8 +219,22 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
     completion.first_height = options.first_height;
     completion.distance = options.distance;
     completion.orthogonalize = options.orthogonalize;
-    SG_ASSIGN_OR_RETURN(
-        out.block, TransfiniteGrid(out.wall, OuterCircle(out.wall, options.distance), completion));
+    if (options.method == LayerMethod::kTransfinite) {
+      SG_ASSIGN_OR_RETURN(
+          out.block,
+          TransfiniteGrid(out.wall, OuterCircle(out.wall, options.distance), completion));
+    } else {
+      EllipticOptions elliptic;
+      elliptic.cancel = options.cancel;
+      SG_ASSIGN_OR_RETURN(CoarseToFine smoothed,
+                          SmoothCoarseToFine(out.wall, completion, elliptic, /*compare=*/false));
+      out.block = std::move(smoothed.fine.grid);
+      out.coarse_sweeps = smoothed.coarse.sweeps;
+      out.fine_sweeps = smoothed.fine.sweeps;
+      out.coarse_seconds = smoothed.coarse.seconds;
+      out.fine_seconds = smoothed.fine.seconds;
+      out.elliptic_converged = smoothed.fine.converged;
+    }
     out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
   }
   out.layer_seconds = SecondsSince(start);

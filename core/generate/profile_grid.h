@@ -8,6 +8,8 @@
 //        (offset_march.h), or
 //      - kTransfinite: interpolated between the wall and a circle `distance` out, the lines
 //        optionally bent to leave the wall orthogonally (transfinite.h);
+//      - kElliptic: the transfinite grid to an evenly spaced circle, smoothed by the elliptic
+//        equations coarse to fine above the boundary layer (elliptic.h);
 //   4. the result is measured (MeasureOGrid).
 // The grid is an O-grid, i along the loop (clockwise, the first line repeated as the last: the
 // seam leaves the trailing edge), j outward from the wall, every cell's signed area positive.
@@ -30,9 +32,10 @@ namespace splinegrid {
 enum class LayerMethod {
   kOffsets,      // curvature-controlled offset curves (default)
   kTransfinite,  // transfinite interpolation between the wall and an outer circle
+  kElliptic,     // transfinite, then elliptic smoothing coarse to fine
 };
 
-// "offsets" or "transfinite".
+// "offsets", "transfinite" or "elliptic".
 std::string_view LayerMethodName(LayerMethod method);
 
 // The most points a generated grid may have (2^24: 256 MiB of coordinates).
@@ -44,11 +47,11 @@ struct ProfileGridOptions {
   int layers = 128;             // cells across, >= 1 (the grid has layers + 1 lines)
   double first_height = 1e-5;   // of the first layer, in the profile's unit (chords)
   double distance = 50.0;       // of the outermost layer from the wall
-  bool orthogonalize = true;    // kTransfinite: lines leave the wall along its normals
+  bool orthogonalize = true;    // kTransfinite, kElliptic: lines leave the wall along its normals
   double fit_tolerance = 1e-4;  // of the profile spline to the coordinates (AirfoilFitOptions)
   CancelCheck cancel;
 
-  // INVALID_ARGUMENT naming the field and its value.
+  // INVALID_ARGUMENT naming the field and its value (kElliptic: wall_points odd, layers even).
   absl::Status Validate() const;
 };
 
@@ -78,6 +81,10 @@ struct ProfileGrid {
   std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;
   int retries = 0;  // kOffsets: extra normal smoothing rounds over all layers
+  // kElliptic: sweeps and seconds of the coarse and the fine level, whether the fine converged.
+  int coarse_sweeps = 0, fine_sweeps = 0;
+  double coarse_seconds = 0.0, fine_seconds = 0.0;
+  bool elliptic_converged = false;
   OGridQuality quality;
   // Seconds of each stage.
   double fit_seconds = 0.0, wall_seconds = 0.0, layer_seconds = 0.0, measure_seconds = 0.0;
