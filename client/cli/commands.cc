@@ -574,7 +574,8 @@ absl::Status Deform(const Args& args) {
 absl::Status Offset(const Args& args) {
   constexpr char kUsage[] =
       "usage: splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] "
-      "[--points 257] [--method offsets|transfinite] [--orthogonalize=false] [--profile_tol T] "
+      "[--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
+      "[--profile_tol T] "
       "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,x,xyz}]";
   if (args.size() != 1) return Usage(kUsage);
   const std::string& path = args[0];
@@ -591,9 +592,11 @@ absl::Status Offset(const Args& args) {
     request.set_method(v1::LAYER_METHOD_OFFSETS);
   } else if (method == "transfinite") {
     request.set_method(v1::LAYER_METHOD_TRANSFINITE);
+  } else if (method == "elliptic") {
+    request.set_method(v1::LAYER_METHOD_ELLIPTIC);
   } else if (!method.empty()) {
     return Usage(absl::StrCat("--method = '", absl::GetFlag(FLAGS_method),
-                              "': give offsets or transfinite"));
+                              "': give offsets, transfinite or elliptic"));
   }
   if (const auto v = absl::GetFlag(FLAGS_layers)) request.set_layers(*v);
   if (const auto v = absl::GetFlag(FLAGS_first)) request.set_first_height(*v);

@@ -42,7 +42,7 @@ constexpr char kUsage[] =
     "                  [--decay_radius D] [--rigid_radius R] [--smoothing N]\n"
     "      a fold is FAILED_PRECONDITION (exit 1), nothing stored\n"
     "  splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50]\n"
-    "                  [--points 257] [--method offsets|transfinite] [--orthogonalize=false]\n"
+    "                  [--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false]\n"
     "                  [--profile_tol 1e-4] [--tol T | --kinds ... | --ctl a,b,c]\n"
     "                  [-o OUT.{vts,x,xyz}]   an O-grid around an airfoil file (Selig or\n"
     "      Lednicer), stored and fitted (default: interpolated); -o writes it at level 0\n"

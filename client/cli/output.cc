@@ -160,7 +160,9 @@ std::string FormatGenerate(const v1::GenerateGridResponse& response) {
   const v1::GenerateGridRequest& p = r.parameters();
   const v1::ProfileFitReport& f = r.profile();
   const v1::OGridQuality& q = r.quality();
-  const std::string method = p.method() == v1::LAYER_METHOD_TRANSFINITE ? "transfinite" : "offsets";
+  const std::string method = p.method() == v1::LAYER_METHOD_TRANSFINITE ? "transfinite"
+                             : p.method() == v1::LAYER_METHOD_ELLIPTIC  ? "elliptic"
+                                                                        : "offsets";
   std::string out = absl::StrFormat(
       "%s: %s O-grid %s around %s, %.1f ms\n", response.grid().name(), method,
       FormatExtents(r.extents()),

@@ -18,6 +18,9 @@ absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGri
     case v1::LAYER_METHOD_TRANSFINITE:
       options.method = LayerMethod::kTransfinite;
       break;
+    case v1::LAYER_METHOD_ELLIPTIC:
+      options.method = LayerMethod::kElliptic;
+      break;
     default:
       return absl::InvalidArgumentError(
           absl::StrCat("method = ", static_cast<int>(request.method()), " is not a known value"));
@@ -33,8 +36,17 @@ absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGri
 }
 
 void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGridRequest* out) {
-  out->set_method(options.method == LayerMethod::kTransfinite ? v1::LAYER_METHOD_TRANSFINITE
-                                                              : v1::LAYER_METHOD_OFFSETS);
+  switch (options.method) {
+    case LayerMethod::kOffsets:
+      out->set_method(v1::LAYER_METHOD_OFFSETS);
+      break;
+    case LayerMethod::kTransfinite:
+      out->set_method(v1::LAYER_METHOD_TRANSFINITE);
+      break;
+    case LayerMethod::kElliptic:
+      out->set_method(v1::LAYER_METHOD_ELLIPTIC);
+      break;
+  }
   out->set_wall_points(options.wall_points);
   out->set_layers(options.layers);
   out->set_first_height(options.first_height);

@@ -99,6 +99,7 @@ _PROPAGATIONS = {
 _LAYER_METHODS = {
     "offsets": service_pb2.LAYER_METHOD_OFFSETS,
     "transfinite": service_pb2.LAYER_METHOD_TRANSFINITE,
+    "elliptic": service_pb2.LAYER_METHOD_ELLIPTIC,
 }
 MAX_CHECK_LEVEL = 4  # the server's highest fold-check level
 
@@ -447,7 +448,9 @@ class Client:
         (the wall points of that 2-D block's j = 0 edge, revision 0 = latest).
 
         Layers (None: the server's defaults, core/generate/profile_grid.h): ``method``
-        ``"offsets"`` (curvature-controlled offsets, default) or ``"transfinite"``,
+        ``"offsets"`` (curvature-controlled offsets, default), ``"transfinite"`` or
+        ``"elliptic"`` (transfinite, smoothed by the elliptic equations coarse to fine; odd
+        ``wall_points``, even ``layers``),
         ``wall_points`` (257; the first repeated as the last), ``layers`` (128 cells outward),
         ``first_height`` (1e-5, the profile's unit), ``distance`` (50, of the outer boundary
         from the wall), ``orthogonalize`` (transfinite: lines leave the wall normally; True),

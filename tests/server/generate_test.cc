@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "absl/strings/str_cat.h"
 #include "core/io/airfoil.h"
 #include "gmock/gmock.h"
 #include "tests/server/service_fixture.h"
@@ -54,15 +55,15 @@ class GenerateTest : public ServiceTest {
     return names;
   }
 
-  // Checks the stored grid `id`: one fitted 129 x 34 block whose level-0 cells all have a
-  // positive signed area, and whose boundary kinds are wall at j = 0, outer at j = max and
-  // interface on the seam i = 0 / i = max.
-  void ExpectValidOGrid(const std::string& id) {
+  // Checks the stored grid `id`: one fitted 129 x (layers + 1) block whose level-0 cells all
+  // have a positive signed area, and whose boundary kinds are wall at j = 0, outer at j = max
+  // and interface on the seam i = 0 / i = max.
+  void ExpectValidOGrid(const std::string& id, int layers = kLayers) {
     const v1::Grid grid = client_->Get(id).value();
     EXPECT_EQ(grid.latest_revision(), 1);
     ASSERT_EQ(grid.source().blocks_size(), 1);
     EXPECT_EQ(grid.source().blocks(0).i(), kWallPoints);
-    EXPECT_EQ(grid.source().blocks(0).j(), kLayers + 1);
+    EXPECT_EQ(grid.source().blocks(0).j(), layers + 1);
     EXPECT_EQ(grid.source().blocks(0).k(), 1);
     EXPECT_GE(grid.source().num_matches(), 1);  // the seam
     EXPECT_EQ(grid.revision().origin(), v1::REVISION_ORIGIN_FIT);
@@ -72,7 +73,7 @@ class GenerateTest : public ServiceTest {
     request.set_refinement_level(0);
     const StructuredBlock points = client_->Evaluate(request).value().blocks.at(0).points;
     ASSERT_EQ(points.extent(0), kWallPoints);
-    ASSERT_EQ(points.extent(1), kLayers + 1);
+    ASSERT_EQ(points.extent(1), layers + 1);
     int64_t non_positive = 0;
     for (int j = 0; j + 1 < points.extent(1); ++j) {
       for (int i = 0; i + 1 < points.extent(0); ++i) non_positive += !(CellArea(points, i, j) > 0);
@@ -81,7 +82,7 @@ class GenerateTest : public ServiceTest {
 
     const auto stored = server_->state().store.Get(id).value();
     const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
-    const int ni = kWallPoints, nj = kLayers + 1;
+    const int ni = kWallPoints, nj = layers + 1;
     const auto has = [&](int i, int j, BoundaryKind kind) {
       return (kinds[i + ni * j] & static_cast<uint8_t>(kind)) != 0;
     };
@@ -171,6 +172,24 @@ TEST_F(GenerateTest, TransfiniteFromPointsWithAServerPickedId) {
   EXPECT_EQ(r.report().profile().num_points(), airfoil.points.num_points());
   EXPECT_EQ(r.report().quality().negative_cells(), 0);
   ExpectValidOGrid(r.grid().name().substr(6));
+}
+
+TEST_F(GenerateTest, EllipticFromAnAirfoilFile) {
+  v1::GenerateGridRequest request = SmallRequest("rae-elliptic");
+  request.set_method(v1::LAYER_METHOD_ELLIPTIC);
+  request.set_layers(kLayers - 1);  // even: the coarse level takes every second layer
+  request.set_airfoil_file(AirfoilText("rae2822.dat"));
+  const v1::GenerateGridResponse r = client_->Generate(request).value();
+  EXPECT_EQ(r.report().parameters().method(), v1::LAYER_METHOD_ELLIPTIC);
+  EXPECT_EQ(r.report().quality().negative_cells(), 0);
+  EXPECT_NEAR(r.report().quality().first_height_min(), kFirstHeight,
+              kFirstLayerTolerance * kFirstHeight);
+  ExpectValidOGrid("rae-elliptic", kLayers - 1);
+  // Coarse to fine halves the points and layers: an even number of wall points is refused.
+  request.set_grid_id("rae-elliptic-even");
+  request.set_wall_points(kWallPoints + 1);
+  ExpectRefused(request, absl::StatusCode::kInvalidArgument,
+                absl::StrCat("wall_points = ", kWallPoints + 1, " must be odd"));
 }
 
 TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
