@@ -36,6 +36,34 @@ Vec At(const StructuredBlock& g, int i, int j) {
   return {p[0], p[1]};
 }
 
+// The nine-point neighbourhood of interior point (i, j) of a periodic O-grid (the last line
+// repeats the first) and the central differences and metric terms the equations use.
+struct Neighbourhood {
+  Vec centre, e, w, n, s;
+  Vec xi, eta, cross;         // x_xi, x_eta, x_xieta
+  double alpha, beta, gamma;  // |x_eta|^2, x_xi . x_eta, |x_xi|^2
+};
+
+Neighbourhood Around(const StructuredBlock& g, int i, int j) {
+  const int ni = g.extent(0);
+  const int im = i == 0 ? ni - 2 : i - 1, ip = i == ni - 1 ? 1 : i + 1;
+  Neighbourhood h;
+  h.centre = At(g, i, j);
+  h.e = At(g, ip, j);
+  h.w = At(g, im, j);
+  h.n = At(g, i, j + 1);
+  h.s = At(g, i, j - 1);
+  const Vec ne = At(g, ip, j + 1), se = At(g, ip, j - 1), nw = At(g, im, j + 1),
+            sw = At(g, im, j - 1);
+  h.xi = {0.5 * (h.e.x - h.w.x), 0.5 * (h.e.y - h.w.y)};
+  h.eta = {0.5 * (h.n.x - h.s.x), 0.5 * (h.n.y - h.s.y)};
+  h.cross = {0.25 * (ne.x - se.x - nw.x + sw.x), 0.25 * (ne.y - se.y - nw.y + sw.y)};
+  h.alpha = h.eta.x * h.eta.x + h.eta.y * h.eta.y;
+  h.beta = h.xi.x * h.eta.x + h.xi.y * h.eta.y;
+  h.gamma = h.xi.x * h.xi.x + h.xi.y * h.xi.y;
+  return h;
+}
+
 absl::Status CheckOGrid(const StructuredBlock& grid) {
   const int ni = grid.extent(0), nj = grid.extent(1);
   if (grid.spatial_dim() != 2 || grid.extent(2) != 1 || ni < 5 || nj < 3) {
@@ -148,22 +176,13 @@ ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
       //   B(-psi) up + B(psi) down = -r0,  up = (x_n - x) . n > 0,  down = (x_s - x) . n < 0,
       // r0 the rest of the equation along n over gamma. The left side increases monotonically
       // from -inf to inf with psi: bisection.
-      const int im = i == 0 ? ni - 2 : i - 1, ip = i == ni - 1 ? 1 : i + 1;
-      const Vec b = At(grid, i, j);
-      const Vec e = At(grid, ip, j), w = At(grid, im, j), n = At(grid, i, j + 1),
-                s = At(grid, i, j - 1);
-      const Vec ne = At(grid, ip, j + 1), se = At(grid, ip, j - 1), nw = At(grid, im, j + 1),
-                sw = At(grid, im, j - 1);
-      const Vec xi = {0.5 * (e.x - w.x), 0.5 * (e.y - w.y)};
-      const Vec eta = {0.5 * (n.x - s.x), 0.5 * (n.y - s.y)};
-      const Vec cross = {0.25 * (ne.x - se.x - nw.x + sw.x), 0.25 * (ne.y - se.y - nw.y + sw.y)};
-      const double alpha = eta.x * eta.x + eta.y * eta.y;
-      const double beta = xi.x * eta.x + xi.y * eta.y;
-      const double gamma = xi.x * xi.x + xi.y * xi.y;
+      const Neighbourhood h = Around(grid, i, j);
+      const Vec &b = h.centre, &e = h.e, &w = h.w, &n = h.n, &s = h.s, &xi = h.xi, &eta = h.eta;
+      const double alpha = h.alpha, beta = h.beta, gamma = h.gamma;
       if (!(gamma > 0.0)) continue;
       const double ae = Bernoulli(-phi), aw = Bernoulli(phi);
-      const Vec rest = {alpha * (ae * (e.x - b.x) + aw * (w.x - b.x)) - 2.0 * beta * cross.x,
-                        alpha * (ae * (e.y - b.y) + aw * (w.y - b.y)) - 2.0 * beta * cross.y};
+      const Vec rest = {alpha * (ae * (e.x - b.x) + aw * (w.x - b.x)) - 2.0 * beta * h.cross.x,
+                        alpha * (ae * (e.y - b.y) + aw * (w.y - b.y)) - 2.0 * beta * h.cross.y};
       const double length = std::sqrt(gamma);
       Vec normal = {-xi.y / length, xi.x / length};
       if (normal.x * eta.x + normal.y * eta.y < 0.0) normal = {-normal.x, -normal.y};
@@ -236,19 +255,12 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
   // The discrete equation at (i, j), split into the neighbours along the line and the rest.
   const auto stencil = [&](int i, int j, bool along_j, double* lower, double* diag, double* upper,
                            Vec* rest) {
-    const int im = i == 0 ? ni - 2 : i - 1, ip = i + 1;
-    const Vec e = At(g, ip, j), w = At(g, im, j), n = At(g, i, j + 1), s = At(g, i, j - 1);
-    const Vec ne = At(g, ip, j + 1), se = At(g, ip, j - 1), nw = At(g, im, j + 1),
-              sw = At(g, im, j - 1);
-    const Vec xi = {0.5 * (e.x - w.x), 0.5 * (e.y - w.y)};
-    const Vec eta = {0.5 * (n.x - s.x), 0.5 * (n.y - s.y)};
-    const Vec cross = {0.25 * (ne.x - se.x - nw.x + sw.x), 0.25 * (ne.y - se.y - nw.y + sw.y)};
-    const double alpha = eta.x * eta.x + eta.y * eta.y;
-    const double beta = xi.x * eta.x + xi.y * eta.y;
-    const double gamma = xi.x * xi.x + xi.y * xi.y;
+    const Neighbourhood h = Around(g, i, j);
+    const Vec &e = h.e, &w = h.w, &n = h.n, &s = h.s, &cross = h.cross;
+    const double alpha = h.alpha, beta = h.beta, gamma = h.gamma;
     const int64_t p = g.Index(i, j, 0);
-    // 2 (alpha + gamma) x = alpha ((1 + phi / 2) x_e + (1 - phi / 2) x_w)
-    //                     + gamma ((1 + psi / 2) x_n + (1 - psi / 2) x_s) - 2 beta x_xieta.
+    // (we + ww + wn + ws) x = we x_e + ww x_w + wn x_n + ws x_s - 2 beta x_xieta, with
+    // we = alpha B(-phi), ww = alpha B(phi), wn = gamma B(-psi), ws = gamma B(psi).
     const double we = alpha * weights[4 * p], ww = alpha * weights[4 * p + 1];
     const double wn = gamma * weights[4 * p + 2], ws = gamma * weights[4 * p + 3];
     *diag = we + ww + wn + ws;

@@ -48,6 +48,20 @@ void ExpectGoodGrid(const ProfileGrid& grid, double first, double far, const std
       << what << ": first at layer " << q.first_self_intersecting_layer;
 }
 
+// Within 4 points of a trailing-edge corner (sharp, or either end of a blunt base) the lines of
+// an orthogonalised transfinite grid fan out (transfinite.h) instead of leaving orthogonally:
+// measures the wall orthogonality beyond them.
+void MeasureOrthogonalityBeyondFans(ProfileGrid* grid) {
+  const int ni = grid->block.extent(0);
+  std::vector<int> fan;
+  for (int c : grid->corners) {
+    for (int d = -4; d <= 4; ++d) fan.push_back(((c + d) % (ni - 1) + (ni - 1)) % (ni - 1));
+  }
+  fan.push_back(ni - 1);
+  grid->quality.wall_orthogonality_degrees =
+      MeasureOGrid(grid->block, fan).wall_orthogonality_degrees;
+}
+
 class SharedAirfoilGridTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SharedAirfoilGridTest, OffsetsMeetTheCriteria) {
@@ -75,16 +89,7 @@ TEST_P(SharedAirfoilGridTest, OrthogonalisedTransfiniteMeetsTheCriteria) {
   ProfileGridOptions options;
   options.method = LayerMethod::kTransfinite;
   ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
-  // Within 4 points of a trailing-edge corner (sharp, or either end of a blunt base) the lines
-  // fan out (transfinite.h) instead of leaving orthogonally: measure the orthogonality beyond.
-  const int ni = grid.block.extent(0);
-  std::vector<int> fan;
-  for (int c : grid.corners) {
-    for (int d = -4; d <= 4; ++d) fan.push_back(((c + d) % (ni - 1) + (ni - 1)) % (ni - 1));
-  }
-  fan.push_back(ni - 1);
-  grid.quality.wall_orthogonality_degrees =
-      MeasureOGrid(grid.block, fan).wall_orthogonality_degrees;
+  MeasureOrthogonalityBeyondFans(&grid);
   ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " transfinite");
 }
 
@@ -96,14 +101,7 @@ TEST_P(SharedAirfoilGridTest, EllipticMeetsTheCriteria) {
   EXPECT_GT(grid.coarse_sweeps, 0);
   EXPECT_GT(grid.fine_sweeps, 0);
   // The boundary layer is the orthogonalised transfinite grid's: its trailing-edge fans too.
-  const int ni = grid.block.extent(0);
-  std::vector<int> fan;
-  for (int c : grid.corners) {
-    for (int d = -4; d <= 4; ++d) fan.push_back(((c + d) % (ni - 1) + (ni - 1)) % (ni - 1));
-  }
-  fan.push_back(ni - 1);
-  grid.quality.wall_orthogonality_degrees =
-      MeasureOGrid(grid.block, fan).wall_orthogonality_degrees;
+  MeasureOrthogonalityBeyondFans(&grid);
   ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " elliptic");
 }
 
