@@ -42,7 +42,7 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
   return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
     const auto start = std::chrono::steady_clock::now();
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     if (request->base_revision() < 0 || request->reference_revision() < 0) {
       return absl::InvalidArgumentError(absl::StrCat(
           "base_revision = ", request->base_revision(),
@@ -124,15 +124,11 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
     revision.deform.decay_radius = deformer->decay_radius();
     revision.deform.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    int64_t bytes = 0;
-    for (const BlockFit& b : revision.blocks) bytes += FittedBlockBytes(b.fitted);
-    for (const std::vector<uint8_t>& k : revision.kinds.point_kinds) {
-      bytes += static_cast<int64_t>(k.size());
-    }
-    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(bytes, "the deformed revision"));
+    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(RevisionBytes(revision),
+                                                                "the deformed revision"));
     SG_ASSIGN_OR_RETURN(
         const std::shared_ptr<const StoredGrid> stored,
-        state_->store.AddRevision(id, std::move(revision), request->base_revision()));
+        state_->store->AddRevision(id, std::move(revision), request->base_revision()));
     const GridRevision& published = *stored->revisions.back();
     response->set_revision(published.number);
     EncodeDeformReport(published.deform, response->mutable_report());

@@ -58,7 +58,7 @@ grpc::ServerUnaryReactor* SplineGridService::EvaluatePoints(
   CallLog log("EvaluatePoints", request->name(), state_->options.log_calls);
   return RunOnPool(context, log, [this, request, response]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> rev,
                         grid->FindRevision(request->revision(), OptionalStep(*request)));
     SG_ASSIGN_OR_RETURN(const int64_t n,

@@ -85,7 +85,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
 
   absl::StatusOr<std::unique_ptr<v1::EvaluateGridResponse>> Plan() {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
-    SG_ASSIGN_OR_RETURN(grid_, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(grid_, state_->store->Get(id));
     if (request_->revision() < 0) {
       return absl::InvalidArgumentError(
           absl::StrCat("revision = ", request_->revision(), " is negative"));

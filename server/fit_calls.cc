@@ -37,7 +37,7 @@ absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFi
   SG_ASSIGN_OR_RETURN(GridRevision revision,
                       FitRevision(*grid.source, options, origin, parent, cancel));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
-                      state_->store.AddRevision(grid.id, std::move(revision)));
+                      state_->store->AddRevision(grid.id, std::move(revision)));
   EncodeFitResponse(*stored->revisions.back(), response);
   return absl::OkStatus();
 }
@@ -49,7 +49,7 @@ grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     SG_ASSIGN_OR_RETURN(const GridFitOptions options, ParseFitSpec(request->spec()));
     return FitAndStore(*grid, options, RevisionOrigin::kFit, 0, cancel, response);
   });
@@ -62,7 +62,7 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     if (request->revision() < 0) {
       return absl::InvalidArgumentError(
           absl::StrCat("revision = ", request->revision(), " is negative"));

@@ -47,7 +47,7 @@ absl::StatusOr<GridFitOptions> GeneratedFitOptions(const v1::GenerateGridRequest
 // The wall points of block `block`'s j = 0 edge of a stored revision, evaluated at the original
 // resolution: the one run of points whose kind includes wall, in Selig orientation
 // (counter-clockwise).
-absl::StatusOr<ProfileSource> StoredWallProfile(const GridStore& store,
+absl::StatusOr<ProfileSource> StoredWallProfile(GridStore& store,
                                                 const v1::StoredWall& wall) {
   SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(wall.name(), "stored_wall.name"));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, store.Get(id));
@@ -113,7 +113,7 @@ absl::StatusOr<ProfileSource> StoredWallProfile(const GridStore& store,
   return out;
 }
 
-absl::StatusOr<ProfileSource> ProfileOf(const GridStore& store,
+absl::StatusOr<ProfileSource> ProfileOf(GridStore& store,
                                         const v1::GenerateGridRequest& request) {
   ProfileSource out;
   switch (request.profile_case()) {
@@ -150,7 +150,7 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
   if (request.display_name().size() > 1024) {
     return absl::InvalidArgumentError("display_name is longer than 1024 bytes");
   }
-  if (!id.empty() && state_->store.Get(id).ok()) {  // fail early; Create decides in the end
+  if (!id.empty() && state_->store->Get(id).ok()) {  // fail early; Create decides in the end
     return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
   }
   SG_ASSIGN_OR_RETURN(ProfileGridOptions options, ParseProfileGridOptions(request));
@@ -161,7 +161,7 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
         state_->options.max_output_points, " (flag --max_output_points)"));
   }
   SG_ASSIGN_OR_RETURN(const GridFitOptions fit_options, GeneratedFitOptions(request));
-  SG_ASSIGN_OR_RETURN(const ProfileSource profile, ProfileOf(state_->store, request));
+  SG_ASSIGN_OR_RETURN(const ProfileSource profile, ProfileOf(*state_->store, request));
 
   // The generated block, as the source points of the new grid.
   auto source = std::make_shared<SourcePoints>();
@@ -199,7 +199,7 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
   grid->source = std::move(source);
   grid->revisions.push_back(std::make_shared<const GridRevision>(std::move(revision)));
   SG_RETURN_IF_ERROR(PollCancel(cancel));
-  SG_RETURN_IF_ERROR(CreateGrid(state_->store, id, grid));
+  SG_RETURN_IF_ERROR(CreateGrid(*state_->store, id, grid));
   SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response->mutable_grid()));
   EncodeFitResponse(*grid->revisions.back(), response->mutable_fit());
   report->set_seconds(

@@ -91,12 +91,14 @@ bool GridSubscription::Next(RevisionSummary* revision, End* end) {
 bool GridSubscription::Push(const RevisionSummary& revision) {
   std::lock_guard<std::mutex> lock(mu_);
   if (end_ != End::kOpen) return false;
+  if (revision.number <= after_) return true;  // in the watcher's snapshot, or queued already
   if (queue_.size() >= max_queued_) {
     end_ = End::kLagged;
     queue_.clear();
     return false;
   }
   queue_.push_back(revision);
+  after_ = revision.number;
   return true;
 }
 
@@ -121,154 +123,50 @@ int64_t FittedBlockBytes(const FittedBlock& block) {
   return bytes + static_cast<int64_t>(sizeof(FittedBlock));
 }
 
-int64_t RevisionBytes(const GridFit& fit) {
+namespace {
+
+int64_t BlocksAndKindsBytes(const std::vector<BlockFit>& blocks, const BoundaryKinds& kinds) {
   int64_t bytes = 0;
-  for (const BlockFit& block : fit.blocks) {
+  for (const BlockFit& block : blocks) {
     bytes += FittedBlockBytes(block.fitted) + static_cast<int64_t>(sizeof(BlockFit)) +
              static_cast<int64_t>(block.quality.bad_cells.size() * sizeof(Extents));
   }
-  for (const std::vector<uint8_t>& kinds : fit.kinds.point_kinds) {
-    bytes += static_cast<int64_t>(kinds.size());
+  for (const std::vector<uint8_t>& point_kinds : kinds.point_kinds) {
+    bytes += static_cast<int64_t>(point_kinds.size());
   }
   return bytes;
 }
 
-absl::Status GridStore::Create(std::shared_ptr<const StoredGrid> grid) {
-  std::lock_guard<std::mutex> lock(mu_);
-  const auto [it, inserted] = grids_.emplace(grid->id, grid);
-  if (!inserted) {
-    return absl::AlreadyExistsError(absl::StrCat("grids/", grid->id, " already exists"));
+}  // namespace
+
+int64_t RevisionBytes(const GridFit& fit) { return BlocksAndKindsBytes(fit.blocks, fit.kinds); }
+
+int64_t RevisionBytes(const GridRevision& revision) {
+  return BlocksAndKindsBytes(revision.blocks, revision.kinds);
+}
+
+int64_t SourceBytes(const MultiBlockGrid& source) {
+  int64_t bytes = 0;
+  for (const StructuredBlock& block : source.blocks) {
+    bytes += static_cast<int64_t>(block.coords().size() * sizeof(double) +
+                                  block.iblank().size() * sizeof(int));
   }
-  return absl::OkStatus();
+  return bytes;
 }
 
-absl::StatusOr<std::shared_ptr<const StoredGrid>> GridStore::Get(const std::string& id) const {
-  std::lock_guard<std::mutex> lock(mu_);
-  const auto it = grids_.find(id);
-  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
-  return it->second;
-}
-
-absl::StatusOr<std::shared_ptr<const StoredGrid>> GridStore::AddRevision(const std::string& id,
-                                                                         GridRevision revision,
-                                                                         int64_t expected_latest) {
-  auto published = std::make_shared<GridRevision>(std::move(revision));
-  std::shared_ptr<const StoredGrid> replaced;  // released after the lock, with what it dropped
-  std::vector<std::shared_ptr<GridSubscription>> woken;
-  std::shared_ptr<const StoredGrid> result;
-  {
-    std::lock_guard<std::mutex> lock(mu_);
-    const auto it = grids_.find(id);
-    if (it == grids_.end()) {
-      return absl::NotFoundError(absl::StrCat("grids/", id, " was deleted"));
-    }
-    const int64_t latest = it->second->revisions.empty() ? 0 : it->second->revisions.back()->number;
-    if (expected_latest != 0 && latest != expected_latest) {
-      return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,
-                                             " is stale; the latest revision is ", latest));
-    }
-    auto next = std::make_shared<StoredGrid>(*it->second);
-    published->number = latest + 1;
-    next->revisions.push_back(published);
-    // Retention: drop the oldest deformed revisions beyond the newest max_deform_revisions_
-    // (the one just published is the newest, so it stays, and so does the latest number).
-    int64_t excess = -max_deform_revisions_;
-    for (const auto& r : next->revisions) excess += r->origin == RevisionOrigin::kDeform;
-    if (excess > 0) {
-      std::vector<std::shared_ptr<const GridRevision>> kept;
-      kept.reserve(next->revisions.size() - excess);
-      for (auto& r : next->revisions) {
-        if (r->origin == RevisionOrigin::kDeform && excess > 0) {
-          --excess;
-          continue;
-        }
-        kept.push_back(std::move(r));
-      }
-      next->revisions = std::move(kept);
-    }
-    replaced = std::move(it->second);
-    it->second = next;
-    result = std::move(next);
-    if (const auto subs = subscriptions_.find(id); subs != subscriptions_.end()) {
-      const RevisionSummary summary = RevisionSummary::Of(*published);
-      std::vector<std::shared_ptr<GridSubscription>>& list = subs->second;
-      // A watcher that lags too far is ended (kLagged) and leaves the list.
-      woken = list;
-      std::erase_if(list, [&](const std::shared_ptr<GridSubscription>& subscription) {
-        return !subscription->Push(summary);
-      });
-      if (list.empty()) subscriptions_.erase(subs);
+std::vector<int64_t> DeformRevisionsBeyond(
+    const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions) {
+  int64_t excess = -max_deform_revisions;
+  for (const auto& r : revisions) excess += r->origin == RevisionOrigin::kDeform;
+  std::vector<int64_t> dropped;
+  for (const auto& r : revisions) {
+    if (excess <= 0) break;
+    if (r->origin == RevisionOrigin::kDeform) {
+      dropped.push_back(r->number);
+      --excess;
     }
   }
-  for (const auto& subscription : woken) subscription->Wake();
-  return result;
-}
-
-absl::Status GridStore::Delete(const std::string& id) {
-  std::shared_ptr<const StoredGrid> removed;  // released after the lock
-  std::vector<std::shared_ptr<GridSubscription>> ended;
-  {
-    std::lock_guard<std::mutex> lock(mu_);
-    const auto it = grids_.find(id);
-    if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
-    removed = std::move(it->second);
-    grids_.erase(it);
-    if (const auto subs = subscriptions_.find(id); subs != subscriptions_.end()) {
-      ended = std::move(subs->second);
-      subscriptions_.erase(subs);
-    }
-    for (const auto& subscription : ended) subscription->Close(GridSubscription::End::kGridDeleted);
-  }
-  for (const auto& subscription : ended) subscription->Wake();
-  return absl::OkStatus();
-}
-
-absl::StatusOr<GridStore::Watch> GridStore::Subscribe(const std::string& id,
-                                                      std::weak_ptr<GridWatcher> watcher,
-                                                      size_t max_queued) {
-  auto subscription = std::make_shared<GridSubscription>(std::move(watcher), max_queued);
-  std::lock_guard<std::mutex> lock(mu_);
-  if (closed_) return absl::UnavailableError("the server is shutting down");
-  const auto it = grids_.find(id);
-  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
-  subscriptions_[id].push_back(subscription);
-  return Watch{it->second, std::move(subscription)};
-}
-
-void GridStore::Unsubscribe(const std::string& id, const GridSubscription* subscription) {
-  std::lock_guard<std::mutex> lock(mu_);
-  const auto subs = subscriptions_.find(id);
-  if (subs == subscriptions_.end()) return;
-  std::erase_if(subs->second, [subscription](const std::shared_ptr<GridSubscription>& s) {
-    return s.get() == subscription;
-  });
-  if (subs->second.empty()) subscriptions_.erase(subs);
-}
-
-void GridStore::CloseSubscriptions() {
-  std::vector<std::shared_ptr<GridSubscription>> ended;
-  {
-    std::lock_guard<std::mutex> lock(mu_);
-    closed_ = true;
-    for (auto& [id, list] : subscriptions_) {
-      for (auto& subscription : list) ended.push_back(std::move(subscription));
-    }
-    subscriptions_.clear();
-    for (const auto& subscription : ended) subscription->Close(GridSubscription::End::kClosed);
-  }
-  for (const auto& subscription : ended) subscription->Wake();
-}
-
-std::vector<std::shared_ptr<const StoredGrid>> GridStore::List(const std::string& after, int limit,
-                                                               bool* more) const {
-  std::vector<std::shared_ptr<const StoredGrid>> page;
-  std::lock_guard<std::mutex> lock(mu_);
-  auto it = grids_.upper_bound(after);
-  for (; it != grids_.end() && static_cast<int>(page.size()) < limit; ++it) {
-    page.push_back(it->second);
-  }
-  *more = it != grids_.end();
-  return page;
+  return dropped;
 }
 
 }  // namespace splinegrid::server

@@ -1,24 +1,20 @@
-// The in-memory store of grids and their immutable revisions.
+// Grids and their immutable revisions, and the interface of the store that holds them.
 //
 // Everything a reader can reach is immutable and shared: a grid is a snapshot
 // (shared_ptr<const StoredGrid>) that holds its source points and revisions by shared_ptr.
-// Adding a revision publishes a new snapshot under a short lock, so a running fit never blocks
-// readers, and a reader keeps its snapshot alive even if the grid is deleted meanwhile.
 //
 // Retention: when a revision is published, the deformed revisions (kDeform) beyond the newest
 // max_deform_revisions of the grid leave the snapshot; fitted and faired ones always stay. A
 // dropped revision's memory goes when its last reader lets go. Numbers are never reused.
 //
 // Watching: a GridSubscription receives the summaries of a grid's revisions in publication
-// order, appended under the store's lock (so the order is the order of the snapshots), then the
-// grid's deletion. Its GridWatcher is woken after the lock is released and takes the events
-// from the subscription; the store never calls a watcher while it holds its lock.
+// order, then the grid's deletion. Its GridWatcher is woken outside the store's locks and takes
+// the events from the subscription.
 #ifndef SPLINEGRID_SERVER_GRID_STORE_H_
 #define SPLINEGRID_SERVER_GRID_STORE_H_
 
 #include <cstddef>
 #include <deque>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -125,8 +121,10 @@ class GridSubscription {
     kClosed,       // the store closed every subscription (server shutdown)
   };
 
-  GridSubscription(std::weak_ptr<GridWatcher> watcher, size_t max_queued)
-      : watcher_(std::move(watcher)), max_queued_(max_queued) {}
+  // `after`: revisions up to this number are in the watcher's snapshot already and are not
+  // queued again (a store that learns of revisions asynchronously may offer them).
+  GridSubscription(std::weak_ptr<GridWatcher> watcher, size_t max_queued, int64_t after = 0)
+      : watcher_(std::move(watcher)), max_queued_(max_queued), after_(after) {}
 
   // The next revision (true), or false and how the watch ended (kOpen: nothing queued now).
   // kLagged and kClosed come at once, dropping what is queued; kGridDeleted after the queue.
@@ -134,15 +132,17 @@ class GridSubscription {
 
   size_t max_queued() const { return max_queued_; }
 
- private:
-  friend class GridStore;
-  // Queues `revision`; false (and the watch ends kLagged) when that would exceed max_queued.
+  // For the stores (through SubscriptionHub): queues `revision` unless its number is not above
+  // the last one queued or `after`; false (and the watch ends kLagged) when that would exceed
+  // max_queued.
   bool Push(const RevisionSummary& revision);
   void Close(End end);
   void Wake() const;
 
+ private:
   const std::weak_ptr<GridWatcher> watcher_;
   const size_t max_queued_;
+  int64_t after_;  // the highest number queued or known to the watcher
   std::mutex mu_;
   std::deque<RevisionSummary> queue_;
   End end_ = End::kOpen;
@@ -153,30 +153,41 @@ int64_t FittedBlockBytes(const FittedBlock& block);
 
 // Bytes a revision made of `fit` takes: its blocks and boundary kinds.
 int64_t RevisionBytes(const GridFit& fit);
+// The same for a revision (what its `memory` should hold).
+int64_t RevisionBytes(const GridRevision& revision);
+// Bytes the points of `source` take.
+int64_t SourceBytes(const MultiBlockGrid& source);
 
+// Where grids live: one interface, three backends (server/store/): MemoryStore (embedded, the
+// default), the same with a DirLog (embedded and durable: every change is on disk before the
+// call returns) and RedisStore (shared by any number of replicas). Chosen by OpenStore
+// (store/open_store.h) from `serve --store`.
+//
+// Every backend serves immutable snapshots: Get returns the grid as it was when the call
+// looked, and a reader keeps its snapshot alive however the grid changes meanwhile. Revision
+// numbers are assigned by the store (latest + 1), atomically with the base-revision check, and
+// never reused.
 class GridStore {
  public:
-  // Keeps the newest `max_deform_revisions` (>= 1) deformed revisions of each grid.
-  explicit GridStore(int max_deform_revisions) : max_deform_revisions_(max_deform_revisions) {}
+  virtual ~GridStore() = default;
 
-  // Adds a new grid; ALREADY_EXISTS if the id is taken.
-  absl::Status Create(std::shared_ptr<const StoredGrid> grid);
+  // Adds a new grid with the revisions it already has (an imported archive brings them, under
+  // their own numbers); ALREADY_EXISTS if the id is taken.
+  virtual absl::Status Create(std::shared_ptr<const StoredGrid> grid) = 0;
 
   // The current snapshot, or NOT_FOUND.
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) const;
+  virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) = 0;
 
   // Publishes `revision` (its number is assigned here: latest + 1) as the grid's newest, drops
-  // deformed revisions beyond the retention limit, queues the revision on the grid's
-  // subscriptions and returns the new snapshot; NOT_FOUND if the grid was deleted meanwhile,
-  // ABORTED if `expected_latest` is not 0 and the grid's latest revision is another one (a
-  // concurrent writer got there first).
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
-                                                                GridRevision revision,
-                                                                int64_t expected_latest = 0);
+  // deformed revisions beyond the retention limit, tells the grid's watchers and returns the new
+  // snapshot; NOT_FOUND if the grid was deleted meanwhile, ABORTED if `expected_latest` is not 0
+  // and the grid's latest revision is another one (a concurrent writer got there first).
+  virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
+      const std::string& id, GridRevision revision, int64_t expected_latest = 0) = 0;
 
-  // Removes the grid and ends its subscriptions (kGridDeleted); NOT_FOUND if absent. Readers
-  // holding snapshots keep them.
-  absl::Status Delete(const std::string& id);
+  // Removes the grid and ends its watches (kGridDeleted); NOT_FOUND if absent. Readers holding
+  // snapshots keep them.
+  virtual absl::Status Delete(const std::string& id) = 0;
 
   // A watch of grid `id`: its current snapshot, and a subscription that receives every revision
   // published after that snapshot (at most `max_queued` waiting) and the grid's deletion.
@@ -185,26 +196,29 @@ class GridStore {
     std::shared_ptr<const StoredGrid> snapshot;
     std::shared_ptr<GridSubscription> subscription;
   };
-  absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
-                                  size_t max_queued);
+  virtual absl::StatusOr<Watch> Subscribe(const std::string& id,
+                                          std::weak_ptr<GridWatcher> watcher,
+                                          size_t max_queued) = 0;
 
   // Stops queuing on `subscription` (a watch that ended); a no-op when it is gone already.
-  void Unsubscribe(const std::string& id, const GridSubscription* subscription);
+  virtual void Unsubscribe(const std::string& id, const GridSubscription* subscription) = 0;
 
   // Ends every subscription (kClosed) and refuses new ones: the server is shutting down.
-  void CloseSubscriptions();
+  virtual void CloseSubscriptions() = 0;
 
   // Up to `limit` grids with ids greater than `after`, in id order, and whether more follow.
-  std::vector<std::shared_ptr<const StoredGrid>> List(const std::string& after, int limit,
-                                                      bool* more) const;
+  virtual absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(
+      const std::string& after, int limit, bool* more) = 0;
 
- private:
-  const int max_deform_revisions_;
-  mutable std::mutex mu_;  // before any GridSubscription::mu_
-  std::map<std::string, std::shared_ptr<const StoredGrid>> grids_;
-  std::map<std::string, std::vector<std::shared_ptr<GridSubscription>>> subscriptions_;
-  bool closed_ = false;  // CloseSubscriptions was called
+  // OK while the store can serve; otherwise why not (UNAVAILABLE: e.g. Redis is unreachable).
+  // Cheap: health checks poll it.
+  virtual absl::Status Available() const { return absl::OkStatus(); }
 };
+
+// Retention: the numbers of the deformed revisions of `revisions` (ascending) beyond the newest
+// `max_deform_revisions`, which publishing the last one drops.
+std::vector<int64_t> DeformRevisionsBeyond(
+    const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions);
 
 }  // namespace splinegrid::server
 

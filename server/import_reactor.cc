@@ -184,19 +184,15 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     SG_ASSIGN_OR_RETURN(source->grid, BuildSource(&source->format));
     bytes_ = std::string();
     if (source->grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
-    int64_t bytes = 0;
-    for (const StructuredBlock& block : source->grid.blocks) {
-      bytes += static_cast<int64_t>(block.coords().size() * sizeof(double) +
-                                    block.iblank().size() * sizeof(int));
-    }
     upload_ = MemoryReservation();
-    SG_ASSIGN_OR_RETURN(source->memory, state_->budget.Reserve(bytes, "the imported grid"));
+    SG_ASSIGN_OR_RETURN(source->memory, state_->budget.Reserve(SourceBytes(source->grid),
+                                                               "the imported grid"));
     SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
     auto grid = std::make_shared<StoredGrid>();
     grid->display_name = header_.display_name();
     grid->create_time = absl::Now();
     grid->source = std::move(source);
-    SG_RETURN_IF_ERROR(CreateGrid(state_->store, header_.grid_id(), grid));
+    SG_RETURN_IF_ERROR(CreateGrid(*state_->store, header_.grid_id(), grid));
     log_.set_grid(absl::StrCat("grids/", grid->id));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }

@@ -40,4 +40,17 @@ absl::StatusOr<MemoryReservation> MemoryBudget::Reserve(int64_t bytes, const std
   return MemoryReservation(this, bytes);
 }
 
+absl::Status MemoryBudget::Extend(MemoryReservation* reservation, int64_t bytes,
+                                  const std::string& what) {
+  absl::StatusOr<MemoryReservation> more = Reserve(bytes, what);
+  if (!more.ok()) return more.status();
+  if (reservation->budget_ != nullptr && reservation->budget_ != this) {
+    return absl::InternalError("a reservation was extended from another budget");
+  }
+  reservation->budget_ = this;
+  reservation->bytes_ += more->bytes_;
+  more->bytes_ = 0;
+  return absl::OkStatus();
+}
+
 }  // namespace splinegrid::server

@@ -39,6 +39,9 @@ class MemoryBudget {
 
   // Reserves `bytes` for `what` (named in the error), or RESOURCE_EXHAUSTED.
   absl::StatusOr<MemoryReservation> Reserve(int64_t bytes, const std::string& what);
+  // Adds `bytes` to `reservation` (which then holds against this budget), or RESOURCE_EXHAUSTED
+  // leaving it as it was: for data charged as it arrives.
+  absl::Status Extend(MemoryReservation* reservation, int64_t bytes, const std::string& what);
 
   int64_t used() const { return used_.load(); }
   int64_t limit() const { return limit_; }

@@ -3,7 +3,10 @@
 #ifndef SPLINEGRID_SERVER_SERVER_H_
 #define SPLINEGRID_SERVER_SERVER_H_
 
+#include <condition_variable>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "absl/status/statusor.h"
 #include "grpcpp/grpcpp.h"
@@ -40,11 +43,20 @@ class Server {
  private:
   Server() = default;
 
+  // Health follows the store: NOT_SERVING while it is unavailable (e.g. Redis is down), SERVING
+  // again when it returns. Polls until Shutdown.
+  void FollowStoreHealth();
+  void SetServing(bool serving);
+
   std::unique_ptr<ServiceState> state_;
   std::unique_ptr<SplineGridService> service_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   std::once_flag shutdown_once_;
+  std::mutex health_mu_;
+  std::condition_variable health_cv_;
+  bool stopping_ = false;
+  std::thread health_thread_;
 };
 
 // Starts a server and runs it until SIGTERM or SIGINT, then shuts down gracefully.

@@ -25,7 +25,6 @@ int DefaultThreads(int requested) {
 
 ServiceState::ServiceState(const ServerOptions& opts)
     : options(opts),
-      store(opts.max_deform_revisions),
       budget(opts.memory_budget_bytes),
       pool(DefaultThreads(opts.worker_threads), opts.max_queued_tasks) {}
 
@@ -119,7 +118,7 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
   CallLog log("GetGrid", request->name(), state_->options.log_calls);
   auto work = [this, request, response]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     if (request->revision() < 0) {
       return absl::InvalidArgumentError(
           absl::StrCat("revision = ", request->revision(), " is negative"));
@@ -155,7 +154,7 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
           absl::StrCat("page_token = '", request->page_token(), "' is not a token of ListGrids"));
     }
     bool more = false;
-    const auto page = state_->store.List(after, size == 0 ? 50 : size, &more);
+    SG_ASSIGN_OR_RETURN(const auto page, state_->store->List(after, size == 0 ? 50 : size, &more));
     for (const auto& grid : page) {
       SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response->add_grids()));
     }
@@ -172,7 +171,7 @@ grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerCont
   CallLog log("DeleteGrid", request->name(), state_->options.log_calls);
   return RunInline(context, log, [this, request]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_RETURN_IF_ERROR(state_->store.Delete(id));
+    SG_RETURN_IF_ERROR(state_->store->Delete(id));
     state_->deformers.Forget(DeformerKeyPrefix(id));
     return absl::OkStatus();
   });

@@ -23,11 +23,12 @@ namespace splinegrid::server {
 
 // What every call may use: the store, the pool, the budget and the configuration.
 struct ServiceState {
+  // The store is opened by the server (store/open_store.h), with this state's budget.
   explicit ServiceState(const ServerOptions& opts);
 
   ServerOptions options;
-  GridStore store;
   MemoryBudget budget;
+  std::unique_ptr<GridStore> store;
   WorkerPool pool;
   DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
@@ -101,6 +102,10 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* EvaluatePoints(grpc::CallbackServerContext* context,
                                            const v1::EvaluatePointsRequest* request,
                                            v1::EvaluatePointsResponse* response) override;
+  grpc::ServerWriteReactor<v1::ExportGridResponse>* ExportGrid(
+      grpc::CallbackServerContext* context, const v1::ExportGridRequest* request) override;
+  grpc::ServerReadReactor<v1::ImportArchiveRequest>* ImportArchive(
+      grpc::CallbackServerContext* context, v1::Grid* response) override;
 
  private:
   // Runs `work` on the worker pool and finishes the call with its status (UNAVAILABLE while

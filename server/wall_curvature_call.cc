@@ -83,7 +83,7 @@ grpc::ServerUnaryReactor* SplineGridService::GetWallCurvature(
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store.Get(id));
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     return WallCurvature(*grid, *request, cancel, response);
   });
 }

@@ -107,7 +107,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
           absl::StrCat("after_revision = ", after_,
                        " is below -1 (0: every stored revision, -1: only new ones)"));
     }
-    absl::StatusOr<GridStore::Watch> watch = state_->store.Subscribe(
+    absl::StatusOr<GridStore::Watch> watch = state_->store->Subscribe(
         id_, std::weak_ptr<GridWatcher>(self_), static_cast<size_t>(state_->options.max_watch_lag));
     if (!watch.ok()) return watch.status();
     std::lock_guard<std::mutex> lock(mu_);
@@ -184,7 +184,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
       }
     }
     if (finish) {
-      if (subscription_) state_->store.Unsubscribe(id_, subscription_.get());
+      if (subscription_) state_->store->Unsubscribe(id_, subscription_.get());
       log_.Finish(final_status);
       SG_HAPPENS_BEFORE(this);
       Finish(ToGrpcStatus(final_status));

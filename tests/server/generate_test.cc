@@ -80,7 +80,7 @@ class GenerateTest : public ServiceTest {
     }
     EXPECT_EQ(non_positive, 0) << id;
 
-    const auto stored = server_->state().store.Get(id).value();
+    const auto stored = server_->state().store->Get(id).value();
     const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
     const int ni = kWallPoints, nj = layers + 1;
     const auto has = [&](int i, int j, BoundaryKind kind) {
@@ -198,7 +198,7 @@ TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
   spec.mutable_boundary_tolerances();
   ASSERT_TRUE(client_->Fit("cgrid", spec).ok());
   // The wall run of the C-grid's j = 0 (its wake cut is an interface).
-  const auto stored = server_->state().store.Get("cgrid").value();
+  const auto stored = server_->state().store->Get("cgrid").value();
   const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
   int wall = 0;
   for (int i = 0; i < stored->source->grid.blocks[0].extent(0); ++i) {

@@ -6,12 +6,14 @@
 #include <thread>
 
 #include "gmock/gmock.h"
+#include "server/store/memory_store.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
 namespace {
 
 using server::GridStore;
+using server::MemoryStore;
 using server::GridSubscription;
 using End = GridSubscription::End;
 
@@ -43,7 +45,7 @@ class StoreWatchTest : public ::testing::Test {
     return numbers;
   }
 
-  GridStore store_{/*max_deform_revisions=*/2};
+  MemoryStore store_{/*max_deform_revisions=*/2};
   std::shared_ptr<CountingWatcher> watcher_ = std::make_shared<CountingWatcher>();
 };
 

@@ -1,0 +1,193 @@
+// ExportGrid and ImportArchive: a grid with its source points and revisions as archive records
+// (store/grid_archive.h), so a user can move grids between servers and keep them with a case.
+#include <deque>
+#include <optional>
+#include <mutex>
+
+#include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
+#include "server/grid_encoding.h"
+#include "server/happens_before.h"
+#include "server/service.h"
+#include "server/store/grid_archive.h"
+
+namespace splinegrid::server {
+namespace {
+
+// Streams the records of one snapshot. They are built on the pool before the first write,
+// charged to the budget (about the size of the source points plus the revisions), and written
+// one at a time as the client takes them.
+class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
+ public:
+  ExportReactor(ServiceState* state, const v1::ExportGridRequest* request)
+      : state_(state), request_(request), log_("ExportGrid", request->name(),
+                                                state->options.log_calls) {
+    if (state_->draining.load()) {
+      End(absl::UnavailableError("the server is shutting down"));
+    } else if (!state_->pool.TrySubmit([this] { Prepare(); })) {
+      End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+    }
+  }
+
+  void OnWriteDone(bool ok) override {
+    SG_HAPPENS_AFTER(this);
+    if (!ok) {
+      End(absl::CancelledError("the client stopped reading the export"));
+      return;
+    }
+    records_.pop_front();
+    WriteNext();
+  }
+
+  void OnDone() override {
+    SG_HAPPENS_AFTER(this);
+    delete this;
+  }
+
+ private:
+  void Prepare() {
+    SG_HAPPENS_AFTER(this);
+    const absl::Status status = [&]() -> absl::Status {
+      SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
+      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+      SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(SourceBytes(grid->source->grid),
+                                                          "the export's records"));
+      int64_t bytes = 0;
+      SG_RETURN_IF_ERROR(ForEachRecord(*grid, [&](const v1::ArchiveRecord& record) {
+        records_.emplace_back();
+        *records_.back().mutable_record() = record;
+        bytes += static_cast<int64_t>(record.ByteSizeLong());
+        return absl::OkStatus();
+      }));
+      // The revisions come on top of the points charged above.
+      return state_->budget.Extend(&memory_, bytes - memory_.bytes(), "the export's records");
+    }();
+    if (!status.ok()) {
+      End(status);
+      return;
+    }
+    WriteNext();
+  }
+
+  void WriteNext() {
+    if (records_.empty()) {
+      log_.Finish(absl::OkStatus());
+      SG_HAPPENS_BEFORE(this);
+      Finish(grpc::Status::OK);
+      return;
+    }
+    SG_HAPPENS_BEFORE(this);
+    StartWrite(&records_.front());
+  }
+
+  void End(const absl::Status& status) {
+    log_.Finish(status);
+    SG_HAPPENS_BEFORE(this);
+    Finish(ToGrpcStatus(status));
+  }
+
+  ServiceState* state_;
+  const v1::ExportGridRequest* request_;
+  CallLog log_;
+  MemoryReservation memory_;
+  std::deque<v1::ExportGridResponse> records_;
+};
+
+// Assembles the records as they arrive (memory charged as data comes, not as the header
+// announces), then stores the grid on the pool: nothing is stored unless the whole archive
+// arrived and checks out.
+class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveRequest> {
+ public:
+  ImportArchiveReactor(ServiceState* state, v1::Grid* response)
+      : state_(state), response_(response), log_("ImportArchive", "", state->options.log_calls) {
+    if (state_->draining.load()) {
+      End(absl::UnavailableError("the server is shutting down"));
+      return;
+    }
+    SG_HAPPENS_BEFORE(this);
+    StartRead(&message_);
+  }
+
+  void OnReadDone(bool ok) override {
+    SG_HAPPENS_AFTER(this);
+    if (!ok) {  // the client closed its side: everything has arrived
+      if (!state_->pool.TrySubmit([this] { Complete(); })) {
+        End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+      }
+      return;
+    }
+    if (absl::Status status = Accept(); !status.ok()) {
+      End(status);
+      return;
+    }
+    SG_HAPPENS_BEFORE(this);
+    StartRead(&message_);
+  }
+
+  void OnDone() override {
+    SG_HAPPENS_AFTER(this);
+    delete this;
+  }
+
+ private:
+  absl::Status Accept() {
+    if (!assembler_) {
+      const std::string& id = message_.grid_id();
+      if (!id.empty() && !IsValidGridId(id)) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "grid_id = '", id.substr(0, 80),
+            "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+      }
+      assembler_.emplace(&state_->budget, id);
+    } else if (!message_.grid_id().empty()) {
+      return absl::InvalidArgumentError("grid_id is set after the first message");
+    }
+    const absl::Status added = assembler_->Add(message_.record());
+    if (!added.ok()) {
+      return absl::Status(added.code(), absl::StrCat("record ", records_, ": ", added.message()));
+    }
+    ++records_;
+    return absl::OkStatus();
+  }
+
+  void Complete() {
+    SG_HAPPENS_AFTER(this);
+    const absl::Status status = [&]() -> absl::Status {
+      if (!assembler_) return absl::InvalidArgumentError("the archive is empty: no records came");
+      SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
+                          assembler_->Finish(/*check_counts=*/true));
+      log_.set_grid(absl::StrCat("grids/", grid->id));
+      SG_RETURN_IF_ERROR(state_->store->Create(grid));
+      return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
+    }();
+    assembler_.reset();
+    End(status);
+  }
+
+  void End(const absl::Status& status) {
+    log_.Finish(status);
+    SG_HAPPENS_BEFORE(this);
+    Finish(ToGrpcStatus(status));
+  }
+
+  ServiceState* state_;
+  v1::Grid* response_;
+  CallLog log_;
+  v1::ImportArchiveRequest message_;
+  std::optional<GridAssembler> assembler_;
+  int64_t records_ = 0;
+};
+
+}  // namespace
+
+grpc::ServerWriteReactor<v1::ExportGridResponse>* SplineGridService::ExportGrid(
+    grpc::CallbackServerContext* /*context*/, const v1::ExportGridRequest* request) {
+  return new ExportReactor(state_, request);
+}
+
+grpc::ServerReadReactor<v1::ImportArchiveRequest>* SplineGridService::ImportArchive(
+    grpc::CallbackServerContext* /*context*/, v1::Grid* response) {
+  return new ImportArchiveReactor(state_, response);
+}
+
+}  // namespace splinegrid::server

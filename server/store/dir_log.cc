@@ -1,0 +1,271 @@
+#include "server/store/dir_log.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/io/record_file.h"
+#include "core/util/status_macros.h"
+#include "server/store/grid_archive.h"
+#include "server/store/revision_codec.h"
+
+namespace splinegrid::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kGridFile[] = "grid.records";
+
+absl::Status ErrnoStatus(const std::string& what) {
+  return absl::InternalError(absl::StrCat(what, ": ", std::strerror(errno)));
+}
+
+absl::Status FsStatus(const std::error_code& error, const std::string& what) {
+  return absl::InternalError(absl::StrCat(what, ": ", error.message()));
+}
+
+// fsync of a directory: makes the renames and unlinks in it durable.
+absl::Status SyncDirectory(const fs::path& dir) {
+  const int fd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return ErrnoStatus(absl::StrCat("cannot open ", dir.string()));
+  const int synced = fsync(fd);
+  close(fd);
+  if (synced != 0) return ErrnoStatus(absl::StrCat("cannot fsync ", dir.string()));
+  return absl::OkStatus();
+}
+
+std::string RevisionFile(int64_t number) { return absl::StrFormat("r%012d.records", number); }
+
+// The revision number of a file name "r{number}.records", or -1.
+int64_t RevisionNumberOf(const std::string& name) {
+  constexpr std::string_view kSuffix = ".records";
+  if (name.size() <= 1 + kSuffix.size() || name[0] != 'r' || !name.ends_with(kSuffix)) return -1;
+  int64_t number = 0;
+  if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - kSuffix.size()), &number)) return -1;
+  return number > 0 ? number : -1;
+}
+
+// Writes `payloads` as the record file `dir/name` through a temporary file: durable and
+// atomic. The directory itself is not synced (the caller does, once per change).
+absl::Status WriteRecordFile(const fs::path& dir, const std::string& name,
+                             const std::vector<std::string>& payloads) {
+  const fs::path tmp = dir / (name + ".tmp");
+  SG_ASSIGN_OR_RETURN(RecordWriter writer, RecordWriter::Create(tmp.string()));
+  for (const std::string& payload : payloads) SG_RETURN_IF_ERROR(writer.Append(payload));
+  SG_RETURN_IF_ERROR(writer.Close(/*sync=*/true));
+  if (std::rename(tmp.c_str(), (dir / name).c_str()) != 0) {
+    return ErrnoStatus(absl::StrCat("cannot rename ", tmp.string()));
+  }
+  return absl::OkStatus();
+}
+
+std::string Serialize(const v1::ArchiveRecord& record) { return record.SerializeAsString(); }
+
+class DirLog final : public DurableLog {
+ public:
+  DirLog(fs::path root, int lock_fd) : root_(std::move(root)), lock_fd_(lock_fd) {}
+  ~DirLog() override { close(lock_fd_); }
+
+  absl::Status WriteGrid(const StoredGrid& grid) override {
+    const fs::path grids = root_ / "grids";
+    const fs::path staging = grids / absl::StrCat(".", grid.id, ".new");
+    std::error_code error;
+    fs::remove_all(staging, error);
+    if (!fs::create_directory(staging, error)) {
+      return FsStatus(error, absl::StrCat("cannot create ", staging.string()));
+    }
+    std::vector<std::string> payloads;
+    v1::ArchiveRecord record;
+    *record.mutable_header() = EncodeGridHeader(grid, 0);
+    payloads.push_back(Serialize(record));
+    SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid, kSourceChunkValues,
+                                          [&](const v1::SourceChunk& chunk) {
+                                            v1::ArchiveRecord r;
+                                            *r.mutable_source() = chunk;
+                                            payloads.push_back(Serialize(r));
+                                            return absl::OkStatus();
+                                          }));
+    SG_RETURN_IF_ERROR(WriteRecordFile(staging, kGridFile, payloads));
+    for (const auto& revision : grid.revisions) {
+      SG_RETURN_IF_ERROR(WriteRevisionFile(staging, *revision));
+    }
+    SG_RETURN_IF_ERROR(SyncDirectory(staging));
+    if (std::rename(staging.c_str(), (grids / grid.id).c_str()) != 0) {
+      return ErrnoStatus(absl::StrCat("cannot rename ", staging.string(), " to ", grid.id));
+    }
+    return SyncDirectory(grids);
+  }
+
+  absl::Status WriteRevision(const std::string& id, const GridRevision& revision) override {
+    const fs::path dir = root_ / "grids" / id;
+    SG_RETURN_IF_ERROR(WriteRevisionFile(dir, revision));
+    return SyncDirectory(dir);
+  }
+
+  void DropRevisions(const std::string& id, const std::vector<int64_t>& numbers) override {
+    const fs::path dir = root_ / "grids" / id;
+    for (int64_t number : numbers) {
+      std::error_code error;
+      fs::remove(dir / RevisionFile(number), error);
+    }
+  }
+
+  absl::Status DeleteGrid(const std::string& id) override {
+    const fs::path trash = root_ / "trash" / absl::StrCat(id, "-", absl::ToUnixNanos(absl::Now()));
+    if (std::rename((root_ / "grids" / id).c_str(), trash.c_str()) != 0) {
+      return ErrnoStatus(absl::StrCat("cannot move grids/", id, " to the trash"));
+    }
+    SG_RETURN_IF_ERROR(SyncDirectory(root_ / "grids"));
+    std::error_code error;
+    fs::remove_all(trash, error);  // a start empties the trash if this did not finish
+    return absl::OkStatus();
+  }
+
+ private:
+  static absl::Status WriteRevisionFile(const fs::path& dir, const GridRevision& revision) {
+    v1::ArchiveRecord record;
+    EncodeRevision(revision, record.mutable_revision());
+    return WriteRecordFile(dir, RevisionFile(revision.number), {Serialize(record)});
+  }
+
+  const fs::path root_;
+  const int lock_fd_;  // flock'ed: one server per directory
+};
+
+// Moves a damaged file or grid directory to corrupt/ and says so.
+void SetAside(const fs::path& root, const fs::path& path, const absl::Status& why) {
+  const fs::path target =
+      root / "corrupt" /
+      absl::StrCat(path.parent_path().filename().string(), "-", path.filename().string(), "-",
+                   absl::ToUnixNanos(absl::Now()));
+  std::error_code error;
+  fs::rename(path, target, error);
+  std::fprintf(stderr, "splinegrid: store: %s is damaged and was skipped (moved to %s): %s\n",
+               path.string().c_str(), target.string().c_str(), std::string(why.message()).c_str());
+}
+
+// Reads one grid directory: its header and points (any fault: the whole grid is unusable), then
+// each revision (a fault skips that revision only).
+absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const fs::path& dir,
+                                                     int max_deform_revisions,
+                                                     MemoryBudget* budget) {
+  const std::string id = dir.filename().string();
+  GridAssembler assembler(budget, id);
+  {
+    SG_ASSIGN_OR_RETURN(RecordReader reader, RecordReader::Open((dir / kGridFile).string()));
+    std::string payload;
+    for (;;) {
+      SG_ASSIGN_OR_RETURN(const bool more, reader.Next(&payload));
+      if (!more) break;
+      v1::ArchiveRecord record;
+      if (!record.ParseFromString(payload) ||
+          record.record_case() == v1::ArchiveRecord::kRevision) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("record at byte ", reader.offset(), " is not a header or source chunk"));
+      }
+      SG_RETURN_IF_ERROR(assembler.Add(record));
+    }
+    if (!assembler.has_source()) {
+      return absl::InvalidArgumentError("the source points are incomplete");
+    }
+  }
+  std::vector<std::pair<int64_t, fs::path>> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".tmp")) {
+      fs::remove(entry.path());  // an unacknowledged write
+    } else if (const int64_t number = RevisionNumberOf(name); number > 0) {
+      files.emplace_back(number, entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  for (const auto& [number, path] : files) {
+    absl::Status loaded = [&]() -> absl::Status {
+      SG_ASSIGN_OR_RETURN(RecordReader reader, RecordReader::Open(path.string()));
+      std::string payload;
+      SG_ASSIGN_OR_RETURN(const bool present, reader.Next(&payload));
+      v1::ArchiveRecord record;
+      if (!present || !record.ParseFromString(payload) || !record.has_revision()) {
+        return absl::InvalidArgumentError("it holds no revision record");
+      }
+      if (record.revision().number() != number) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "it holds revision ", record.revision().number(), ", not ", number));
+      }
+      return assembler.AddRevision(record.revision());
+    }();
+    if (loaded.code() == absl::StatusCode::kResourceExhausted) return loaded;
+    if (!loaded.ok()) SetAside(root, path, loaded);
+  }
+  SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid, assembler.Finish(/*check_counts=*/false));
+  // Retention may not have finished removing files before a crash: apply it again.
+  const std::vector<int64_t> dropped = DeformRevisionsBeyond(grid->revisions, max_deform_revisions);
+  for (int64_t number : dropped) {
+    std::error_code error;
+    fs::remove(dir / RevisionFile(number), error);
+  }
+  std::erase_if(grid->revisions, [&](const std::shared_ptr<const GridRevision>& r) {
+    return std::find(dropped.begin(), dropped.end(), r->number) != dropped.end();
+  });
+  return grid;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<MemoryStore>> OpenDirStore(const std::string& path,
+                                                          int max_deform_revisions,
+                                                          MemoryBudget* budget) {
+  const fs::path root(path);
+  std::error_code error;
+  for (const char* sub : {"grids", "corrupt", "trash"}) {
+    fs::create_directories(root / sub, error);
+    if (error) return FsStatus(error, absl::StrCat("--store=dir:", path, ": cannot create ", sub));
+  }
+  const int lock_fd = open((root / "LOCK").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd < 0) return ErrnoStatus(absl::StrCat("--store=dir:", path, ": cannot open LOCK"));
+  if (flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    close(lock_fd);
+    return absl::FailedPreconditionError(absl::StrCat(
+        "--store=dir:", path, " is in use by another process (its LOCK file is locked)"));
+  }
+  fs::remove_all(root / "trash", error);
+  fs::create_directories(root / "trash", error);
+  std::vector<std::shared_ptr<const StoredGrid>> loaded;
+  for (const fs::directory_entry& entry : fs::directory_iterator(root / "grids", error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(".")) {  // a Create that did not finish
+      fs::remove_all(entry.path(), error);
+      continue;
+    }
+    absl::StatusOr<std::shared_ptr<StoredGrid>> grid =
+        LoadGrid(root, entry.path(), max_deform_revisions, budget);
+    if (grid.ok()) {
+      loaded.push_back(*std::move(grid));
+    } else if (grid.status().code() == absl::StatusCode::kResourceExhausted) {
+      close(lock_fd);
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "--store=dir:", path, ": loading grids/", name, ": ", grid.status().message()));
+    } else {
+      SetAside(root, entry.path(), grid.status());
+    }
+  }
+  if (error) {
+    close(lock_fd);
+    return FsStatus(error, absl::StrCat("--store=dir:", path, ": cannot list grids/"));
+  }
+  std::fprintf(stderr, "splinegrid: store dir:%s: %zu grids loaded\n", path.c_str(), loaded.size());
+  return std::make_unique<MemoryStore>(max_deform_revisions,
+                                       std::make_unique<DirLog>(root, lock_fd), std::move(loaded));
+}
+
+}  // namespace splinegrid::server

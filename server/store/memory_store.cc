@@ -1,0 +1,155 @@
+#include "server/store/memory_store.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+
+namespace splinegrid::server {
+
+MemoryStore::MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log,
+                         std::vector<std::shared_ptr<const StoredGrid>> loaded)
+    : max_deform_revisions_(max_deform_revisions), log_(std::move(log)) {
+  for (auto& grid : loaded) grids_.emplace(grid->id, std::move(grid));
+}
+
+std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  std::shared_ptr<std::mutex>& writer = writers_[id];
+  if (!writer) writer = std::make_shared<std::mutex>();
+  return writer;
+}
+
+absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (grids_.contains(grid->id) || creating_.contains(grid->id)) {
+      return absl::AlreadyExistsError(absl::StrCat("grids/", grid->id, " already exists"));
+    }
+    if (!log_) {
+      grids_.emplace(grid->id, std::move(grid));
+      return absl::OkStatus();
+    }
+    creating_.insert(grid->id);
+  }
+  // The source points may take a while to write: outside the lock, the id held by creating_.
+  const absl::Status written = log_->WriteGrid(*grid);
+  std::lock_guard<std::mutex> lock(mu_);
+  creating_.erase(grid->id);
+  if (written.ok()) grids_.emplace(grid->id, std::move(grid));
+  return written;
+}
+
+absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::Get(const std::string& id) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto it = grids_.find(id);
+  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+  return it->second;
+}
+
+absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::AddRevision(
+    const std::string& id, GridRevision revision, int64_t expected_latest) {
+  const std::shared_ptr<std::mutex> writer = WriterOf(id);
+  std::lock_guard<std::mutex> write(*writer);
+  auto published = std::make_shared<GridRevision>(std::move(revision));
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    const auto it = grids_.find(id);
+    if (it == grids_.end()) {
+      return absl::NotFoundError(absl::StrCat("grids/", id, " was deleted"));
+    }
+    const auto& revisions = it->second->revisions;
+    const int64_t latest = revisions.empty() ? 0 : revisions.back()->number;
+    if (expected_latest != 0 && latest != expected_latest) {
+      return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,
+                                             " is stale; the latest revision is ", latest));
+    }
+    published->number = latest + 1;
+  }
+  // Only this writer changes the grid's revisions, so the number stays free while it is written.
+  if (log_) {
+    if (absl::Status written = log_->WriteRevision(id, *published); !written.ok()) return written;
+  }
+  std::shared_ptr<const StoredGrid> replaced;  // released after the lock, with what it dropped
+  std::shared_ptr<const StoredGrid> result;
+  std::vector<int64_t> dropped;
+  SubscriptionHub::Woken woken;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    const auto it = grids_.find(id);  // Delete takes the writer lock too: still here
+    auto next = std::make_shared<StoredGrid>(*it->second);
+    next->revisions.push_back(published);
+    dropped = DeformRevisionsBeyond(next->revisions, max_deform_revisions_);
+    if (!dropped.empty()) {
+      std::erase_if(next->revisions, [&](const std::shared_ptr<const GridRevision>& r) {
+        return std::find(dropped.begin(), dropped.end(), r->number) != dropped.end();
+      });
+    }
+    replaced = std::move(it->second);
+    it->second = next;
+    result = std::move(next);
+    woken = hub_.Publish(id, RevisionSummary::Of(*published));
+  }
+  SubscriptionHub::Wake(woken);
+  if (log_ && !dropped.empty()) log_->DropRevisions(id, dropped);
+  return result;
+}
+
+absl::Status MemoryStore::Delete(const std::string& id) {
+  const std::shared_ptr<std::mutex> writer = WriterOf(id);
+  std::lock_guard<std::mutex> write(*writer);
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (!grids_.contains(id)) {
+      writers_.erase(id);
+      return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+    }
+  }
+  if (log_) {
+    if (absl::Status deleted = log_->DeleteGrid(id); !deleted.ok()) return deleted;
+  }
+  std::shared_ptr<const StoredGrid> removed;  // released after the lock
+  SubscriptionHub::Woken ended;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    const auto it = grids_.find(id);
+    removed = std::move(it->second);
+    grids_.erase(it);
+    writers_.erase(id);
+    ended = hub_.EndGrid(id);
+  }
+  SubscriptionHub::Wake(ended);
+  return absl::OkStatus();
+}
+
+absl::StatusOr<GridStore::Watch> MemoryStore::Subscribe(const std::string& id,
+                                                        std::weak_ptr<GridWatcher> watcher,
+                                                        size_t max_queued) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto it = grids_.find(id);
+  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+  const auto& revisions = it->second->revisions;
+  auto subscription = std::make_shared<GridSubscription>(
+      std::move(watcher), max_queued, revisions.empty() ? 0 : revisions.back()->number);
+  if (absl::Status added = hub_.Add(id, subscription); !added.ok()) return added;
+  return Watch{it->second, std::move(subscription)};
+}
+
+void MemoryStore::Unsubscribe(const std::string& id, const GridSubscription* subscription) {
+  hub_.Remove(id, subscription);
+}
+
+void MemoryStore::CloseSubscriptions() { SubscriptionHub::Wake(hub_.CloseAll()); }
+
+absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> MemoryStore::List(
+    const std::string& after, int limit, bool* more) {
+  std::vector<std::shared_ptr<const StoredGrid>> page;
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = grids_.upper_bound(after);
+  for (; it != grids_.end() && static_cast<int>(page.size()) < limit; ++it) {
+    page.push_back(it->second);
+  }
+  *more = it != grids_.end();
+  return page;
+}
+
+}  // namespace splinegrid::server

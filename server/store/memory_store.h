@@ -1,0 +1,72 @@
+// The embedded store: grids in this process's memory, optionally made durable by a DurableLog
+// that every change goes through before it is published (the `dir:` backend, dir_log.h).
+//
+// Adding a revision publishes a new snapshot under a short lock, so a running fit never blocks
+// readers. Writers of one grid are serialised by a per-grid mutex, held while the log writes:
+// the number is assigned, the revision written and then published, so what is on disk is
+// always a prefix of what was published, and nothing is published that is not on disk.
+#ifndef SPLINEGRID_SERVER_STORE_MEMORY_STORE_H_
+#define SPLINEGRID_SERVER_STORE_MEMORY_STORE_H_
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "server/grid_store.h"
+#include "server/store/subscription_hub.h"
+
+namespace splinegrid::server {
+
+// Where a MemoryStore writes its changes before publishing them. A failed write leaves the
+// store unchanged and fails the call.
+class DurableLog {
+ public:
+  virtual ~DurableLog() = default;
+  // A new grid: its header, source points and the revisions it has.
+  virtual absl::Status WriteGrid(const StoredGrid& grid) = 0;
+  virtual absl::Status WriteRevision(const std::string& id, const GridRevision& revision) = 0;
+  // Retention dropped `numbers` of grid `id`. Best effort: what is left behind is dropped again
+  // when the log is loaded.
+  virtual void DropRevisions(const std::string& id, const std::vector<int64_t>& numbers) = 0;
+  virtual absl::Status DeleteGrid(const std::string& id) = 0;
+};
+
+class MemoryStore final : public GridStore {
+ public:
+  // Keeps the newest `max_deform_revisions` (>= 1) deformed revisions of each grid; starts with
+  // `loaded` grids (what `log` held).
+  explicit MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log = nullptr,
+                       std::vector<std::shared_ptr<const StoredGrid>> loaded = {});
+
+  absl::Status Create(std::shared_ptr<const StoredGrid> grid) override;
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) override;
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
+      const std::string& id, GridRevision revision, int64_t expected_latest = 0) override;
+  absl::Status Delete(const std::string& id) override;
+  absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
+                                  size_t max_queued) override;
+  void Unsubscribe(const std::string& id, const GridSubscription* subscription) override;
+  void CloseSubscriptions() override;
+  absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(const std::string& after,
+                                                                      int limit,
+                                                                      bool* more) override;
+
+ private:
+  // The mutex that serialises the writers of grid `id`.
+  std::shared_ptr<std::mutex> WriterOf(const std::string& id);
+
+  const int max_deform_revisions_;
+  const std::unique_ptr<DurableLog> log_;
+  mutable std::mutex mu_;  // before the hub's
+  std::map<std::string, std::shared_ptr<const StoredGrid>> grids_;
+  std::set<std::string> creating_;  // ids whose Create is writing to the log
+  std::map<std::string, std::shared_ptr<std::mutex>> writers_;
+  SubscriptionHub hub_;
+};
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_STORE_MEMORY_STORE_H_
