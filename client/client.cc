@@ -1,8 +1,10 @@
 #include "client/client.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "third_party/grpc_health/health.grpc.pb.h"
 
 namespace splinegrid::client {
@@ -12,6 +14,86 @@ constexpr int64_t kUploadChunkBytes = 1 << 20;
 
 Extents ExtentsOf(const v1::Extents& e) { return {e.i(), e.j(), e.k()}; }
 
+// Reassembles an EvaluateGrid stream (a header, then chunks of every announced block's fields).
+class EvaluationAssembler {
+ public:
+  explicit EvaluationAssembler(const ProgressFn& progress) : progress_(progress) {}
+
+  // Takes the next message; DATA_LOSS when it does not fit what the header announced.
+  absl::Status Add(const v1::EvaluateGridResponse& message) {
+    if (message.has_header()) {
+      const v1::EvaluationHeader& h = message.header();
+      result_.revision = h.revision();
+      const int s = h.spatial_dim();
+      for (const v1::EvaluatedBlock& eb : h.blocks()) {
+        if (eb.block() >= static_cast<int>(slot_.size())) slot_.resize(eb.block() + 1, -1);
+        slot_[eb.block()] = static_cast<int>(result_.blocks.size());
+        EvaluatedBlock block{eb.block(), StructuredBlock(ExtentsOf(eb.extents()), s), {}, {}, {}};
+        if (h.derivatives()) {
+          block.du.resize(block.points.coords().size());
+          block.dv.resize(block.points.coords().size());
+          block.dw.resize(block.points.coords().size());
+        }
+        total_values_ +=
+            static_cast<int64_t>(block.points.coords().size()) * (h.derivatives() ? 4 : 1);
+        result_.blocks.push_back(std::move(block));
+      }
+      return absl::OkStatus();
+    }
+    const v1::EvaluationChunk& chunk = message.chunk();
+    if (chunk.block() < 0 || chunk.block() >= static_cast<int>(slot_.size()) ||
+        slot_[chunk.block()] < 0) {
+      return absl::DataLossError(absl::StrCat("chunk for unannounced block ", chunk.block()));
+    }
+    EvaluatedBlock& block = result_.blocks[slot_[chunk.block()]];
+    double* target = nullptr;
+    switch (chunk.field()) {
+      case v1::FIELD_POINTS:
+        target = block.points.coords().data();
+        break;
+      case v1::FIELD_DU:
+        target = block.du.data();
+        break;
+      case v1::FIELD_DV:
+        target = block.dv.data();
+        break;
+      case v1::FIELD_DW:
+        target = block.dw.data();
+        break;
+      default:
+        break;
+    }
+    const int64_t n = chunk.values_size() + chunk.float_values_size();
+    if (!target || chunk.offset() < 0 ||
+        chunk.offset() + n > static_cast<int64_t>(block.points.coords().size())) {
+      return absl::DataLossError("a chunk does not fit its block");
+    }
+    if (chunk.values_size() > 0) {
+      std::memcpy(target + chunk.offset(), chunk.values().data(), n * sizeof(double));
+    } else {
+      for (int64_t x = 0; x < n; ++x) target[chunk.offset() + x] = chunk.float_values(x);
+    }
+    received_ += n;
+    if (progress_) progress_(received_ * 8, total_values_ * 8);
+    return absl::OkStatus();
+  }
+
+  // The evaluation once the stream has ended OK; DATA_LOSS when values are missing.
+  absl::StatusOr<EvaluatedGrid> Finish() && {
+    if (received_ != total_values_) {
+      return absl::DataLossError(
+          absl::StrCat("received ", received_, " of ", total_values_, " values"));
+    }
+    return std::move(result_);
+  }
+
+ private:
+  const ProgressFn& progress_;
+  EvaluatedGrid result_;
+  std::vector<int> slot_;  // block index -> position in result_.blocks
+  int64_t total_values_ = 0, received_ = 0;
+};
+
 }  // namespace
 
 absl::Status FromGrpc(const grpc::Status& status) {
@@ -19,8 +101,28 @@ absl::Status FromGrpc(const grpc::Status& status) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
 }
 
+bool PauseBeforeRetry(grpc::Channel& channel, absl::Duration wait,
+                      const std::function<bool()>& stop) {
+  const absl::Time until = absl::Now() + wait;
+  for (absl::Time now = absl::Now(); now < until; now = absl::Now()) {
+    if (stop && stop()) return true;
+    const absl::Time slice = std::min(until, now + absl::Milliseconds(100));
+    const grpc_connectivity_state state = channel.GetState(/*try_to_connect=*/true);
+    if (state == GRPC_CHANNEL_READY) {
+      absl::SleepFor(slice - now);
+    } else {
+      channel.WaitForStateChange(state, absl::ToChronoTime(slice));
+    }
+  }
+  return stop && stop();
+}
+
 std::string GridName(const std::string& name_or_id) {
   return name_or_id.rfind("grids/", 0) == 0 ? name_or_id : absl::StrCat("grids/", name_or_id);
+}
+
+std::string GridId(const std::string& name_or_id) {
+  return name_or_id.rfind("grids/", 0) == 0 ? name_or_id.substr(6) : name_or_id;
 }
 
 Client::Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
@@ -29,39 +131,76 @@ Client::Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
 std::unique_ptr<Client> Client::Connect(const std::string& target, ClientOptions options) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(8 << 20);
+  if (options.retry.max_attempts > 1) {
+    // gRPC's own reconnect backoff starts at 1 s: a restarted server would be reached only
+    // after the retries are spent. Reconnect at the pace of the retry policy instead.
+    const auto ms = [](absl::Duration d) {
+      return static_cast<int>(std::clamp<int64_t>(absl::ToInt64Milliseconds(d), 1, 1 << 30));
+    };
+    args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, ms(options.retry.initial_backoff));
+    args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, ms(options.retry.max_backoff));
+  }
   return std::make_unique<Client>(
       grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), args), options);
 }
 
-std::unique_ptr<grpc::ClientContext> Client::NewContext() const {
+std::unique_ptr<grpc::ClientContext> Client::NewContext(absl::Time deadline,
+                                                        const std::string& grid) {
   auto context = std::make_unique<grpc::ClientContext>();
-  context->set_deadline(std::chrono::system_clock::now() +
-                        absl::ToChronoNanoseconds(options_.timeout));
+  if (deadline != absl::InfiniteFuture()) context->set_deadline(absl::ToChronoTime(deadline));
+  if (!grid.empty() &&
+      std::all_of(grid.begin(), grid.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
+    context->AddMetadata(kGridRoutingHeader, grid);
+  }
   return context;
+}
+
+absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const {
+  const absl::Time deadline = absl::Now() + options_.timeout;
+  Backoff backoff(options_.retry);
+  for (int attempts = 1;; ++attempts) {
+    auto context = NewContext(deadline, grid);
+    bool responded = false;
+    const grpc::Status status = attempt(context.get(), &responded);
+    std::optional<absl::Duration> wait;
+    if (status.error_code() == grpc::StatusCode::UNAVAILABLE && !responded) {
+      wait = backoff.Next(deadline);
+    }
+    if (!wait) {
+      absl::Status result = FromGrpc(status);
+      if (!result.ok() && attempts > 1) {
+        result = absl::Status(result.code(),
+                              absl::StrCat(result.message(), " [attempt ", attempts,
+                                           "; the earlier ones failed with UNAVAILABLE]"));
+      }
+      return result;
+    }
+    PauseBeforeRetry(*channel_, *wait);
+  }
 }
 
 absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const std::string& grid_id,
                                               const std::string& display_name, bool planar_view,
                                               const ProgressFn& progress) {
-  auto context = NewContext();
-  v1::Grid grid;
-  auto writer = stub_->ImportGrid(context.get(), &grid);
-  v1::ImportGridRequest request;
-  v1::ImportHeader* header = request.mutable_header();
+  v1::ImportGridRequest head;
+  v1::ImportHeader* header = head.mutable_header();
   header->set_grid_id(grid_id);
   header->set_display_name(display_name);
   header->mutable_plot3d()->set_total_bytes(static_cast<int64_t>(bytes.size()));
   header->mutable_plot3d()->set_planar_view(planar_view);
-  bool open = writer->Write(request);
-  for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
-    request.Clear();
-    request.set_plot3d_chunk(bytes.substr(at, kUploadChunkBytes));
-    open = writer->Write(request);
-    if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
-  }
-  writer->WritesDone();
-  const grpc::Status status = writer->Finish();
-  if (!status.ok()) return FromGrpc(status);
+  v1::Grid grid;
+  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
+    auto writer = stub_->ImportGrid(context, &grid);
+    bool open = writer->Write(head);
+    v1::ImportGridRequest request;
+    for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
+      request.set_plot3d_chunk(bytes.substr(at, kUploadChunkBytes));
+      open = writer->Write(request);
+      if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  }));
   return grid;
 }
 
@@ -70,11 +209,8 @@ absl::StatusOr<v1::Grid> Client::ImportPoints(const MultiBlockGrid& source,
                                               const std::string& display_name,
                                               const ProgressFn& progress) {
   if (source.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
-  auto context = NewContext();
-  v1::Grid grid;
-  auto writer = stub_->ImportGrid(context.get(), &grid);
-  v1::ImportGridRequest request;
-  v1::ImportHeader* header = request.mutable_header();
+  v1::ImportGridRequest head;
+  v1::ImportHeader* header = head.mutable_header();
   header->set_grid_id(grid_id);
   header->set_display_name(display_name);
   header->mutable_points()->set_spatial_dim(source.blocks.front().spatial_dim());
@@ -86,25 +222,28 @@ absl::StatusOr<v1::Grid> Client::ImportPoints(const MultiBlockGrid& source,
     e->set_k(block.extent(2));
     total += static_cast<int64_t>(block.coords().size() * sizeof(double));
   }
-  bool open = writer->Write(request);
-  int64_t done = 0;
-  constexpr int64_t kValues = kUploadChunkBytes / sizeof(double);
-  for (size_t b = 0; open && b < source.blocks.size(); ++b) {
-    const std::span<const double> coords = source.blocks[b].coords();
-    for (int64_t at = 0; open && at < static_cast<int64_t>(coords.size()); at += kValues) {
-      request.Clear();
-      v1::PointChunk* chunk = request.mutable_points();
-      chunk->set_block(static_cast<int>(b));
-      const int64_t n = std::min<int64_t>(kValues, coords.size() - at);
-      chunk->mutable_coordinates()->Assign(coords.begin() + at, coords.begin() + at + n);
-      open = writer->Write(request);
-      done += n * static_cast<int64_t>(sizeof(double));
-      if (progress) progress(done, total);
+  v1::Grid grid;
+  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
+    auto writer = stub_->ImportGrid(context, &grid);
+    bool open = writer->Write(head);
+    int64_t done = 0;
+    constexpr int64_t kValues = kUploadChunkBytes / sizeof(double);
+    v1::ImportGridRequest request;
+    for (size_t b = 0; open && b < source.blocks.size(); ++b) {
+      const std::span<const double> coords = source.blocks[b].coords();
+      for (int64_t at = 0; open && at < static_cast<int64_t>(coords.size()); at += kValues) {
+        v1::PointChunk* chunk = request.mutable_points();
+        chunk->set_block(static_cast<int>(b));
+        const int64_t n = std::min<int64_t>(kValues, coords.size() - at);
+        chunk->mutable_coordinates()->Assign(coords.begin() + at, coords.begin() + at + n);
+        open = writer->Write(request);
+        done += n * static_cast<int64_t>(sizeof(double));
+        if (progress) progress(done, total);
+      }
     }
-  }
-  writer->WritesDone();
-  const grpc::Status status = writer->Finish();
-  if (!status.ok()) return FromGrpc(status);
+    writer->WritesDone();
+    return writer->Finish();
+  }));
   return grid;
 }
 
@@ -150,35 +289,61 @@ void WatchCancel::Attach(grpc::ClientContext* context) {
   if (context_ != nullptr && cancelled_) context_->TryCancel();
 }
 
-RevisionStream::RevisionStream(std::unique_ptr<grpc::ClientContext> context,
-                               std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader,
+RevisionStream::RevisionStream(std::function<Call()> open, const RetryPolicy& retry,
+                               std::shared_ptr<grpc::Channel> channel,
                                std::shared_ptr<WatchCancel> cancel)
-    : context_(std::move(context)), reader_(std::move(reader)), cancel_(std::move(cancel)) {
-  cancel_->Attach(context_.get());
+    : open_(std::move(open)),
+      backoff_(retry),
+      channel_(std::move(channel)),
+      cancel_(std::move(cancel)) {
+  Open();
 }
 
 RevisionStream::~RevisionStream() { (void)Finish(); }
 
+void RevisionStream::Open() {
+  cancel_->Attach(nullptr);  // before the previous attempt's context goes
+  call_ = open_();
+  cancel_->Attach(call_.context.get());
+}
+
 bool RevisionStream::Next(v1::WatchGridResponse* message) {
-  if (ended_) return false;
-  if (reader_->Read(message)) return true;
-  ended_ = true;
+  while (!ended_) {
+    if (call_.reader->Read(message)) {
+      received_ = true;
+      return true;
+    }
+    ended_ = true;
+    if (received_) break;
+    // Nothing arrived yet: a call that failed with UNAVAILABLE is opened again.
+    finished_ = call_.reader->Finish();
+    if (finished_->error_code() != grpc::StatusCode::UNAVAILABLE || cancel_->cancelled()) break;
+    const std::optional<absl::Duration> wait = backoff_.Next(absl::InfiniteFuture());
+    if (!wait) break;
+    if (PauseBeforeRetry(*channel_, *wait, [&] { return cancel_->cancelled(); })) {
+      finished_ = grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+      break;
+    }
+    finished_.reset();
+    ended_ = false;
+    Open();
+  }
   return false;
 }
 
 absl::Status RevisionStream::Finish() {
   if (status_.has_value()) return *status_;
   if (!ended_) {
-    context_->TryCancel();
+    call_.context->TryCancel();
     v1::WatchGridResponse ignored;
-    while (reader_->Read(&ignored)) {
+    while (call_.reader->Read(&ignored)) {
     }
     ended_ = true;
   }
-  const grpc::Status status = reader_->Finish();
+  if (!finished_) finished_ = call_.reader->Finish();
   cancel_->Attach(nullptr);
-  status_ = FromGrpc(status);
-  if (status.error_code() == grpc::StatusCode::CANCELLED && cancel_->cancelled()) {
+  status_ = FromGrpc(*finished_);
+  if (finished_->error_code() == grpc::StatusCode::CANCELLED && cancel_->cancelled()) {
     status_ = absl::CancelledError("the watch was cancelled");
   }
   return *status_;
@@ -233,89 +398,41 @@ absl::Status Client::Delete(const std::string& name) {
 absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
                                                const ProgressFn& progress) {
   request.set_name(GridName(request.name()));
-  auto context = NewContext();
-  auto reader = stub_->EvaluateGrid(context.get(), request);
-  v1::EvaluateGridResponse message;
-  EvaluatedGrid result;
-  std::vector<int> slot;  // block index -> position in result.blocks
-  int64_t total_values = 0, received = 0;
-  int s = 3;
-  while (reader->Read(&message)) {
-    if (message.has_header()) {
-      const v1::EvaluationHeader& h = message.header();
-      result.revision = h.revision();
-      s = h.spatial_dim();
-      for (const v1::EvaluatedBlock& eb : h.blocks()) {
-        if (eb.block() >= static_cast<int>(slot.size())) slot.resize(eb.block() + 1, -1);
-        slot[eb.block()] = static_cast<int>(result.blocks.size());
-        EvaluatedBlock block{eb.block(), StructuredBlock(ExtentsOf(eb.extents()), s), {}, {}, {}};
-        if (h.derivatives()) {
-          block.du.resize(block.points.coords().size());
-          block.dv.resize(block.points.coords().size());
-          block.dw.resize(block.points.coords().size());
+  std::optional<EvaluationAssembler> assembler;
+  absl::Status malformed;  // the stream did not fit together (the call was cancelled)
+  const absl::Status status =
+      Call(GridId(request.name()), [&](grpc::ClientContext* context, bool* responded) {
+        assembler.emplace(progress);
+        auto reader = stub_->EvaluateGrid(context, request);
+        v1::EvaluateGridResponse message;
+        while (malformed.ok() && reader->Read(&message)) {
+          *responded = true;
+          malformed = assembler->Add(message);
+          if (!malformed.ok()) context->TryCancel();
         }
-        total_values +=
-            static_cast<int64_t>(block.points.coords().size()) * (h.derivatives() ? 4 : 1);
-        result.blocks.push_back(std::move(block));
-      }
-      continue;
-    }
-    const v1::EvaluationChunk& chunk = message.chunk();
-    if (chunk.block() < 0 || chunk.block() >= static_cast<int>(slot.size()) ||
-        slot[chunk.block()] < 0) {
-      context->TryCancel();
-      return absl::DataLossError(absl::StrCat("chunk for unannounced block ", chunk.block()));
-    }
-    EvaluatedBlock& block = result.blocks[slot[chunk.block()]];
-    double* target = nullptr;
-    switch (chunk.field()) {
-      case v1::FIELD_POINTS:
-        target = block.points.coords().data();
-        break;
-      case v1::FIELD_DU:
-        target = block.du.data();
-        break;
-      case v1::FIELD_DV:
-        target = block.dv.data();
-        break;
-      case v1::FIELD_DW:
-        target = block.dw.data();
-        break;
-      default:
-        break;
-    }
-    const int64_t n = chunk.values_size() + chunk.float_values_size();
-    if (!target || chunk.offset() < 0 ||
-        chunk.offset() + n > static_cast<int64_t>(block.points.coords().size())) {
-      context->TryCancel();
-      return absl::DataLossError("a chunk does not fit its block");
-    }
-    if (chunk.values_size() > 0) {
-      std::memcpy(target + chunk.offset(), chunk.values().data(), n * sizeof(double));
-    } else {
-      for (int64_t x = 0; x < n; ++x) target[chunk.offset() + x] = chunk.float_values(x);
-    }
-    received += n;
-    if (progress) progress(received * 8, total_values * 8);
-  }
-  const grpc::Status status = reader->Finish();
-  if (!status.ok()) return FromGrpc(status);
-  if (received != total_values) {
-    return absl::DataLossError(
-        absl::StrCat("received ", received, " of ", total_values, " values"));
-  }
-  return result;
+        return reader->Finish();
+      });
+  SG_RETURN_IF_ERROR(malformed);
+  SG_RETURN_IF_ERROR(status);
+  return std::move(*assembler).Finish();
 }
 
 std::unique_ptr<RevisionStream> Client::Watch(const std::string& name, int64_t after_revision,
                                               std::shared_ptr<WatchCancel> cancel) {
-  auto context = std::make_unique<grpc::ClientContext>();  // no deadline: a watch lasts
   v1::WatchGridRequest request;
   request.set_name(GridName(name));
   request.set_after_revision(after_revision);
-  auto reader = stub_->WatchGrid(context.get(), request);
   if (cancel == nullptr) cancel = std::make_shared<WatchCancel>();
-  return std::make_unique<RevisionStream>(std::move(context), std::move(reader), std::move(cancel));
+  // The stream may outlive this client: it keeps a stub of its own (sharing the channel).
+  std::shared_ptr<v1::SplineGrid::Stub> stub = v1::SplineGrid::NewStub(channel_);
+  auto open = [stub, request] {
+    RevisionStream::Call call;
+    // No deadline: a watch lasts.
+    call.context = NewContext(absl::InfiniteFuture(), GridId(request.name()));
+    call.reader = stub->WatchGrid(call.context.get(), request);
+    return call;
+  };
+  return std::make_unique<RevisionStream>(open, options_.retry, channel_, std::move(cancel));
 }
 
 absl::Status Client::Watch(const std::string& name, int64_t after_revision,
@@ -346,7 +463,7 @@ absl::StatusOr<v1::EvaluatePointsResponse> Client::EvaluatePoints(
 
 absl::StatusOr<std::string> Client::Health(const std::string& service) {
   auto stub = grpc::health::v1::Health::NewStub(channel_);
-  auto context = NewContext();
+  auto context = NewContext(absl::Now() + options_.timeout, "");  // not retried: a probe
   grpc::health::v1::HealthCheckRequest request;
   request.set_service(service);
   grpc::health::v1::HealthCheckResponse response;

@@ -12,15 +12,34 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "client/retry.h"
 #include "core/grid/structured_grid.h"
 #include "grpcpp/grpcpp.h"
 #include "splinegrid/v1/splinegrid_service.grpc.pb.h"
 
 namespace splinegrid::client {
 
+// The header naming the grid a call is about ("naca" for grids/naca), sent with every call that
+// names one (and with imports and GenerateGrid when the new id is given): a balancer in front
+// of several replicas hashes on it, so the calls about one grid go to one replica.
+inline constexpr char kGridRoutingHeader[] = "x-splinegrid-grid";
+
 struct ClientOptions {
-  // Deadline of every call, measured from its start.
+  // Deadline of every call, measured from its start; retries run within it.
   absl::Duration timeout = absl::Seconds(120);
+  // Calls that fail with UNAVAILABLE (a replica died, a balancer had no upstream, the server is
+  // restarting) are made again: every unary call, and streaming calls that fail before their
+  // first response (EvaluateGrid, ExportGrid, WatchGrid; uploads, whose only response comes at
+  // the end, are sent again whole). Health checks are not retried (a probe answers for now).
+  // The channel of Connect() also reconnects at this pace (initial/max backoff).
+  //
+  // An attempt whose answer was lost may still have been carried out, so a retried call that
+  // stores something can meet its own earlier attempt: DeformGrid with a base_revision answers
+  // ABORTED (the grid has the revision that attempt stored: ask Get with the request's `step`
+  // whether it landed, as examples/pitching.cc does); DeformGrid without base_revision, FitGrid
+  // and FairGrid may store a second revision; imports and GenerateGrid with an id answer
+  // ALREADY_EXISTS, DeleteGrid NOT_FOUND. Set retry.max_attempts = 1 to see every UNAVAILABLE.
+  RetryPolicy retry;
 };
 
 // Progress of a transfer: bytes done and the total (0 when unknown).
@@ -40,6 +59,16 @@ struct EvaluatedGrid {
 
 // "name" or "grids/name" -> "grids/name".
 std::string GridName(const std::string& name_or_id);
+// "grids/name" or "name" -> "name" (what kGridRoutingHeader carries).
+std::string GridId(const std::string& name_or_id);
+
+// What ExportGrid wrote or ImportArchive read: the archive's header and its size.
+struct ArchiveSummary {
+  v1::ArchiveHeader header;
+  int64_t source_chunks = 0;
+  int64_t revisions = 0;
+  int64_t bytes = 0;  // of the file
+};
 
 // Stops a watch (Client::Watch) from any thread, also before the call has started or after it
 // ended. Shared between the caller and the watch.
@@ -70,12 +99,17 @@ class WatchCancel {
 //
 // Next() blocks until the server sends the next revision. Cancel() (or cancel()->Cancel()) may
 // be called from any other thread while Next() blocks; the stream must outlive those calls.
-// Destroying an unfinished stream cancels the call.
+// Destroying an unfinished stream cancels the call. A call that fails with UNAVAILABLE before
+// its first message is opened again under the client's RetryPolicy (inside Next()).
 class RevisionStream {
  public:
-  RevisionStream(std::unique_ptr<grpc::ClientContext> context,
-                 std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader,
-                 std::shared_ptr<WatchCancel> cancel);
+  struct Call {
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader;
+  };
+  // `open` starts the call on `channel` (again on a retry).
+  RevisionStream(std::function<Call()> open, const RetryPolicy& retry,
+                 std::shared_ptr<grpc::Channel> channel, std::shared_ptr<WatchCancel> cancel);
   ~RevisionStream();
   RevisionStream(const RevisionStream&) = delete;
   RevisionStream& operator=(const RevisionStream&) = delete;
@@ -92,15 +126,30 @@ class RevisionStream {
   absl::Status Finish();
 
  private:
-  std::unique_ptr<grpc::ClientContext> context_;
-  std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader_;
+  // Starts the call (again).
+  void Open();
+
+  std::function<Call()> open_;
+  Backoff backoff_;
+  std::shared_ptr<grpc::Channel> channel_;
+  Call call_;
   std::shared_ptr<WatchCancel> cancel_;
+  bool received_ = false;  // a message arrived: no more retries
   bool ended_ = false;
+  std::optional<grpc::Status> finished_;  // the reader's Finish(), once called
   std::optional<absl::Status> status_;
 };
 
 // grpc::Status -> absl::Status.
 absl::Status FromGrpc(const grpc::Status& status);
+
+// Waits `wait` before the next attempt of a call on `channel`, watching the channel meanwhile:
+// gRPC takes in the outcome of a reconnection only while something waits on the channel
+// (otherwise its backup poller does, every 5 s), so a plain sleep would leave a restarted
+// server unseen for seconds. Ends early, returning true, when `stop` (checked every 100 ms)
+// says so.
+bool PauseBeforeRetry(grpc::Channel& channel, absl::Duration wait,
+                      const std::function<bool()>& stop = {});
 
 class Client {
  public:
@@ -155,25 +204,68 @@ class Client {
   absl::StatusOr<EvaluatedGrid> Evaluate(v1::EvaluateGridRequest request,
                                          const ProgressFn& progress = {});
   absl::StatusOr<v1::EvaluatePointsResponse> EvaluatePoints(v1::EvaluatePointsRequest request);
+  // Writes a grid with its source points and every revision it keeps (ExportGrid) to `path`
+  // as a record file (core/io/record_file.h) of ArchiveRecords: header, source chunks,
+  // revisions. The records go to a temporary file beside `path`, fsynced and renamed onto it
+  // when the stream is complete (its counts match the header): on any error nothing is left
+  // behind and an existing file at `path` stays as it was. `progress` gets the bytes written
+  // (total 0: unknown).
+  absl::StatusOr<ArchiveSummary> ExportGrid(const std::string& name, const std::string& path,
+                                            const ProgressFn& progress = {});
+  // Creates a grid from a record file written by ExportGrid (ImportArchive): under `new_id`,
+  // or the archive's own id when empty, with every revision under its original number. A file
+  // that is not a record file, or is damaged or truncated (a torn record, a CRC mismatch,
+  // fewer records than its header announces, a first record that is not a header), is
+  // INVALID_ARGUMENT naming the file, the record and its byte offset; found while sending, the
+  // call is cancelled, so nothing is stored. `progress` gets bytes sent of the file's size.
+  absl::StatusOr<v1::Grid> ImportArchive(const std::string& path, const std::string& new_id,
+                                         const ProgressFn& progress = {});
   // grpc.health.v1 status of `service` ("" = the whole server): "SERVING", "NOT_SERVING", ...
   absl::StatusOr<std::string> Health(const std::string& service = "");
 
   v1::SplineGrid::Stub& stub() { return *stub_; }
 
  private:
-  // A context whose deadline is options_.timeout from now.
-  std::unique_ptr<grpc::ClientContext> NewContext() const;
+  // One attempt of a call on `context`: its status; `*responded` set once a response has
+  // arrived (a streaming call is not retried past that).
+  using Attempt = std::function<grpc::Status(grpc::ClientContext* context, bool* responded)>;
 
-  // One unary call of `method` with a fresh deadline: the response, or the call's status.
+  // A context with `deadline` (InfiniteFuture: none) and, for a non-empty `grid` of printable
+  // ASCII (anything else is no grid id the server accepts), the routing header naming it.
+  static std::unique_ptr<grpc::ClientContext> NewContext(absl::Time deadline,
+                                                         const std::string& grid);
+  // Runs `attempt` on a fresh context (deadline options_.timeout from now, shared by all
+  // attempts; routing header `grid`) until it does not fail with UNAVAILABLE, has responded,
+  // or options_.retry gives up; the last attempt's status (annotated with the attempt count
+  // when there were retries).
+  absl::Status Call(const std::string& grid, const Attempt& attempt) const;
+
+  // The grid a request is about, for the routing header: the id of its `name`, else its
+  // `grid_id` (a new grid's), else none.
+  template <typename Request>
+  static std::string RoutingGrid(const Request& request) {
+    if constexpr (requires { request.name(); }) {
+      return GridId(request.name());
+    } else if constexpr (requires { request.grid_id(); }) {
+      return request.grid_id();
+    } else {
+      return "";
+    }
+  }
+
+  // One unary call of `method`, retried as Call says: the response, or the call's status.
   template <typename Request, typename Response>
   absl::StatusOr<Response> Unary(grpc::Status (v1::SplineGrid::Stub::*method)(grpc::ClientContext*,
                                                                               const Request&,
                                                                               Response*),
                                  const Request& request) const {
-    auto context = NewContext();
     Response response;
-    const grpc::Status status = (stub_.get()->*method)(context.get(), request, &response);
-    if (!status.ok()) return FromGrpc(status);
+    const absl::Status status =
+        Call(RoutingGrid(request), [&](grpc::ClientContext* context, bool*) {
+          response.Clear();
+          return (stub_.get()->*method)(context, request, &response);
+        });
+    if (!status.ok()) return status;
     return response;
   }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <optional>
@@ -26,6 +27,7 @@
 #include "core/io/file_util.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
+#include "core/io/record_file.h"
 #include "core/io/vtk.h"
 #include "core/util/status_macros.h"
 #include "server/server.h"
@@ -155,6 +157,7 @@ absl::Status Serve(const Args& args) {
   if (!args.empty()) return Usage("serve takes no arguments, only flags");
   server::ServerOptions options;
   options.address = absl::GetFlag(FLAGS_address);
+  options.store = absl::GetFlag(FLAGS_store);
   options.worker_threads = absl::GetFlag(FLAGS_threads);
   options.memory_budget_bytes = absl::GetFlag(FLAGS_memory_budget_mb) << 20;
   options.max_output_points = absl::GetFlag(FLAGS_max_output_points);
@@ -668,6 +671,53 @@ absl::Status Watch(const Args& args) {
                cancel->cancelled() ? "interrupted"
                                    : "the stream ended (the grid was deleted or the server "
                                      "stopped)");
+  return absl::OkStatus();
+}
+
+absl::Status Export(const Args& args) {
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (args.size() != 1 || out.empty()) return Usage("usage: splinegrid export NAME -o FILE.sgrid");
+  const std::string name = client::GridName(args[0]);
+  ProgressLine download("export");
+  SG_ASSIGN_OR_RETURN(const client::ArchiveSummary summary,
+                      Connect()->ExportGrid(name, out, download.callback()));
+  download.Done();
+  Print(absl::StrCat("exported ", name, " to ", out, ": ", summary.revisions, " revision(s), ",
+                     summary.source_chunks, " source chunk(s), ", summary.bytes, " bytes\n"),
+        summary.header);
+  return absl::OkStatus();
+}
+
+namespace {
+
+// Whether the file at `path` starts like a record file (an unreadable one: the import says why).
+bool LooksLikeRecordFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return true;
+  std::string start(kRecordFileMagic.size(), '\0');
+  in.read(start.data(), static_cast<std::streamsize>(start.size()));
+  return in.gcount() == static_cast<std::streamsize>(start.size()) && start == kRecordFileMagic;
+}
+
+}  // namespace
+
+absl::Status Import(const Args& args) {
+  if (args.size() != 1) return Usage("usage: splinegrid import FILE.sgrid [--name NEW]");
+  const std::string& path = args[0];
+  if (!LooksLikeRecordFile(path)) {
+    return Usage(absl::StrCat(path, " is not a splinegrid archive (a record file written by ",
+                              "`splinegrid export`); for a Plot3D grid use `splinegrid fit ",
+                              path, "`"));
+  }
+  const std::string name = absl::GetFlag(FLAGS_name);
+  ProgressLine upload("import");
+  SG_ASSIGN_OR_RETURN(
+      const v1::Grid grid,
+      Connect()->ImportArchive(path, name.empty() ? "" : client::GridId(name), upload.callback()));
+  upload.Done();
+  Print(absl::StrCat("imported ", path, " as ", grid.name(), " (", grid.revisions_size(),
+                     " revision(s))\n", FormatGrid(grid)),
+        grid);
   return absl::OkStatus();
 }
 

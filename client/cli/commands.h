@@ -29,6 +29,10 @@ absl::Status Deform(const Args& args);
 absl::Status Offset(const Args& args);
 // Prints one line per new revision of a grid (WatchGrid) until interrupted or it is deleted.
 absl::Status Watch(const Args& args);
+// Writes a grid with its source points and revisions to a .sgrid archive (ExportGrid).
+absl::Status Export(const Args& args);
+// Creates a grid from a .sgrid archive (ImportArchive), under --name or the archive's id.
+absl::Status Import(const Args& args);
 absl::Status Remove(const Args& args);
 absl::Status Health(const Args& args);
 

@@ -7,7 +7,9 @@ ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to 
 ABSL_FLAG(bool, json, false, "print results as JSON");
 ABSL_FLAG(absl::Duration, timeout, absl::Minutes(10), "deadline of each call");
 
-ABSL_FLAG(std::string, name, "", "fit/offset: id of the new grid (default: from the file name)");
+ABSL_FLAG(std::string, name, "",
+          "fit/offset: id of the new grid (default: from the file name); import: (default: the "
+          "archive's)");
 ABSL_FLAG(double, tol, 0.0, "fit: largest allowed deviation, in the grid's length unit");
 ABSL_FLAG(std::string, ctl, "", "fit: control points per direction, e.g. 24,16 or 24,16,8");
 ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
@@ -32,7 +34,8 @@ ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
 ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
 ABSL_FLAG(std::string, o, "",
-          "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv");
+          "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv; "
+          "export: the archive (.sgrid)");
 ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
 
@@ -86,6 +89,9 @@ ABSL_FLAG(std::string, service, "splinegrid.v1.SplineGrid",
           "health: service to check (empty: the whole server)");
 
 ABSL_FLAG(std::string, address, "localhost:50051", "serve: address to listen on");
+ABSL_FLAG(std::string, store, "memory",
+          "serve: where grids live: memory (default), dir:PATH (durable) or "
+          "redis://HOST:PORT[/DB] (shared by replicas)");
 ABSL_FLAG(int, threads, 0, "serve: worker threads (0: one per core)");
 ABSL_FLAG(int64_t, memory_budget_mb, 4096, "serve: memory budget for grids and work, MiB");
 ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,

@@ -67,6 +67,7 @@ ABSL_DECLARE_FLAG(int64_t, after);
 ABSL_DECLARE_FLAG(std::string, service);
 // serve
 ABSL_DECLARE_FLAG(std::string, address);
+ABSL_DECLARE_FLAG(std::string, store);
 ABSL_DECLARE_FLAG(int, threads);
 ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);
 ABSL_DECLARE_FLAG(int64_t, max_output_points);

@@ -10,6 +10,7 @@
 //   splinegrid deform NAME --rotate DEG [--about X,Y[,Z]] [--translate DX,DY[,DZ]] ...
 //   splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] ... [-o OUT]
 //   splinegrid watch NAME [--after R]
+//   splinegrid export NAME -o FILE.sgrid      splinegrid import FILE.sgrid [--name NEW]
 //   splinegrid health
 // Client commands talk to --server (default localhost:50051); --json prints JSON.
 #include <cstdio>
@@ -25,7 +26,8 @@ namespace {
 
 constexpr char kUsage[] =
     "splinegrid: structured grids as B-spline mappings.\n"
-    "  splinegrid serve [--address localhost:50051] [--threads N] [--memory_budget_mb M]\n"
+    "  splinegrid serve [--address localhost:50051] [--store memory|dir:PATH|redis://H:P[/DB]]\n"
+    "                   [--threads N] [--memory_budget_mb M]\n"
     "                   [--keep_revisions N]   (deformed revisions kept per grid, default 64)\n"
     "  splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] |\n"
     "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
@@ -47,6 +49,9 @@ constexpr char kUsage[] =
     "                  [-o OUT.{vts,x,xyz}]   an O-grid around an airfoil file (Selig or\n"
     "      Lednicer), stored and fitted (default: interpolated); -o writes it at level 0\n"
     "  splinegrid watch NAME [--after R]   one line per new revision until ^C or deletion\n"
+    "  splinegrid export NAME -o FILE.sgrid   the grid with its source and revisions (archive)\n"
+    "  splinegrid import FILE.sgrid [--name NEW]   a grid from an archive, revisions keep their\n"
+    "      numbers (a Plot3D file is not an archive: use fit)\n"
     "Client commands use --server host:port (default localhost:50051) and --json.";
 
 }  // namespace
@@ -66,7 +71,8 @@ int main(int argc, char** argv) {
       {"fair", splinegrid::cli::Fair},       {"curvature", splinegrid::cli::Curvature},
       {"airfoil", splinegrid::cli::Airfoil}, {"health", splinegrid::cli::Health},
       {"deform", splinegrid::cli::Deform},   {"watch", splinegrid::cli::Watch},
-      {"offset", splinegrid::cli::Offset}};
+      {"offset", splinegrid::cli::Offset},   {"export", splinegrid::cli::Export},
+      {"import", splinegrid::cli::Import}};
   const auto command = commands.find(positional[1]);
   if (command == commands.end()) {
     std::fprintf(stderr, "unknown command '%s'\n%s\n", positional[1], kUsage);

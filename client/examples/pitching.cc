@@ -4,26 +4,42 @@
 // tolerances by boundary kind, then runs a solver's time loop against the server: every step
 //   1. DeformGrid: the wall turned by alpha(n) = amplitude sin(2 pi n / period) about the
 //      quarter chord (0.25, 0), with reference_revision = the fit (motions are absolute, no
-//      drift), base_revision = the previous step's revision (a concurrent change is ABORTED),
-//      and the step's time and number stamped on the new revision;
+//      drift), base_revision = the last acknowledged step's revision (a concurrent change is
+//      ABORTED, so a step never forks the history), and the step's time and number stamped on
+//      the new revision;
 //   2. EvaluateGrid of that revision at refinement level 1 (what the solver would compute on);
 //   3. a client-side fold check: the signed area of every cell of the evaluated grid against
 //      its sign in the fitted grid at the same level (step 0).
 // Prints latency percentiles (p50, p90, p99, max) of the deform call, the evaluate call and the
-// whole step, and the number of folded cells; exits 1 if any cell folded or the server refused
-// a step (a fold it found itself), 2 for bad flags, 3 when the setup (import, fit) failed.
+// whole step, and the number of folded cells; exits 1 if any cell folded, the server refused
+// a step (a fold it found itself) or a step failed, 2 for bad flags, 3 when the setup (import,
+// fit) failed.
+//
+// Surviving a replica's death: every call is retried on UNAVAILABLE with backoff (--attempts,
+// the client's RetryPolicy). A DeformGrid attempt whose answer was lost may still have been
+// stored; its retry then meets base_revision and answers ABORTED. So when a deform fails with
+// anything but a fold (FAILED_PRECONDITION) or a bad request, the client asks GetGrid(step=n)
+// whether that step's revision landed and, if so, takes it as acknowledged. --acked FILE
+// records one line "step revision" per acknowledged step (flushed at once), so every
+// acknowledged revision can be checked afterwards.
 //
 //   splinegrid_pitching --server localhost:50051 --steps 100 [--amplitude 10] [--grid FILE]
+//       [--acked FILE] [--attempts N]
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/client.h"
@@ -41,6 +57,12 @@ ABSL_FLAG(std::string, grid, SPLINEGRID_SOURCE_DIR "/../shared/data/grids/n0012_
 ABSL_FLAG(std::string, name, "pitching-cpp", "grid id on the server");
 ABSL_FLAG(bool, keep, false, "keep the grid on the server");
 ABSL_FLAG(bool, quiet, false, "no line per step");
+ABSL_FLAG(std::string, acked, "",
+          "write one line 'step revision' per acknowledged step to this file (flushed per step)");
+ABSL_FLAG(int, attempts, 8,
+          "attempts per call while the server is UNAVAILABLE (8: about 5 s of backoff, enough "
+          "for a balancer to find another replica or a server to restart)");
+ABSL_FLAG(double, timeout, 120.0, "deadline of each call in seconds, retries included");
 
 namespace splinegrid {
 namespace {
@@ -84,6 +106,138 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+// The --acked file: one line "step revision" per acknowledged step, flushed at once so that a
+// killed run leaves every line it acknowledged. Without a path it records nothing.
+class AckLog {
+ public:
+  explicit AckLog(std::FILE* file) : file_(file) {}
+  ~AckLog() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  AckLog(const AckLog&) = delete;
+  AckLog& operator=(const AckLog&) = delete;
+
+  void Add(int64_t step, int64_t revision) {
+    if (file_ == nullptr) return;
+    std::fprintf(file_, "%lld %lld\n", static_cast<long long>(step),
+                 static_cast<long long>(revision));
+    std::fflush(file_);
+  }
+
+ private:
+  std::FILE* file_;
+};
+
+// What became of one step's deformation.
+struct DeformOutcome {
+  enum Kind {
+    kAcknowledged,  // stored as `revision`
+    kRefused,       // the server's fold check refused it (FAILED_PRECONDITION): not stored
+    kFailed,        // not stored (a bad request, or the server could not be reached)
+    kConflict,      // ABORTED, and not by an attempt of ours: someone else changed the grid
+  } kind;
+  int64_t revision = 0;
+  v1::DeformReport report;  // of the acknowledged revision
+  bool answered = false;    // the deform call itself answered OK (not a later GetGrid)
+  std::string note;         // what happened, for the step's line
+};
+
+// The revision stored for solver step `step` (GetGrid with step), nullopt when there is none.
+absl::StatusOr<std::optional<v1::Revision>> RevisionOfStep(client::Client& client,
+                                                           const std::string& name, int64_t step) {
+  v1::GetGridRequest request;
+  request.set_name(name);
+  request.set_step(step);
+  absl::StatusOr<v1::Grid> grid = client.Get(request);
+  if (absl::IsNotFound(grid.status())) return std::nullopt;
+  if (!grid.ok()) return grid.status();
+  if (grid->revision().origin() != v1::REVISION_ORIGIN_DEFORM || grid->revision().step() != step) {
+    return std::nullopt;
+  }
+  return grid->revision();
+}
+
+// EvaluateGrid, asked for again when the stream broke off after its first chunk (which the
+// client does not retry): a replica that dies mid-reply shows as UNAVAILABLE, or, through a
+// balancer that resets the half-sent stream, as INTERNAL "RST_STREAM". Evaluation only reads,
+// so repeating it is safe; a few attempts with growing waits cover the balancer's failover.
+absl::StatusOr<client::EvaluatedGrid> Evaluate(client::Client& client,
+                                               const v1::EvaluateGridRequest& request) {
+  absl::StatusOr<client::EvaluatedGrid> grid = client.Evaluate(request);
+  for (int attempt = 1; attempt < 5; ++attempt) {
+    const bool broken = absl::IsUnavailable(grid.status()) ||
+                        (absl::IsInternal(grid.status()) &&
+                         absl::StrContains(grid.status().message(), "RST_STREAM"));
+    if (!broken) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50 << attempt));
+    grid = client.Evaluate(request);
+  }
+  return grid;
+}
+
+// One step's DeformGrid (retried on UNAVAILABLE by the client) and, when it fails without a
+// verdict, whether one of its attempts was stored anyway:
+//   - OK: acknowledged;
+//   - FAILED_PRECONDITION (a fold), INVALID_ARGUMENT, NOT_FOUND: nothing was stored;
+//   - anything else (UNAVAILABLE after all retries, DEADLINE_EXCEEDED, ABORTED because a retry
+//     met the revision its own earlier attempt stored, ...): GetGrid(step) says whether the
+//     step's revision landed; if it did, it is acknowledged. ABORTED without one means the
+//     grid moved past `base_revision` for another reason: the newest revision is adopted when
+//     it is a deformation of this run (same reference) for an unacknowledged earlier step,
+//     whose lost attempt landed after the client gave up on it (`late`), and the step is made
+//     again on top of it; anything else is a conflict, never deformed over.
+DeformOutcome DeformStep(client::Client& client, v1::DeformGridRequest request, int64_t acked_step,
+                         std::optional<v1::Revision>* late) {
+  for (int round = 0;; ++round) {
+    absl::StatusOr<v1::DeformGridResponse> moved = client.Deform(request);
+    if (moved.ok()) {
+      return {DeformOutcome::kAcknowledged, moved->revision(), moved->report(), true, ""};
+    }
+    const absl::Status& error = moved.status();
+    if (absl::IsFailedPrecondition(error)) {
+      return {DeformOutcome::kRefused, 0, {}, false, error.ToString()};
+    }
+    if (absl::IsInvalidArgument(error) || absl::IsNotFound(error)) {
+      return {DeformOutcome::kFailed, 0, {}, false, error.ToString()};
+    }
+    absl::StatusOr<std::optional<v1::Revision>> landed =
+        RevisionOfStep(client, request.name(), request.step());
+    if (!landed.ok()) {
+      return {DeformOutcome::kFailed,
+              0,
+              {},
+              false,
+              absl::StrCat(error.ToString(),
+                           "; whether it was stored is unknown: ", landed.status().ToString())};
+    }
+    if (landed->has_value()) {
+      return {DeformOutcome::kAcknowledged, (*landed)->revision(), (*landed)->deform_report(),
+              false,
+              absl::StrCat(error.ToString(), "; its revision ", (*landed)->revision(),
+                           " had been stored: acknowledged")};
+    }
+    if (!absl::IsAborted(error)) {
+      return {DeformOutcome::kFailed, 0, {}, false, absl::StrCat(error.ToString(), "; not stored")};
+    }
+    absl::StatusOr<v1::Grid> latest = client.Get(request.name());
+    if (round == 0 && latest.ok()) {
+      const v1::Revision& r = latest->revision();
+      if (r.origin() == v1::REVISION_ORIGIN_DEFORM &&
+          r.parent_revision() == request.reference_revision() && r.step() > acked_step &&
+          r.step() < request.step()) {
+        *late = r;
+        request.set_base_revision(r.revision());
+        continue;
+      }
+    }
+    return {DeformOutcome::kConflict,
+            0,
+            {},
+            false,
+            absl::StrCat(error.ToString(), "; the grid was changed by another client")};
+  }
+}
+
 int Run() {
   const int steps = absl::GetFlag(FLAGS_steps);
   const double amplitude = absl::GetFlag(FLAGS_amplitude);
@@ -94,7 +248,23 @@ int Run() {
     std::fprintf(stderr, "--steps must be >= 1, --level >= 0 and --amplitude finite\n");
     return 2;
   }
-  auto client = client::Client::Connect(absl::GetFlag(FLAGS_server));
+  client::ClientOptions options;
+  options.retry.max_attempts = absl::GetFlag(FLAGS_attempts);
+  options.timeout = absl::Seconds(absl::GetFlag(FLAGS_timeout));
+  if (options.retry.max_attempts < 1 || !(absl::GetFlag(FLAGS_timeout) > 0.0)) {
+    std::fprintf(stderr, "--attempts must be >= 1 and --timeout positive\n");
+    return 2;
+  }
+  std::FILE* acked_file = nullptr;
+  if (const std::string path = absl::GetFlag(FLAGS_acked); !path.empty()) {
+    acked_file = std::fopen(path.c_str(), "w");
+    if (acked_file == nullptr) {
+      std::fprintf(stderr, "--acked %s: %s\n", path.c_str(), std::strerror(errno));
+      return 2;
+    }
+  }
+  AckLog acked(acked_file);
+  auto client = client::Client::Connect(absl::GetFlag(FLAGS_server), options);
   const std::string name = client::GridName(absl::GetFlag(FLAGS_name));
 
   // Setup: import (2D view of the two-plane file) and fit to the tolerances by kind.
@@ -126,7 +296,7 @@ int Run() {
   evaluate.set_name(name);
   evaluate.set_refinement_level(level);
   evaluate.set_revision(fit->revision());
-  absl::StatusOr<client::EvaluatedGrid> start = client->Evaluate(evaluate);
+  absl::StatusOr<client::EvaluatedGrid> start = Evaluate(*client, evaluate);
   if (!start.ok()) {
     std::fprintf(stderr, "evaluate: %s\n", start.status().ToString().c_str());
     return 3;
@@ -139,7 +309,10 @@ int Run() {
 
   std::vector<double> deform_ms, server_ms, evaluate_ms, step_ms;
   int64_t folded_cells = 0, refused = 0, failed = 0;
+  // The base of every deformation: the last acknowledged revision (the fit's at first). A step
+  // whose deformation was not stored leaves it, so the next step still builds on it.
   int64_t previous = fit->revision();
+  int64_t acked_step = 0;
   for (int n = 1; n <= steps; ++n) {
     const double alpha = amplitude * std::sin(2.0 * kPi * n / period);
     const auto step_start = std::chrono::steady_clock::now();
@@ -153,19 +326,32 @@ int Run() {
     deform.mutable_rigid()->set_angle_degrees(alpha);
     deform.mutable_rigid()->add_center(0.25);
     deform.mutable_rigid()->add_center(0.0);
-    absl::StatusOr<v1::DeformGridResponse> moved = client->Deform(deform);
+    std::optional<v1::Revision> late;
+    const DeformOutcome outcome = DeformStep(*client, deform, acked_step, &late);
     deform_ms.push_back(MillisecondsSince(step_start));
-    if (!moved.ok()) {
-      std::printf("step %d alpha %.3f: %s\n", n, alpha, moved.status().ToString().c_str());
-      (absl::IsFailedPrecondition(moved.status()) ? refused : failed) += 1;
+    if (late.has_value()) {
+      std::printf("step %d: the revision %d of step %d had been stored after all: acknowledged\n",
+                  n, static_cast<int>(late->revision()), static_cast<int>(late->step()));
+      acked.Add(late->step(), late->revision());
+      previous = late->revision();
+      acked_step = late->step();
+    }
+    if (outcome.kind != DeformOutcome::kAcknowledged) {
+      std::printf("step %d alpha %.3f: %s\n", n, alpha, outcome.note.c_str());
+      (outcome.kind == DeformOutcome::kRefused ? refused : failed) += 1;
+      if (outcome.kind == DeformOutcome::kConflict) break;  // never deform over someone else
       continue;
     }
-    server_ms.push_back(1e3 * moved->report().seconds());
-    previous = moved->revision();
+    if (!outcome.note.empty())
+      std::printf("step %d alpha %.3f: %s\n", n, alpha, outcome.note.c_str());
+    acked.Add(n, outcome.revision);
+    previous = outcome.revision;
+    acked_step = n;
+    if (outcome.answered) server_ms.push_back(1e3 * outcome.report.seconds());
 
     const auto evaluate_start = std::chrono::steady_clock::now();
-    evaluate.set_revision(moved->revision());
-    absl::StatusOr<client::EvaluatedGrid> grid = client->Evaluate(evaluate);
+    evaluate.set_revision(outcome.revision);
+    absl::StatusOr<client::EvaluatedGrid> grid = Evaluate(*client, evaluate);
     evaluate_ms.push_back(MillisecondsSince(evaluate_start));
     if (!grid.ok()) {
       std::printf("step %d: evaluate: %s\n", n, grid.status().ToString().c_str());
@@ -188,8 +374,8 @@ int Run() {
       std::printf(
           "step %3d t %.3f alpha %8.3f revision %4d min Jacobian ratio %.4f "
           "deform %7.3f ms evaluate %7.3f ms folds %d\n",
-          n, deform.time(), alpha, static_cast<int>(moved->revision()),
-          moved->report().min_jacobian_ratio(), deform_ms.back(), evaluate_ms.back(),
+          n, deform.time(), alpha, static_cast<int>(outcome.revision),
+          outcome.report.min_jacobian_ratio(), deform_ms.back(), evaluate_ms.back(),
           static_cast<int>(folds));
     }
   }

@@ -9,17 +9,22 @@
 
 The generated stubs live in ``splinegrid.v1`` (built next to this package by the
 ``splinegrid_python`` CMake target, so ``BUILD/python`` is the PYTHONPATH). See ``client`` for
-the conventions (names, array layout, deadlines, errors).
+the conventions (names, array layout, deadlines, retries, routing, errors);
+``splinegrid.records`` reads and writes the framed record files of ``.sgrid`` archives
+(``Client.export_grid`` / ``Client.import_archive``).
 """
 
 from splinegrid.client import (  # __all__: the public names, listed once in client.py
     __all__,
+    GRID_ROUTING_HEADER,
     SERVICE,
+    ArchiveSummary,
     BoundaryPoints,
     Client,
     EvaluatedBlock,
     EvaluatedGrid,
     EvaluatedPoints,
+    RetryPolicy,
     RevisionWatch,
     SplinegridError,
     WallCurvatureLine,

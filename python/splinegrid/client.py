@@ -15,7 +15,25 @@ Arrays
 
 Deadlines
     Every call gets a deadline of ``timeout`` seconds from its start (each page of ``list``,
-    each attempt of ``import_plot3d`` and each batch of ``evaluate_points`` separately).
+    each upload of ``import_plot3d`` and each batch of ``evaluate_points`` separately); its
+    retries run within it.
+
+Retries
+    A call that fails with UNAVAILABLE (a replica died, a balancer had no upstream, the server
+    is restarting) is made again after a growing, jittered wait (:class:`RetryPolicy`): every
+    unary call, and streaming calls that fail before their first response (``evaluate``,
+    ``export_grid``, ``watch``; uploads, whose only response comes at the end, are sent again
+    whole). ``health`` is not retried. An attempt whose answer was lost may still have been
+    carried out, so a retried call that stores something can meet its own earlier attempt:
+    ``deform`` with a ``base_revision`` answers ABORTED (ask ``get(name, step=...)`` whether
+    the step landed, as ``examples/pitching.py`` does); ``deform`` without one, ``fit`` and
+    ``fair`` may store a second revision; imports and ``generate`` with an id answer
+    ALREADY_EXISTS, ``delete`` NOT_FOUND. ``RetryPolicy(max_attempts=1)`` turns retrying off.
+
+Routing
+    Every call about a grid carries the metadata ``x-splinegrid-grid: <id>`` (the name
+    without ``grids/``; for imports and ``generate`` the requested id, when given), which a
+    balancer in front of several replicas hashes on.
 
 Errors
     A failed call raises :class:`SplinegridError`, which keeps the gRPC status code name (e.g.
@@ -38,9 +56,12 @@ import collections.abc
 import contextlib
 import math
 import os
+import random
 import threading
+import time
 from dataclasses import dataclass
-from typing import (Any, Iterable, Iterator, Mapping, NamedTuple, Optional, Sequence, Union)
+from typing import (Any, Callable, Iterable, Iterator, Mapping, NamedTuple, Optional, Sequence,
+                    TypeVar, Union)
 
 import grpc
 import numpy as np
@@ -48,17 +69,22 @@ import numpy.typing as npt
 from google.protobuf.message import Message
 
 from splinegrid import _wire
+from splinegrid import records
+from splinegrid.v1 import archive_pb2
 from splinegrid.v1 import grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
 __all__ = [
+    "GRID_ROUTING_HEADER",
     "SERVICE",
+    "ArchiveSummary",
     "BoundaryPoints",
     "Client",
     "EvaluatedBlock",
     "EvaluatedGrid",
     "EvaluatedPoints",
+    "RetryPolicy",
     "RevisionWatch",
     "SplinegridError",
     "WallCurvatureLine",
@@ -66,11 +92,13 @@ __all__ = [
 ]
 
 SERVICE = "splinegrid.v1.SplineGrid"
+GRID_ROUTING_HEADER = "x-splinegrid-grid"  # the grid a call is about, for a balancer to hash on
 UPLOAD_CHUNK_BYTES = 1 << 20  # Plot3D bytes or point coordinates per upload message
 MAX_RECEIVE_BYTES = 8 << 20
 LIST_PAGE_SIZE = 500
 POINTS_BATCH_BYTES = 3 << 20  # EvaluatePoints request or response size per call
 
+_T = TypeVar("_T")
 PathOrBytes = Union[str, "os.PathLike[str]", bytes, bytearray, memoryview]
 Triple = Sequence[int]  # (i, j) or (i, j, k)
 Blocks = Union[None, int, Iterable[int]]
@@ -126,6 +154,47 @@ class SplinegridError(grpc.RpcError):
         code = error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
         details = error.details() if hasattr(error, "details") else str(error)
         return cls(code.name, details or "")
+
+
+@dataclass(frozen=True)
+class RetryPolicy:
+    """When and how often a call that failed with UNAVAILABLE is made again (the C++ client's
+    ``RetryPolicy``). The n-th retry waits ``min(initial_backoff * multiplier**(n-1),
+    max_backoff)`` seconds, scaled by a random factor uniform in ``[1 - jitter, 1 + jitter]``;
+    a wait that would end at or past the call's deadline is not taken (the call raises its last
+    error). The defaults wait about 0.05, 0.1, 0.2, 0.4 s: a call gives up after ~0.75 s of
+    UNAVAILABLE."""
+
+    max_attempts: int = 5          # attempts in all, the first included; 1 turns retrying off
+    initial_backoff: float = 0.05  # seconds before the first retry
+    max_backoff: float = 2.0       # longest wait between two attempts (before jitter)
+    multiplier: float = 2.0        # growth of the wait per retry
+    jitter: float = 0.2            # relative spread of each wait, in [0, 1]
+
+    def __post_init__(self) -> None:
+        if self.max_attempts < 1:
+            raise ValueError(f"max_attempts = {self.max_attempts}; must be at least 1")
+        if not (self.initial_backoff >= 0 and self.max_backoff >= 0 and self.multiplier >= 1
+                and 0 <= self.jitter <= 1):
+            raise ValueError(f"{self}: backoffs must be >= 0, multiplier >= 1, jitter in "
+                             "[0, 1]")
+
+    def waits(self) -> Iterator[float]:
+        """The waits before the 2nd, 3rd, ... attempt (``max_attempts - 1`` of them)."""
+        backoff = self.initial_backoff
+        for _ in range(self.max_attempts - 1):
+            yield min(backoff, self.max_backoff) * random.uniform(1 - self.jitter,
+                                                                  1 + self.jitter)
+            backoff = min(backoff * self.multiplier, self.max_backoff)
+
+
+class ArchiveSummary(NamedTuple):
+    """What :meth:`Client.export_grid` wrote: the archive's header (an ``ArchiveHeader``
+    proto), its source chunk and revision records, and the file's size in bytes."""
+    header: Any
+    source_chunks: int
+    revisions: int
+    bytes: int
 
 
 @dataclass
@@ -185,30 +254,50 @@ class RevisionWatch(collections.abc.Generator):
     collection) cancels the call; ``cancel()`` does the same from any other thread, and a
     ``next()`` blocked there then ends the iteration (StopIteration). A failed call raises
     :class:`SplinegridError` (e.g. ``NOT_FOUND``; ``UNIMPLEMENTED`` from a server without
-    WatchGrid). ``name`` is the grid's resource name.
+    WatchGrid). ``name`` is the grid's resource name. A call that fails with UNAVAILABLE
+    before its first message is opened again under ``retry`` (inside ``next()``).
     """
 
-    def __init__(self, call: Any, name: str) -> None:
-        self._call = call
+    def __init__(self, open_call: Callable[[], Any], name: str,
+                 retry: Optional[RetryPolicy] = None,
+                 pause: Optional[Callable[[float, threading.Event], bool]] = None) -> None:
+        self._open = open_call
+        self._pause = pause or (lambda wait, stop: stop.wait(wait))
+        self._waits = (retry or RetryPolicy(max_attempts=1)).waits()
+        self._received = False  # a message arrived: no more retries
         self.name = name
         self._cancelled = threading.Event()
         self._done = False
+        self._call = open_call()
 
     def send(self, value: object) -> grid_pb2.RevisionInfo:
         """The next revision (``value`` is ignored, as for ``next()``)."""
-        if self._done:
-            raise StopIteration
-        try:
-            message = next(self._call)
-        except StopIteration:
-            self._done = True
-            raise
-        except grpc.RpcError as error:
-            self._done = True
-            if self._cancelled.is_set() and error.code() == grpc.StatusCode.CANCELLED:
-                raise StopIteration from None
-            raise SplinegridError.from_rpc_error(error) from error
-        return message.revision
+        while True:
+            if self._done:
+                raise StopIteration
+            try:
+                message = next(self._call)
+            except StopIteration:
+                self._done = True
+                raise
+            except grpc.RpcError as error:
+                if (_code(error) == grpc.StatusCode.UNAVAILABLE and not self._received
+                        and not self._cancelled.is_set()):
+                    wait = next(self._waits, None)
+                    if wait is not None:
+                        if self._pause(wait, self._cancelled):  # cancelled while waiting
+                            self._done = True
+                            raise StopIteration from None
+                        self._call = self._open()
+                        if self._cancelled.is_set():  # cancel() raced with the reopening
+                            self._call.cancel()
+                        continue
+                self._done = True
+                if self._cancelled.is_set() and _code(error) == grpc.StatusCode.CANCELLED:
+                    raise StopIteration from None
+                raise SplinegridError.from_rpc_error(error) from error
+            self._received = True
+            return message.revision
 
     def throw(self, typ: Any, val: Any = None, tb: Any = None) -> grid_pb2.RevisionInfo:
         """Cancels the call and raises the exception (a generator that does not catch it)."""
@@ -264,17 +353,28 @@ class Client:
     """A connection to a splinegrid server (an insecure channel to ``target``).
 
     Use it as a context manager, or call :meth:`close`. ``timeout`` is the deadline of every
-    call in seconds. ``stub`` is the generated ``SplineGridStub`` for anything not wrapped here
-    (its calls get neither deadlines nor error translation).
+    call in seconds; ``retry`` says how calls failing with UNAVAILABLE are retried within it
+    (see the module's "Retries"; the channel also reconnects at that pace). ``stub`` is the
+    generated ``SplineGridStub`` for anything not wrapped here (its calls get neither
+    deadlines, retries, routing header nor error translation).
     """
 
-    def __init__(self, target: str = "localhost:50051", timeout: float = 120.0) -> None:
+    def __init__(self, target: str = "localhost:50051", timeout: float = 120.0,
+                 retry: Optional[RetryPolicy] = None) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout = {timeout}; must be positive")
         self.target = target
         self.timeout = timeout
-        self._channel = grpc.insecure_channel(
-            target, options=[("grpc.max_receive_message_length", MAX_RECEIVE_BYTES)])
+        self.retry = RetryPolicy() if retry is None else retry
+        options = [("grpc.max_receive_message_length", MAX_RECEIVE_BYTES)]
+        if self.retry.max_attempts > 1:
+            # gRPC's own reconnect backoff starts at 1 s: a restarted server would be reached
+            # only after the retries are spent. Reconnect at the retry policy's pace instead.
+            options += [("grpc.initial_reconnect_backoff_ms",
+                         max(1, int(self.retry.initial_backoff * 1000))),
+                        ("grpc.max_reconnect_backoff_ms",
+                         max(1, int(self.retry.max_backoff * 1000)))]
+        self._channel = grpc.insecure_channel(target, options=options)
         self.stub = service_grpc.SplineGridStub(self._channel)
         # The bulk methods exchange hand-encoded bytes (see _wire) instead of generated classes.
         self._import_grid = self._channel.stream_unary(
@@ -289,6 +389,13 @@ class Client:
         self._health_check = self._channel.unary_unary(
             "/grpc.health.v1.Health/Check", request_serializer=_encode_health_request,
             response_deserializer=_decode_health_response)
+        # Archives pass as raw ArchiveRecord bytes (the payloads of the record file).
+        self._export_grid = self._channel.unary_stream(
+            f"/{SERVICE}/ExportGrid", request_serializer=_serialize,
+            response_deserializer=_export_record_bytes)
+        self._import_archive = self._channel.stream_unary(
+            f"/{SERVICE}/ImportArchive", request_serializer=_serialize,
+            response_deserializer=grid_pb2.Grid.FromString)
 
     def close(self) -> None:
         self._channel.close()
@@ -298,6 +405,68 @@ class Client:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+    # Calls: deadline, routing header, retries, error translation
+
+    def _call(self, attempt: Callable[[_Attempt], _T], grid: str = "") -> _T:
+        """Runs ``attempt`` (one try of a call, given its timeout and metadata) until it does not
+        fail with UNAVAILABLE, it has responded (``_Attempt.responded``: a stream is not
+        retried past its first message), or ``self.retry`` gives up; all attempts share the
+        deadline ``self.timeout`` from now. grpc.RpcError -> SplinegridError (chained; the
+        message says the attempt when there were retries)."""
+        deadline = time.monotonic() + self.timeout
+        metadata = _routing_metadata(grid)
+        waits = self.retry.waits()
+        attempts = 0
+        while True:
+            attempts += 1
+            state = _Attempt(max(deadline - time.monotonic(), 1e-3), metadata)
+            try:
+                return attempt(state)
+            except SplinegridError:
+                raise
+            except grpc.RpcError as error:
+                wait = None
+                if _code(error) == grpc.StatusCode.UNAVAILABLE and not state.responded:
+                    wait = next(waits, None)
+                if wait is None or time.monotonic() + wait >= deadline:
+                    translated = SplinegridError.from_rpc_error(error)
+                    if attempts > 1:
+                        translated = SplinegridError(
+                            translated.code, f"{translated.message} [attempt {attempts}; the "
+                            "earlier ones failed with UNAVAILABLE]")
+                    raise translated from error
+            self._pause_before_retry(wait)
+
+    def _pause_before_retry(self, wait: float, stop: Optional[threading.Event] = None) -> bool:
+        """Waits ``wait`` seconds before the next attempt of a call, with a health check that
+        waits for the channel to be connected meanwhile: gRPC takes in the outcome of a
+        reconnection only while a call waits on the channel (otherwise its backup poller does,
+        every 5 s), so a plain sleep would leave a restarted server unseen for seconds. Ends
+        early, returning True, when ``stop`` is set."""
+        until = time.monotonic() + wait
+        probe = self._health_check.future("", timeout=wait, wait_for_ready=True)
+        try:
+            while not probe.done() and time.monotonic() < until:
+                if stop is not None and stop.is_set():
+                    return True
+                with contextlib.suppress(grpc.FutureTimeoutError):
+                    probe.exception(timeout=min(0.1, max(0.0, until - time.monotonic())))
+        finally:
+            probe.cancel()
+        left = max(0.0, until - time.monotonic())
+        if stop is not None:
+            return stop.wait(left)
+        time.sleep(left)
+        return False
+
+    def _unary(self, method: Callable[..., _T], request: Union[bytes, Message],
+               grid: Optional[str] = None) -> _T:
+        """One unary call with :meth:`_call`; ``grid`` (default: the request's) routes it."""
+        if grid is None:
+            grid = _routing_grid(request)
+        return self._call(lambda a: method(request, timeout=a.timeout, metadata=a.metadata),
+                          grid)
 
     # Import
 
@@ -338,8 +507,8 @@ class Client:
                 # ImportGridRequest.plot3d_chunk (field 2), without copying into a message.
                 yield _wire.length_delimited(2, data[at:at + UPLOAD_CHUNK_BYTES].tobytes())
 
-        with _translated_errors():
-            return self._import_grid(requests(), timeout=self.timeout)
+        return self._call(lambda a: self._import_grid(requests(), timeout=a.timeout,
+                                                      metadata=a.metadata), header.grid_id)
 
     def import_points(self, blocks: Sequence[npt.ArrayLike], grid_id: str = "",
                       display_name: str = "") -> grid_pb2.Grid:
@@ -373,8 +542,8 @@ class Client:
                     chunk = prefix + _wire.packed_doubles(2, flat[at:at + values_per_chunk])
                     yield _wire.length_delimited(3, chunk)
 
-        with _translated_errors():
-            return self._import_grid(requests(), timeout=self.timeout)
+        return self._call(lambda a: self._import_grid(requests(), timeout=a.timeout,
+                                                      metadata=a.metadata), header.grid_id)
 
     # Fit and the grid resource
 
@@ -406,8 +575,7 @@ class Client:
         spec = _fit_spec(control_counts, tolerance, order, max_controls, boundary_tolerances,
                          fairing)
         request = service_pb2.FitGridRequest(name=grid_name(name), spec=spec)
-        with _translated_errors():
-            return self.stub.FitGrid(request, timeout=self.timeout)
+        return self._unary(self.stub.FitGrid, request)
 
     def fair(self, name: str, revision: int = 0,
              fairing: Union[None, str, float] = None) -> service_pb2.FitGridResponse:
@@ -420,8 +588,7 @@ class Client:
         request = service_pb2.FairGridRequest(name=grid_name(name), revision=revision)
         if fairing is not None:
             request.fairing.CopyFrom(_fairing(fairing))
-        with _translated_errors():
-            return self.stub.FairGrid(request, timeout=self.timeout)
+        return self._unary(self.stub.FairGrid, request)
 
     def generate(self, name: str = "", airfoil: Union[None, str, bytes,
                                                       "os.PathLike[str]"] = None,
@@ -506,8 +673,7 @@ class Client:
                                             boundary_tolerances, fairing))
             if not request.spec.HasField("resolution"):
                 request.spec.boundary_tolerances.SetInParent()
-        with _translated_errors():
-            return self.stub.GenerateGrid(request, timeout=self.timeout)
+        return self._unary(self.stub.GenerateGrid, request)
 
     def wall_curvature(self, name: str, revision: int = 0, level: int = 2,
                        blocks: Blocks = None) -> list[WallCurvatureLine]:
@@ -516,8 +682,7 @@ class Client:
         request = service_pb2.GetWallCurvatureRequest(
             name=grid_name(name), revision=revision, refinement_level=level,
             blocks=_block_list(blocks))
-        with _translated_errors():
-            response = self.stub.GetWallCurvature(request, timeout=self.timeout)
+        response = self._unary(self.stub.GetWallCurvature, request)
         dim = response.spatial_dim
         return [WallCurvatureLine(
             block=line.block, direction=line.direction,
@@ -536,25 +701,21 @@ class Client:
             name=grid_name(name), revision=revision, blocks=list(blocks),
             view=service_pb2.GRID_VIEW_FULL if full else service_pb2.GRID_VIEW_BASIC)
         _set_step(request, revision, step)
-        with _translated_errors():
-            return self.stub.GetGrid(request, timeout=self.timeout)
+        return self._unary(self.stub.GetGrid, request)
 
     def list(self) -> list[grid_pb2.Grid]:
         """Every grid (BASIC view), ordered by name, following the pages."""
         grids: list[grid_pb2.Grid] = []
         request = service_pb2.ListGridsRequest(page_size=LIST_PAGE_SIZE)
-        with _translated_errors():
-            while True:
-                response = self.stub.ListGrids(request, timeout=self.timeout)
-                grids.extend(response.grids)
-                if not response.next_page_token:
-                    return grids
-                request.page_token = response.next_page_token
+        while True:
+            response = self._unary(self.stub.ListGrids, request)
+            grids.extend(response.grids)
+            if not response.next_page_token:
+                return grids
+            request.page_token = response.next_page_token
 
     def delete(self, name: str) -> None:
-        with _translated_errors():
-            self.stub.DeleteGrid(service_pb2.DeleteGridRequest(name=grid_name(name)),
-                                 timeout=self.timeout)
+        self._unary(self.stub.DeleteGrid, service_pb2.DeleteGridRequest(name=grid_name(name)))
 
     # Deformation (fluid-structure coupling)
 
@@ -697,8 +858,7 @@ class Client:
                     displacements=bool(item.displacements))
             if not request.boundary_points.ranges:
                 raise ValueError("boundary_points is empty")
-        with _translated_errors():
-            return self.stub.DeformGrid(request, timeout=self.timeout)
+        return self._unary(self.stub.DeformGrid, request)
 
     def watch(self, name: str, after_revision: int = 0) -> RevisionWatch:
         """The grid's revisions as they are stored (WatchGrid): a generator of
@@ -717,9 +877,9 @@ class Client:
         if after < -1:
             raise ValueError(f"after_revision = {after_revision}; must be >= -1")
         request = service_pb2.WatchGridRequest(name=grid_name(name), after_revision=after)
-        with _translated_errors():
-            call = self.stub.WatchGrid(request)
-        return RevisionWatch(call, request.name)
+        metadata = _routing_metadata(_routing_grid(request))
+        return RevisionWatch(lambda: self.stub.WatchGrid(request, metadata=metadata),
+                             request.name, self.retry, self._pause_before_retry)
 
     # Evaluation
 
@@ -766,13 +926,15 @@ class Client:
             begin, end = index_box
             request.index_box.begin.CopyFrom(_extents(begin, "index_box begin", fill=0))
             request.index_box.end.CopyFrom(_extents(end, "index_box end", fill=0))
-        with _translated_errors():
-            call = self._evaluate_grid(request, timeout=self.timeout)
+        def attempt(a: _Attempt) -> EvaluatedGrid:
+            call = self._evaluate_grid(request, timeout=a.timeout, metadata=a.metadata)
             try:
-                return _assemble(call, out_dtype)
+                return _assemble(a.marking(call), out_dtype)
             except SplinegridError:
                 call.cancel()
                 raise
+
+        return self._call(attempt, _routing_grid(request))
 
     def evaluate_points(self, name: str, params: npt.ArrayLike,
                         blocks: Union[int, npt.ArrayLike] = 0, derivatives: bool = False,
@@ -801,34 +963,242 @@ class Client:
         per_point = max(29, 3 * (4 if derivatives else 1) * 9)
         batch = max(1, POINTS_BATCH_BYTES // per_point)
         parts: list[EvaluatedPoints] = []
-        with _translated_errors():
-            for at in range(0, max(len(uvw), 1), batch):
-                head = service_pb2.EvaluatePointsRequest(
-                    name=grid_name(name), revision=revision, derivatives=derivatives,
-                    blocks=(block_array if block_array.size == 1
-                            else block_array[at:at + batch]).tolist())
-                if step is not None and not parts:  # later batches: the first's revision
-                    head.step = int(step)
-                request = head.SerializeToString() + _wire.packed_doubles(  # + parameters
-                    4, uvw[at:at + batch])
-                parts.append(self._evaluate_points(request, timeout=self.timeout))
-                revision = parts[0].revision
+        for at in range(0, max(len(uvw), 1), batch):
+            head = service_pb2.EvaluatePointsRequest(
+                name=grid_name(name), revision=revision, derivatives=derivatives,
+                blocks=(block_array if block_array.size == 1
+                        else block_array[at:at + batch]).tolist())
+            if step is not None and not parts:  # later batches: the first's revision
+                head.step = int(step)
+            request = head.SerializeToString() + _wire.packed_doubles(  # + parameters
+                4, uvw[at:at + batch])
+            parts.append(self._unary(self._evaluate_points, request, _routing_grid(head)))
+            revision = parts[0].revision
         if len(parts) == 1:
             return parts[0]
         joined = {f: np.concatenate([getattr(part, f) for part in parts])
                   for f in (("points", "du", "dv", "dw") if derivatives else ("points",))}
         return EvaluatedPoints(revision, **joined)
 
+    # Archives
+
+    def export_grid(self, name: str, path: Union[str, "os.PathLike[str]"]) -> ArchiveSummary:
+        """Writes the grid with its source points and every revision it keeps (ExportGrid) to
+        ``path`` as a record file of ``ArchiveRecord`` payloads (header, source chunks,
+        revisions; the framing of :mod:`splinegrid.records`, the C++ client's and
+        ``splinegrid export``'s). The records go to a temporary file beside ``path``, fsynced
+        and renamed onto it once the stream is complete (its counts match the header): on any
+        error nothing is left behind and an existing file stays as it was. An inconsistent
+        stream raises :class:`SplinegridError` ``DATA_LOSS``."""
+        request = service_pb2.ExportGridRequest(name=grid_name(name))
+        path = os.fspath(path)
+        temp = f"{path}.partial-{os.getpid()}"
+        try:
+            with records.RecordWriter(temp) as writer:
+                def attempt(a: _Attempt) -> _ArchiveShape:
+                    shape = _ArchiveShape(lambda what: _data_loss(
+                        f"the export of {request.name}: {what}"))
+                    call = self._export_grid(request, timeout=a.timeout, metadata=a.metadata)
+                    try:
+                        for payload in a.marking(call):
+                            shape.add(payload)
+                            writer.append(payload)
+                    except BaseException:
+                        call.cancel()
+                        raise
+                    shape.complete()
+                    return shape
+
+                shape = self._call(attempt, _routing_grid(request))
+            os.replace(temp, path)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.remove(temp)
+            raise
+        _sync_directory(os.path.dirname(path))
+        return shape.summary(os.path.getsize(path))
+
+    def import_archive(self, path: Union[str, "os.PathLike[str]"],
+                       name: Optional[str] = None) -> grid_pb2.Grid:
+        """Creates a grid from a record file written by :meth:`export_grid` (or the C++ client,
+        or ``splinegrid export``): under ``name`` ("foo" or "grids/foo"), or the archive's own
+        id when None, with every revision under its original number (ImportArchive). Returns
+        the grid (BASIC view).
+
+        A file that is not a record file, or is damaged or truncated (a torn record, a CRC
+        mismatch, fewer records than its header announces, a first record that is not a
+        header), raises :class:`splinegrid.records.RecordFileError` (a ``ValueError``) naming
+        the file, the record and its byte offset; found while sending, the call is cancelled
+        first, so nothing is stored.
+        """
+        path = os.fspath(path)
+        new_id = _grid_id(name or "")
+
+        def fault(what: str) -> records.RecordFileError:
+            return records.RecordFileError(f"'{path}': {what}", path)
+
+        # The header first: a file that is not an archive is refused before any call, and the
+        # archive's id routes the call when no new one is given.
+        with records.RecordReader(path) as reader:
+            first = next(reader, None)
+        shape = _ArchiveShape(fault)
+        if first is None:
+            shape.complete()
+        shape.add(first)
+
+        def attempt(a: _Attempt) -> grid_pb2.Grid:
+            started = threading.Event()
+            failure: list[Exception] = []
+            box: dict[str, Any] = {}
+
+            def requests() -> Iterator[bytes]:
+                started.wait()
+                try:
+                    shape = _ArchiveShape(fault)
+                    with records.RecordReader(path) as reader:
+                        for payload in reader:
+                            shape.add(payload)
+                            # ImportArchiveRequest: grid_id (1, first message only), record (2).
+                            message = _wire.length_delimited(2, payload)
+                            if reader.record == 1 and new_id:
+                                message = _wire.length_delimited(1, new_id.encode()) + message
+                            yield message
+                    shape.complete()
+                except (records.RecordFileError, OSError) as error:
+                    failure.append(error)
+                    box["call"].cancel()  # before the stream ends: nothing is stored
+
+            box["call"] = self._import_archive.future(requests(), timeout=a.timeout,
+                                                      metadata=a.metadata)
+            started.set()
+            try:
+                return box["call"].result()
+            except (grpc.RpcError, grpc.FutureCancelledError):
+                if failure:
+                    raise failure[0] from None
+                raise
+
+        return self._call(attempt, new_id or shape.header.id)
+
     # Health
 
     def health(self, service: str = SERVICE) -> str:
         """The grpc.health.v1 status of ``service`` ("" = the whole server): "SERVING",
         "NOT_SERVING", ... A service the server does not know raises NOT_FOUND."""
-        with _translated_errors():
+        with _translated_errors():  # not retried: a probe answers for now
             return self._health_check(service, timeout=self.timeout)
 
 
 # Helpers
+
+
+class _Attempt:
+    """One try of a call: its ``timeout`` (what is left of the call's deadline), its
+    ``metadata``, and whether a response has arrived (``responded``; see ``marking``)."""
+
+    __slots__ = ("timeout", "metadata", "responded")
+
+    def __init__(self, timeout: float, metadata: Optional[tuple]) -> None:
+        self.timeout = timeout
+        self.metadata = metadata
+        self.responded = False
+
+    def marking(self, messages: Iterable[_T]) -> Iterator[_T]:
+        """``messages`` passed through, setting ``responded`` at the first."""
+        for message in messages:
+            self.responded = True
+            yield message
+
+
+def _code(error: grpc.RpcError) -> grpc.StatusCode:
+    return error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
+
+
+def _routing_grid(request: Union[bytes, Message]) -> str:
+    """The grid a request is about: the id of its ``name``, else its ``grid_id`` (a new
+    grid's), else none."""
+    if isinstance(request, Message):
+        fields = request.DESCRIPTOR.fields_by_name
+        if "name" in fields:
+            return _grid_id(request.name)
+        if "grid_id" in fields:
+            return request.grid_id
+    return ""
+
+
+def _routing_metadata(grid: str) -> Optional[tuple]:
+    """The routing header naming ``grid`` (none for no grid, or an id that is not printable
+    ASCII, which the server refuses anyway)."""
+    grid = _grid_id(grid)
+    if not grid or not (grid.isascii() and grid.isprintable()):
+        return None
+    return ((GRID_ROUTING_HEADER, grid),)
+
+
+class _ArchiveShape:
+    """Checks the shape of an archive as its records (serialized ``ArchiveRecord`` payloads)
+    pass: a header first and only there, then as many source chunks and revisions as the
+    header announces. ``fault`` makes the exception to raise from a description."""
+
+    def __init__(self, fault: Callable[[str], Exception]) -> None:
+        self._fault = fault
+        self.header = archive_pb2.ArchiveHeader()
+        self.records = self.source_chunks = self.revisions = 0
+
+    def add(self, payload: bytes) -> None:
+        self.records += 1
+        try:
+            kinds = [number for number, _, _ in _wire.fields(payload)]
+        except ValueError:
+            kinds = None
+        if kinds is None or not kinds:
+            raise self._fault(f"record {self.records - 1} is not an archive record")
+        kind = kinds[-1]  # the oneof's last field wins
+        if self.records == 1:
+            if kind != 1:
+                raise self._fault("the first record is not an archive header (is this an "
+                                  "archive?)")
+            self.header = archive_pb2.ArchiveRecord.FromString(payload).header
+        elif kind == 1:
+            raise self._fault(f"record {self.records - 1} is a second header")
+        elif kind == 2:
+            self.source_chunks += 1
+        elif kind == 3:
+            self.revisions += 1
+
+    def complete(self) -> None:
+        """After the last record: the counts match the header (revisions only when it counts
+        them, as an export's does)."""
+        if self.records == 0:
+            raise self._fault("no records (an archive starts with its header)")
+        h = self.header
+        if (self.source_chunks != h.num_source_chunks
+                or (h.num_revisions > 0 and self.revisions != h.num_revisions)):
+            raise self._fault(f"truncated or incomplete: the header announces "
+                              f"{h.num_source_chunks} source chunks and {h.num_revisions} "
+                              f"revisions, there are {self.source_chunks} and {self.revisions}")
+
+    def summary(self, size: int) -> ArchiveSummary:
+        return ArchiveSummary(self.header, self.source_chunks, self.revisions, size)
+
+
+def _export_record_bytes(data: bytes) -> bytes:
+    """An ExportGridResponse's ``record`` (field 1) as raw ArchiveRecord bytes."""
+    record = b""
+    for number, wire_type, value in _wire.fields(data):
+        if number == 1 and wire_type == _wire.LENGTH_DELIMITED:
+            record += bytes(value)  # repeated occurrences of a message field merge
+    return record
+
+
+def _sync_directory(directory: str) -> None:
+    """Makes a rename into ``directory`` durable (best effort)."""
+    with contextlib.suppress(OSError):
+        fd = os.open(directory or ".", os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
 
 
 @contextlib.contextmanager

@@ -12,11 +12,15 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
@@ -73,16 +77,27 @@ class EndToEndTest : public ::testing::Test {
     dir_ = std::filesystem::temp_directory_path() / absl::StrCat("splinegrid-e2e-", getpid());
     std::filesystem::create_directories(dir_);
     log_ = (dir_ / "server.log").string();
+    ASSERT_NO_FATAL_FAILURE(StartServer());
+  }
+
+  // Starts `splinegrid serve` on port_ with `flags` (the server's log appended to log_) and
+  // waits until it is healthy.
+  void StartServer(const std::vector<std::string>& flags = {}) {
+    stopped_ = false;
     server_ = fork();
     if (server_ == 0) {
-      freopen(log_.c_str(), "w", stderr);
-      const std::string address = absl::StrCat("--address=127.0.0.1:", port_);
-      execl(kBinary.c_str(), kBinary.c_str(), "serve", address.c_str(), "--threads=2",
-            static_cast<char*>(nullptr));
+      freopen(log_.c_str(), "a", stderr);
+      std::vector<std::string> args = {kBinary, "serve",
+                                       absl::StrCat("--address=127.0.0.1:", port_), "--threads=2"};
+      args.insert(args.end(), flags.begin(), flags.end());
+      std::vector<char*> argv;
+      for (std::string& arg : args) argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(kBinary.c_str(), argv.data());
       _exit(127);
     }
     for (int i = 0; i < 100; ++i) {
-      if (Cli("health").exit_code == 0) return;
+      if (Cli("health --timeout=1s").exit_code == 0) return;
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     FAIL() << "the server did not become healthy:\n" << ReadLog();
@@ -95,10 +110,10 @@ class EndToEndTest : public ::testing::Test {
     std::filesystem::remove_all(dir_);
   }
 
-  // SIGTERM and the server's exit code.
-  int Stop() {
+  // `signal` (SIGTERM: a clean stop) and the server's exit code (-1 when killed).
+  int Stop(int signal = SIGTERM) {
     stopped_ = true;
-    kill(server_, SIGTERM);
+    kill(server_, signal);
     int status = 0;
     waitpid(server_, &status, 0);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -113,6 +128,43 @@ class EndToEndTest : public ::testing::Test {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+  }
+
+  // A grid `name` with a fitted, a faired and a deformed revision (step 4) of the coarse
+  // NACA 0012 C-grid.
+  void MakeGridWithRevisions(const std::string& name) {
+    const Result fit = Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+                                        " --name=", name, " --kinds"));
+    ASSERT_EQ(fit.exit_code, 0) << fit.out;
+    const Result fair = Cli(absl::StrCat("fair ", name));
+    ASSERT_EQ(fair.exit_code, 0) << fair.out;
+    const Result deform = Cli(absl::StrCat(
+        "deform ", name, " --rotate=4 --about=0.25,0 --reference=1 --base=2 --time=0.4 --step=4"));
+    ASSERT_EQ(deform.exit_code, 0) << deform.out;
+  }
+
+  // The `step revision` lines of a pitching client's --acked file.
+  static std::vector<std::pair<int, int64_t>> ReadAcked(const std::string& path) {
+    std::vector<std::pair<int, int64_t>> acked;
+    std::istringstream lines(ReadFileToString(path).value_or(""));
+    int step = 0;
+    int64_t revision = 0;
+    while (lines >> step >> revision) acked.emplace_back(step, revision);
+    return acked;
+  }
+
+  // Every acknowledged step's revision is stored with its step.
+  void ExpectAckedRevisionsStored(const std::string& name, const std::string& acked_path,
+                                  int steps) {
+    const std::vector<std::pair<int, int64_t>> acked = ReadAcked(acked_path);
+    ASSERT_EQ(static_cast<int>(acked.size()), steps) << ReadFileToString(acked_path).value_or("");
+    for (int n = 1; n <= steps; ++n) {
+      EXPECT_EQ(acked[n - 1].first, n);
+      const Result get = Cli(absl::StrCat("get ", name, " --step=", n));
+      ASSERT_EQ(get.exit_code, 0) << get.out;
+      EXPECT_THAT(get.out, HasSubstr(absl::StrCat("  revision ", acked[n - 1].second, " of ")));
+      EXPECT_THAT(get.out, HasSubstr(absl::StrCat(", step ", n, "\n")));
+    }
   }
 
   int port_ = 0;
@@ -424,31 +476,256 @@ TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) 
   EXPECT_THAT(unknown.out, HasSubstr("NOT_FOUND"));
 }
 
+TEST_F(EndToEndTest, CliExportRemoveImportGivesByteIdenticalEvaluations) {
+  ASSERT_NO_FATAL_FAILURE(MakeGridWithRevisions("naca"));
+  // The evaluations to compare: the latest (deformed) revision, the fit, the step.
+  const std::vector<std::string> evals = {"--level=1", "--revision=1 --level=0",
+                                          "--step=4 --res=57,17"};
+  const auto evaluate = [&](const std::string& name, const std::string& tag) {
+    std::vector<std::string> files;
+    for (size_t e = 0; e < evals.size(); ++e) {
+      const std::string out = (dir_ / absl::StrCat(name, "-", tag, "-", e, ".xyz")).string();
+      const Result eval = Cli(absl::StrCat("eval ", name, " ", evals[e], " -o ", out));
+      EXPECT_EQ(eval.exit_code, 0) << eval.out;
+      files.push_back(ReadFileToString(out).value_or(""));
+    }
+    return files;
+  };
+  const std::vector<std::string> before = evaluate("naca", "before");
+  const std::string get_before = Cli("get naca").out;
+
+  const std::string archive = (dir_ / "naca.sgrid").string();
+  const Result exported = Cli(absl::StrCat("export naca -o ", archive));
+  ASSERT_EQ(exported.exit_code, 0) << exported.out;
+  EXPECT_THAT(exported.out,
+              HasSubstr(absl::StrCat("exported grids/naca to ", archive, ": 3 ", "revision(s), ")));
+  EXPECT_EQ(ReadFileToString(archive).value().rfind("splinegrid-records\n", 0), 0u);
+  ASSERT_EQ(Cli("rm naca").exit_code, 0);
+  EXPECT_EQ(Cli("get naca").exit_code, 1);
+
+  const Result imported = Cli(absl::StrCat("import ", archive));
+  ASSERT_EQ(imported.exit_code, 0) << imported.out;
+  EXPECT_THAT(imported.out,
+              HasSubstr(absl::StrCat("imported ", archive, " as grids/naca (3 revision(s))")));
+  EXPECT_THAT(imported.out, HasSubstr("revision 3 of 3"));
+  const std::vector<std::string> after = evaluate("naca", "after");
+  for (size_t e = 0; e < evals.size(); ++e) {
+    EXPECT_FALSE(before[e].empty());
+    EXPECT_TRUE(after[e] == before[e]) << "eval " << evals[e] << " differs after the round trip";
+  }
+  EXPECT_EQ(Cli("get naca").out, get_before);
+
+  // Under a new name, next to the original; the archive's own name is taken now.
+  const Result copy = Cli(absl::StrCat("import ", archive, " --name=copy"));
+  ASSERT_EQ(copy.exit_code, 0) << copy.out;
+  EXPECT_THAT(copy.out, HasSubstr("as grids/copy (3 revision(s))"));
+  EXPECT_TRUE(evaluate("copy", "copy") == before);
+  const Result taken = Cli(absl::StrCat("import ", archive));
+  EXPECT_EQ(taken.exit_code, 1) << taken.out;
+  EXPECT_THAT(taken.out, HasSubstr("ALREADY_EXISTS"));
+
+  const Result usage = Cli("export naca");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_THAT(usage.out, HasSubstr("usage: splinegrid export NAME -o FILE.sgrid"));
+  const Result unknown = Cli(absl::StrCat("export nope -o ", (dir_ / "nope.sgrid").string()));
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_THAT(unknown.out, HasSubstr("NOT_FOUND"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "nope.sgrid"));
+}
+
+TEST_F(EndToEndTest, CliImportOfADamagedFileFailsAndStoresNothing) {
+  ASSERT_NO_FATAL_FAILURE(MakeGridWithRevisions("naca"));
+  const std::string archive = (dir_ / "naca.sgrid").string();
+  ASSERT_EQ(Cli(absl::StrCat("export naca -o ", archive)).exit_code, 0);
+  const std::string whole = ReadFileToString(archive).value();
+  const std::string list_before = Cli("list").out;
+
+  // Cut in half: the file ends inside a record.
+  const std::string half = (dir_ / "half.sgrid").string();
+  ASSERT_TRUE(WriteFileAtomically(half, whole.substr(0, whole.size() / 2)).ok());
+  const Result cut = Cli(absl::StrCat("import ", half, " --name=half"));
+  EXPECT_NE(cut.exit_code, 0) << cut.out;
+  EXPECT_THAT(cut.out, HasSubstr(absl::StrCat("record file '", half, "': record ")));
+  EXPECT_THAT(cut.out, HasSubstr("truncated record"));
+  // A damaged byte in the last record.
+  std::string flipped = whole;
+  flipped[flipped.size() - 3] ^= 0x10;
+  const std::string damaged = (dir_ / "damaged.sgrid").string();
+  ASSERT_TRUE(WriteFileAtomically(damaged, flipped).ok());
+  const Result crc = Cli(absl::StrCat("import ", damaged, " --name=damaged"));
+  EXPECT_NE(crc.exit_code, 0) << crc.out;
+  EXPECT_THAT(crc.out, HasSubstr("CRC mismatch"));
+  // A Plot3D file is not an archive: the tool says what to do instead.
+  const std::string plot3d = SharedData("grids/n0012_113-33.p2dfmt");
+  const Result grid = Cli(absl::StrCat("import ", plot3d));
+  EXPECT_EQ(grid.exit_code, 2) << grid.out;
+  EXPECT_THAT(grid.out, HasSubstr(absl::StrCat(plot3d, " is not a splinegrid archive")));
+  EXPECT_THAT(grid.out, HasSubstr(absl::StrCat("use `splinegrid fit ", plot3d, "`")));
+
+  EXPECT_EQ(Cli("list").out, list_before);  // nothing stored
+}
+
+TEST_F(EndToEndTest, ArchivesMoveBetweenTheCppAndPythonClients) {
+  ASSERT_NO_FATAL_FAILURE(MakeGridWithRevisions("naca"));
+  const std::string from_cpp = (dir_ / "cpp.sgrid").string();
+  const std::string from_python = (dir_ / "python.sgrid").string();
+  ASSERT_EQ(Cli(absl::StrCat("export naca -o ", from_cpp)).exit_code, 0);
+  // Python imports the C++ client's file and exports its copy; both files hold the same
+  // records (the same grid, the same revisions).
+  const std::string script = (dir_ / "archives.py").string();
+  ASSERT_TRUE(WriteFileAtomically(script, R"(
+import sys
+from splinegrid import Client, records
+
+server, from_cpp, from_python = sys.argv[1:4]
+with Client(server) as client:
+    grid = client.import_archive(from_cpp, name="py-copy")
+    print("imported", grid.name, len(grid.revisions))
+    summary = client.export_grid("py-copy", from_python)
+    print("exported", summary.revisions, "revisions", summary.source_chunks, "chunks")
+    a, b = list(records.read_records(from_cpp)), list(records.read_records(from_python))
+    print("records", len(a), len(b), "same after the header", a[1:] == b[1:])
+)")
+                  .ok());
+  const Result python =
+      RunCommand(absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ",
+                              script, " 127.0.0.1:", port_, " ", from_cpp, " ", from_python));
+  ASSERT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("imported grids/py-copy 3"));
+  EXPECT_THAT(python.out, HasSubstr("exported 3 revisions"));
+  EXPECT_THAT(python.out, HasSubstr("same after the header True"));
+  // The C++ client imports the Python client's file.
+  const Result imported = Cli(absl::StrCat("import ", from_python, " --name=cpp-copy"));
+  ASSERT_EQ(imported.exit_code, 0) << imported.out;
+  EXPECT_THAT(imported.out, HasSubstr("as grids/cpp-copy (3 revision(s))"));
+  std::vector<std::string> evaluations;
+  for (const char* name : {"naca", "py-copy", "cpp-copy"}) {
+    const std::string out = (dir_ / absl::StrCat(name, ".xyz")).string();
+    ASSERT_EQ(Cli(absl::StrCat("eval ", name, " --level=1 -o ", out)).exit_code, 0);
+    evaluations.push_back(ReadFileToString(out).value());
+  }
+  EXPECT_TRUE(evaluations[1] == evaluations[0]);
+  EXPECT_TRUE(evaluations[2] == evaluations[0]);
+}
+
 TEST_F(EndToEndTest, CppPitchingExampleRunsWithoutFolds) {
+  const std::string acked = (dir_ / "cpp.acked").string();
   const Result run = RunCommand(absl::StrCat(
       SPLINEGRID_BINARY_DIR, "/splinegrid_pitching --server=127.0.0.1:", port_,
-      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt")));
+      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt"),
+      " --acked=", acked, " --keep"));
   ASSERT_EQ(run.exit_code, 0) << run.out;
+  ExpectAckedRevisionsStored("pitching-cpp", acked, 10);
+  ASSERT_EQ(Cli("rm pitching-cpp").exit_code, 0);
   EXPECT_THAT(run.out, HasSubstr("p50       p90       p99       max"));
   EXPECT_THAT(run.out, HasSubstr("  deform "));
   EXPECT_THAT(run.out, HasSubstr("  evaluate "));
   EXPECT_THAT(run.out, HasSubstr("  step "));
   EXPECT_THAT(run.out, HasSubstr("step  10 "));
   EXPECT_THAT(run.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused"));
-  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));  // deleted at the end
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));
+  // Without --keep the grid is deleted at the end.
+  ASSERT_EQ(RunCommand(absl::StrCat(SPLINEGRID_BINARY_DIR,
+                                    "/splinegrid_pitching --quiet --steps=2 --server=127.0.0.1:",
+                                    port_, " --grid=", SharedData("grids/n0012_pitch_257x129.fmt")))
+                .exit_code,
+            0);
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));
 }
 
 TEST_F(EndToEndTest, PythonPitchingExampleRunsWithoutFolds) {
+  const std::string acked = (dir_ / "python.acked").string();
   const Result python = RunCommand(absl::StrCat(
       "PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
       "/python/examples/pitching.py --server=127.0.0.1:", port_,
-      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt")));
+      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt"),
+      " --acked=", acked, " --keep"));
   ASSERT_EQ(python.exit_code, 0) << python.out;
+  ExpectAckedRevisionsStored("pitching-py", acked, 10);
   EXPECT_THAT(python.out, HasSubstr("p50       p90       p99       max"));
   EXPECT_THAT(python.out, HasSubstr("  deform "));
   EXPECT_THAT(python.out, HasSubstr("  evaluate "));
   EXPECT_THAT(python.out, HasSubstr("step  10 "));
   EXPECT_THAT(python.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused"));
+}
+
+TEST_F(EndToEndTest, PitchingClientsAcknowledgeStepsWhoseAnswersWereLost) {
+  // Through a proxy that loses DeformGrid answers after the server stored them, refuses calls
+  // with UNAVAILABLE and breaks evaluations off: every step is still acknowledged exactly once,
+  // with the revision the server stored for it.
+  const std::string port_file = (dir_ / "proxy.port").string();
+  const Result started =
+      RunCommand(absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ",
+                              kSource, "/tests/e2e/fault_proxy.py 127.0.0.1:", port_, " ",
+                              port_file, " > ", (dir_ / "proxy.log").string(), " 2>&1 & echo $!"));
+  const pid_t proxy = std::atoi(started.out.c_str());
+  ASSERT_GT(proxy, 0) << started.out;
+  std::string proxy_port;
+  for (int i = 0; i < 200 && proxy_port.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    proxy_port = ReadFileToString(port_file).value_or("");
+  }
+  ASSERT_FALSE(proxy_port.empty()) << ReadFileToString((dir_ / "proxy.log").string()).value_or("");
+  const std::string through = absl::StrCat(" --server=127.0.0.1:", proxy_port,
+                                           " --steps=12 --amplitude=20 --quiet --keep --grid=",
+                                           SharedData("grids/n0012_pitch_257x129.fmt"));
+  const std::string cpp_acked = (dir_ / "cpp.acked").string();
+  const Result cpp = RunCommand(
+      absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching", through, " --acked=", cpp_acked));
+  const std::string python_acked = (dir_ / "python.acked").string();
+  const Result python = RunCommand(
+      absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
+                   "/python/examples/pitching.py", through, " --acked=", python_acked));
+  kill(proxy, SIGTERM);
+  for (const auto& [run, name, acked] : {std::tuple(cpp, "pitching-cpp", cpp_acked),
+                                         std::tuple(python, "pitching-py", python_acked)}) {
+    ASSERT_EQ(run.exit_code, 0) << run.out;
+    EXPECT_THAT(run.out, HasSubstr("had been stored: acknowledged"));
+    EXPECT_THAT(run.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused "
+                                   "by the server, 0 failed"));
+    ExpectAckedRevisionsStored(name, acked, 12);
+    // One deformed revision per step: nothing was stored twice.
+    EXPECT_THAT(Cli(absl::StrCat("get ", name)).out, HasSubstr(" of 13: "));
+  }
+}
+
+TEST_F(EndToEndTest, PitchingClientsSurviveAServerKilledAndRestartedWithADurableStore) {
+  // The server keeps its grids in a directory; SIGKILLed in the middle of a coupling run and
+  // started again, it is reached by the retries (the channel reconnects while they wait), and
+  // every step the client acknowledged is stored with its revision.
+  const std::vector<std::string> flags = {absl::StrCat("--store=dir:", (dir_ / "store").string()),
+                                          "--keep_revisions=1000"};
+  ASSERT_EQ(Stop(), 0);
+  ASSERT_NO_FATAL_FAILURE(StartServer(flags));
+  constexpr int kSteps = 60;
+  const std::string common = absl::StrCat(
+      " --server=127.0.0.1:", port_, " --steps=", kSteps,
+      " --amplitude=10 --quiet --keep --grid=", SharedData("grids/n0012_pitch_257x129.fmt"));
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"pitching-cpp", absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching", common)},
+      {"pitching-py",
+       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
+                    "/python/examples/pitching.py", common)}};
+  for (const auto& [name, command] : runs) {
+    const std::string acked = (dir_ / absl::StrCat(name, ".acked")).string();
+    Result run;
+    std::thread client([&] { run = RunCommand(absl::StrCat(command, " --acked=", acked)); });
+    int lines = 0;
+    for (int i = 0; i < 600 && lines < kSteps / 3; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      lines = static_cast<int>(ReadAcked(acked).size());
+    }
+    EXPECT_GE(lines, kSteps / 3) << "the run did not get going";
+    Stop(SIGKILL);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ASSERT_NO_FATAL_FAILURE(StartServer(flags));
+    client.join();
+    ASSERT_EQ(run.exit_code, 0) << name << ":\n" << run.out;
+    EXPECT_THAT(run.out, HasSubstr("0 steps refused by the server, 0 failed"));
+    ExpectAckedRevisionsStored(name, acked, kSteps);
+    EXPECT_THAT(Cli(absl::StrCat("get ", name)).out,
+                HasSubstr(absl::StrCat(" of ", kSteps + 1, ": ")));
+  }
 }
 
 TEST_F(EndToEndTest, SigtermDrainsAndExitsZeroWithOneLogLinePerCall) {

@@ -140,7 +140,9 @@ TEST_F(DirStoreCrashTest, EveryAcknowledgedRevisionSurvivesSigkill) {
         << "revision " << revision << " differs after the restart";
   }
   // The one in flight, if it reached the disk, is whole: it evaluates.
-  if (numbers.back() > acked.rbegin()->first) EXPECT_FALSE(Evaluation(*client, numbers.back()).empty());
+  if (numbers.back() > acked.rbegin()->first) {
+    EXPECT_FALSE(Evaluation(*client, numbers.back()).empty());
+  }
   // Nothing damaged was found, nothing temporary was left.
   EXPECT_THAT(server_->ReadLog(), ::testing::Not(::testing::HasSubstr("damaged")));
   for (const auto& entry : fs::recursive_directory_iterator(dir_ / "store" / "grids")) {

@@ -1,0 +1,273 @@
+"""The Python client's calls against an in-process fake SplineGrid server: retries of
+UNAVAILABLE (unary, before a stream's first message, within the deadline), the routing header,
+and export/import of archives (framing, a damaged file cancels the upload)."""
+
+import threading
+import time
+from concurrent import futures
+
+import grpc
+import pytest
+
+from splinegrid import Client, RetryPolicy, SplinegridError, records
+from splinegrid.v1 import archive_pb2, grid_pb2
+from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
+from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
+
+FAST = RetryPolicy(max_attempts=4, initial_backoff=0.01, max_backoff=0.02)
+
+
+class FakeSplineGrid(service_grpc.SplineGridServicer):
+    """Fails the first ``failures[method]`` calls of a method with UNAVAILABLE, records the
+    routing header of every call, and keeps imported archives."""
+
+    def __init__(self):
+        self.failures = {}
+        self.calls = {}
+        self.routing = {}
+        self.archive = []        # ArchiveRecords of ExportGrid
+        self.imported = None     # (grid_id, [record bytes]) of the last complete ImportArchive
+        self.import_ended = threading.Event()
+        self.import_outcome = None
+
+    def _enter(self, method, context):
+        self.calls[method] = self.calls.get(method, 0) + 1
+        self.routing.setdefault(method, []).append(
+            dict(context.invocation_metadata()).get("x-splinegrid-grid"))
+        if self.failures.get(method, 0) > 0:
+            self.failures[method] -= 1
+            context.abort(grpc.StatusCode.UNAVAILABLE, "no upstream")
+
+    def GetGrid(self, request, context):
+        self._enter("GetGrid", context)
+        if request.name == "grids/stale":
+            context.abort(grpc.StatusCode.ABORTED, "stale")
+        return grid_pb2.Grid(name=request.name, latest_revision=3)
+
+    def ListGrids(self, request, context):
+        self._enter("ListGrids", context)
+        return service_pb2.ListGridsResponse(grids=[grid_pb2.Grid(name="grids/a")])
+
+    def DeformGrid(self, request, context):
+        self._enter("DeformGrid", context)
+        return service_pb2.DeformGridResponse(revision=7)
+
+    def ImportGrid(self, request_iterator, context):
+        self._enter("ImportGrid", context)
+        header = next(request_iterator).header
+        for _ in request_iterator:
+            pass
+        return grid_pb2.Grid(name=f"grids/{header.grid_id or 'picked'}")
+
+    def EvaluateGrid(self, request, context):
+        self._enter("EvaluateGrid", context)
+        yield service_pb2.EvaluateGridResponse(header=service_pb2.EvaluationHeader(
+            revision=2, spatial_dim=2, blocks=[service_pb2.EvaluatedBlock(
+                block=0, extents=grid_pb2.Extents(i=2, j=1, k=1))]))
+        if request.name == "grids/broken":
+            context.abort(grpc.StatusCode.UNAVAILABLE, "broken off")
+        yield service_pb2.EvaluateGridResponse(chunk=service_pb2.EvaluationChunk(
+            block=0, field=service_pb2.FIELD_POINTS, offset=0, values=[0, 0, 1, 0]))
+
+    def WatchGrid(self, request, context):
+        self._enter("WatchGrid", context)
+        for revision in (1, 2):
+            yield service_pb2.WatchGridResponse(revision=grid_pb2.RevisionInfo(revision=revision))
+
+    def ExportGrid(self, request, context):
+        self._enter("ExportGrid", context)
+        for record in self.archive:
+            yield service_pb2.ExportGridResponse(record=record)
+
+    def ImportArchive(self, request_iterator, context):
+        self._enter("ImportArchive", context)
+        grid_id, payloads = None, []
+        try:
+            for request in request_iterator:
+                if grid_id is None:
+                    grid_id = request.grid_id
+                payloads.append(request.record.SerializeToString())
+        except Exception:  # the client cancelled
+            self.import_outcome = "cancelled"
+            self.import_ended.set()
+            raise
+        # A cancellation can also end the requests like a half-close: it shows in the context.
+        for _ in range(20):
+            if not context.is_active():
+                self.import_outcome = "cancelled"
+                self.import_ended.set()
+                return grid_pb2.Grid()
+            time.sleep(0.01)
+        self.import_outcome = "complete"
+        self.imported = (grid_id, payloads)
+        self.import_ended.set()
+        header = archive_pb2.ArchiveRecord.FromString(payloads[0]).header
+        return grid_pb2.Grid(name=f"grids/{grid_id or header.id}")
+
+
+@pytest.fixture
+def fake():
+    servicer = FakeSplineGrid()
+    server = grpc.server(futures.ThreadPoolExecutor(max_workers=4))
+    service_grpc.add_SplineGridServicer_to_server(servicer, server)
+    servicer.port = server.add_insecure_port("127.0.0.1:0")
+    server.start()
+    yield servicer
+    server.stop(None)
+
+
+def connect(fake, **kwargs):
+    kwargs.setdefault("retry", FAST)
+    return Client(f"127.0.0.1:{fake.port}", **kwargs)
+
+
+def test_unary_calls_retry_unavailable_and_name_their_grid(fake):
+    fake.failures["GetGrid"] = 2
+    with connect(fake) as client:
+        assert client.get("grids/naca").latest_revision == 3
+        assert client.list()[0].name == "grids/a"
+    assert fake.calls["GetGrid"] == 3
+    assert fake.routing["GetGrid"] == ["naca"] * 3
+    assert fake.routing["ListGrids"] == [None]  # no grid, no header
+
+
+def test_retries_stop_after_max_attempts_with_the_last_error(fake):
+    fake.failures["DeformGrid"] = 10
+    with connect(fake) as client:
+        with pytest.raises(SplinegridError) as error:
+            client.deform("naca", rotate_degrees=1.0)
+    assert error.value.code == "UNAVAILABLE"
+    assert "no upstream [attempt 4; the earlier ones failed with UNAVAILABLE]" in str(error.value)
+    assert fake.calls["DeformGrid"] == 4
+
+
+def test_other_errors_and_disabled_retries_make_one_attempt(fake):
+    with connect(fake) as client:
+        with pytest.raises(SplinegridError, match="ABORTED: stale$"):
+            client.get("stale")
+    assert fake.calls["GetGrid"] == 1
+    fake.failures["GetGrid"] = 1
+    with connect(fake, retry=RetryPolicy(max_attempts=1)) as client:
+        with pytest.raises(SplinegridError, match="UNAVAILABLE: no upstream$"):
+            client.get("naca")
+    assert fake.calls["GetGrid"] == 2
+
+
+def test_a_wait_past_the_deadline_is_not_taken(fake):
+    fake.failures["GetGrid"] = 10
+    slow = RetryPolicy(max_attempts=5, initial_backoff=5.0, max_backoff=5.0)
+    start = time.monotonic()
+    with connect(fake, retry=slow, timeout=1.0) as client:
+        with pytest.raises(SplinegridError, match="UNAVAILABLE"):
+            client.get("naca")
+    assert time.monotonic() - start < 1.0
+    assert fake.calls["GetGrid"] == 1
+
+
+def test_uploads_are_sent_again_whole_and_route_by_the_requested_id(fake):
+    fake.failures["ImportGrid"] = 1
+    with connect(fake) as client:
+        grid = client.import_plot3d(b"1\n2 1\n0 1\n0 0\n", grid_id="grids/new",
+                                    planar_view=False)
+        assert grid.name == "grids/new"
+        client.import_plot3d(b"1\n2 1\n0 1\n0 0\n", planar_view=False)
+    assert fake.routing["ImportGrid"] == ["new", "new", None]
+
+
+def test_a_stream_is_retried_only_before_its_first_message(fake):
+    fake.failures["EvaluateGrid"] = 2
+    with connect(fake) as client:
+        grid = client.evaluate("naca")
+        assert grid.revision == 2 and grid[0].points.shape == (1, 1, 2, 2)
+        assert fake.calls["EvaluateGrid"] == 3
+        with pytest.raises(SplinegridError, match="UNAVAILABLE: broken off$"):
+            client.evaluate("broken")
+    assert fake.calls["EvaluateGrid"] == 4
+    assert fake.routing["EvaluateGrid"] == ["naca"] * 3 + ["broken"]
+
+
+def test_a_watch_is_opened_again_before_its_first_revision(fake):
+    fake.failures["WatchGrid"] = 2
+    with connect(fake) as client:
+        with client.watch("naca") as revisions:
+            assert [info.revision for info in revisions] == [1, 2]
+    assert fake.calls["WatchGrid"] == 3
+    assert fake.routing["WatchGrid"] == ["naca"] * 3
+
+
+def archive(num_chunks=2, num_revisions=1):
+    header = archive_pb2.ArchiveHeader(format_version=1, id="naca", spatial_dim=2,
+                                       num_source_chunks=num_chunks,
+                                       num_revisions=num_revisions)
+    out = [archive_pb2.ArchiveRecord(header=header)]
+    out += [archive_pb2.ArchiveRecord(source=archive_pb2.SourceChunk(
+        block=0, first=1000 * c, coords=[float(c)] * 1000)) for c in range(num_chunks)]
+    out += [archive_pb2.ArchiveRecord(revision=archive_pb2.StoredRevision())
+            for _ in range(num_revisions)]
+    return out
+
+
+def test_export_writes_the_records_framed_and_import_streams_them_back(fake, tmp_path):
+    fake.archive = archive()
+    fake.failures["ExportGrid"] = 1
+    path = tmp_path / "naca.sgrid"
+    with connect(fake) as client:
+        summary = client.export_grid("naca", path)
+        assert (summary.header.id, summary.source_chunks, summary.revisions) == ("naca", 2, 1)
+        assert summary.bytes == path.stat().st_size
+        payloads = list(records.read_records(path))
+        assert payloads == [r.SerializeToString() for r in fake.archive]
+        assert [p.name for p in tmp_path.iterdir()] == ["naca.sgrid"]  # no temporary left
+
+        assert client.import_archive(path).name == "grids/naca"
+        assert fake.imported == ("", payloads)
+        assert client.import_archive(path, name="grids/copy").name == "grids/copy"
+        assert fake.imported == ("copy", payloads)
+    assert fake.routing["ImportArchive"] == ["naca", "copy"]
+    assert fake.routing["ExportGrid"] == ["naca", "naca"]
+
+
+def test_an_incomplete_export_stream_leaves_nothing(fake, tmp_path):
+    fake.archive = archive()[:-1]  # the header announces a revision that does not come
+    path = tmp_path / "naca.sgrid"
+    path.write_bytes(b"old")
+    with connect(fake) as client:
+        with pytest.raises(SplinegridError, match="DATA_LOSS: the export of grids/naca: "
+                           "truncated or incomplete"):
+            client.export_grid("naca", path)
+    assert [p.name for p in tmp_path.iterdir()] == ["naca.sgrid"]
+    assert path.read_bytes() == b"old"
+
+
+def test_a_damaged_archive_is_refused_before_or_while_sending(fake, tmp_path):
+    path = tmp_path / "naca.sgrid"
+    with records.RecordWriter(path) as writer:
+        for record in archive(num_chunks=40):
+            writer.append(record.SerializeToString())
+    data = path.read_bytes()
+    with connect(fake) as client:
+        # Cut in half: the records before the cut go out, then the call is cancelled.
+        path.write_bytes(data[:len(data) // 2])
+        with pytest.raises(records.RecordFileError, match="truncated record"):
+            client.import_archive(path)
+        fake.import_ended.wait(2)
+        assert fake.import_outcome != "complete" and fake.imported is None  # cancelled
+        # Cut at a record boundary: complete records, fewer than the header announces.
+        boundary = len(records.MAGIC) + sum(8 + len(r.SerializeToString())
+                                            for r in archive(num_chunks=40)[:3])
+        path.write_bytes(data[:boundary])
+        with pytest.raises(records.RecordFileError, match="truncated or incomplete: the header "
+                           "announces 40 source chunks and 1 revisions, there are 2 and 0"):
+            client.import_archive(path)
+        assert fake.imported is None
+        # Not an archive at all: refused before any call.
+        calls = fake.calls.get("ImportArchive", 0)
+        path.write_bytes(b"1\n2 1\n0 1\n0 0\n")
+        with pytest.raises(records.RecordFileError, match="is not a record file"):
+            client.import_archive(path)
+        with records.RecordWriter(path) as writer:
+            writer.append(archive()[1].SerializeToString())
+        with pytest.raises(records.RecordFileError, match="the first record is not an archive "
+                           "header"):
+            client.import_archive(path)
+        assert fake.calls.get("ImportArchive", 0) == calls
