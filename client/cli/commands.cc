@@ -706,8 +706,8 @@ absl::Status Import(const Args& args) {
   const std::string& path = args[0];
   if (!LooksLikeRecordFile(path)) {
     return Usage(absl::StrCat(path, " is not a splinegrid archive (a record file written by ",
-                              "`splinegrid export`); for a Plot3D grid use `splinegrid fit ",
-                              path, "`"));
+                              "`splinegrid export`); for a Plot3D grid use `splinegrid fit ", path,
+                              "`"));
   }
   const std::string name = absl::GetFlag(FLAGS_name);
   ProgressLine upload("import");

@@ -1,6 +1,8 @@
 // End to end: the real `splinegrid serve` on a free loopback port, driven by the CLI, the C++
 // coupling example and the Python examples, then stopped with SIGTERM (exit code 0, one log line
-// per call).
+// per call). Archives go out and back in through both clients; the coupling clients run through
+// a proxy that loses answers (fault_proxy.py) and across a SIGKILL and restart of a server with
+// a durable store.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <signal.h>
