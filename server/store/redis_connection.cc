@@ -1,6 +1,7 @@
 #include "server/store/redis_connection.h"
 
 #include <hiredis/hiredis.h>
+#include <poll.h>
 
 #include <algorithm>
 #include <cctype>
@@ -16,7 +17,8 @@ namespace {
 constexpr std::string_view kScheme = "redis://";
 
 absl::Status BadSpec(std::string_view spec, std::string_view why) {
-  return absl::InvalidArgumentError(absl::StrCat("--store = '", Absl(spec.substr(0, 200)), "': ", Absl(why),
+  return absl::InvalidArgumentError(absl::StrCat("--store = '", Absl(spec.substr(0, 200)),
+                                                 "': ", Absl(why),
                                                  "; a Redis store is redis://HOST:PORT[/DB]"));
 }
 
@@ -114,8 +116,8 @@ void RedisReply::Free::operator()(redisReply* reply) const { freeReplyObject(rep
 
 absl::Status MapRedisError(std::string_view error, const std::string& address) {
   const std::string message = absl::StrCat("Redis at ", address, ": ", Absl(error.substr(0, 300)));
-  for (std::string_view transient : {"LOADING", "READONLY", "BUSY", "MISCONF", "MASTERDOWN",
-                                     "TRYAGAIN", "CLUSTERDOWN"}) {
+  for (std::string_view transient :
+       {"LOADING", "READONLY", "BUSY", "MISCONF", "MASTERDOWN", "TRYAGAIN", "CLUSTERDOWN"}) {
     if (error.starts_with(transient)) return absl::UnavailableError(message);
   }
   if (error.starts_with("OOM")) return absl::ResourceExhaustedError(message);
@@ -131,8 +133,8 @@ absl::Status MapRedisError(std::string_view error, const std::string& address) {
 absl::StatusOr<std::unique_ptr<RedisConnection>> RedisConnection::Open(
     const RedisAddress& address, const RedisConnectionOptions& options) {
   const std::string name = address.ToString();
-  redisContext* context =
-      redisConnectWithTimeout(address.host.c_str(), address.port, absl::ToTimeval(options.connect_timeout));
+  redisContext* context = redisConnectWithTimeout(address.host.c_str(), address.port,
+                                                  absl::ToTimeval(options.connect_timeout));
   if (context == nullptr) {
     return absl::UnavailableError(absl::StrCat("Redis at ", name, ": cannot allocate a context"));
   }
@@ -161,6 +163,12 @@ absl::StatusOr<std::unique_ptr<RedisConnection>> RedisConnection::Open(
 RedisConnection::~RedisConnection() { redisFree(context_); }
 
 bool RedisConnection::broken() const { return context_->err != 0; }
+
+bool RedisConnection::IdleAndOpen() const {
+  if (broken()) return false;
+  pollfd fd{context_->fd, POLLIN | POLLRDHUP, 0};
+  return poll(&fd, 1, 0) == 0;
+}
 
 absl::Status RedisConnection::IoError(const char* what) const {
   std::string why = context_->errstr;
@@ -290,16 +298,16 @@ absl::StatusOr<RedisPool::Lease> RedisPool::Acquire() {
   while (idle_.empty() && open_ >= max_connections_) {
     if (released_.wait_until(lock, deadline) == std::cv_status::timeout && idle_.empty() &&
         open_ >= max_connections_) {
-      return absl::UnavailableError(absl::StrCat("all ", max_connections_,
-                                                 " connections to Redis at ", address_.ToString(),
-                                                 " stayed busy for ",
-                                                 absl::FormatDuration(options_.command_timeout)));
+      return absl::UnavailableError(
+          absl::StrCat("all ", max_connections_, " connections to Redis at ", address_.ToString(),
+                       " stayed busy for ", absl::FormatDuration(options_.command_timeout)));
     }
   }
-  if (!idle_.empty()) {
+  while (!idle_.empty()) {
     std::unique_ptr<RedisConnection> connection = std::move(idle_.back());
     idle_.pop_back();
-    return Lease(this, std::move(connection));
+    if (connection->IdleAndOpen()) return Lease(this, std::move(connection));
+    --open_;  // closed by Redis (e.g. it restarted): drop it, try the next one or connect
   }
   if (absl::Now() < retry_after_) return last_error_;  // fail fast while backing off
   ++open_;

@@ -115,6 +115,9 @@ class RedisConnection {
 
   // The socket failed or timed out: the connection must be dropped.
   bool broken() const;
+  // False if the idle connection has something to read: Redis closed it (restarted) or sent
+  // what nobody asked for. One poll(2), no round trip.
+  bool IdleAndOpen() const;
   const std::string& address() const { return address_; }
 
  private:

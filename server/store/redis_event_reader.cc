@@ -40,9 +40,9 @@ std::string_view FieldOf(RedisValue fields, std::string_view name) {
 
 std::string EncodeEventSummary(const RevisionSummary& summary) {
   // The time step's double by its bits: exact, whatever it holds.
-  return absl::StrCat(absl::ToUnixNanos(summary.create_time), " ",
-                      static_cast<int>(summary.origin), " ", summary.parent, " ",
-                      absl::bit_cast<uint64_t>(summary.time), " ", summary.step);
+  return absl::StrCat(absl::ToUnixNanos(summary.create_time), " ", static_cast<int>(summary.origin),
+                      " ", summary.parent, " ", absl::bit_cast<uint64_t>(summary.time), " ",
+                      summary.step);
 }
 
 absl::StatusOr<RevisionSummary> ParseEventSummary(int64_t number, std::string_view value) {
@@ -209,8 +209,13 @@ absl::Status RedisEventReader::Admit(RedisConnection& connection) {
       continue;
     }
     if (it == streams_.end()) {
-      it = streams_.emplace(p.hub_key, Stream{p.id, p.gen, keys_.Gen(p.id, p.gen, "events"), p.after,
-                                              /*checked=*/false, {}})
+      it = streams_
+               .emplace(p.hub_key, Stream{p.id,
+                                          p.gen,
+                                          keys_.Gen(p.id, p.gen, "events"),
+                                          p.after,
+                                          /*checked=*/false,
+                                          {}})
                .first;
     }
     it->second.subscriptions.push_back(p.subscription);
@@ -223,10 +228,9 @@ absl::Status RedisEventReader::Check(RedisConnection& connection) {
   std::vector<std::string> lost;
   for (auto& [hub_key, stream] : streams_) {
     if (stream.checked) continue;
-    SG_ASSIGN_OR_RETURN(
-        std::vector<RedisReply> replies,
-        connection.Pipeline({{"XREVRANGE", stream.key, "+", "-", "COUNT", "1"},
-                             {"HMGET", keys_.Grid(stream.id), "gen", "latest"}}));
+    SG_ASSIGN_OR_RETURN(std::vector<RedisReply> replies,
+                        connection.Pipeline({{"XREVRANGE", stream.key, "+", "-", "COUNT", "1"},
+                                             {"HMGET", keys_.Grid(stream.id), "gen", "latest"}}));
     bool intact = false;
     const RedisValue last = replies[0].value();
     int64_t ms = 0;
@@ -256,9 +260,13 @@ absl::Status RedisEventReader::Check(RedisConnection& connection) {
 }
 
 absl::Status RedisEventReader::ReadOnce(RedisConnection& connection) {
-  std::vector<std::string> args = {"XREAD", "COUNT", absl::StrCat(kReadCount), "BLOCK",
-                                   absl::StrCat(std::max<int64_t>(1, absl::ToInt64Milliseconds(block_))),
-                                   "STREAMS"};
+  std::vector<std::string> args = {
+      "XREAD",
+      "COUNT",
+      absl::StrCat(kReadCount),
+      "BLOCK",
+      absl::StrCat(std::max<int64_t>(1, absl::ToInt64Milliseconds(block_))),
+      "STREAMS"};
   std::map<std::string, std::string> hub_key_of;  // stream key -> hub key
   for (const auto& [hub_key, stream] : streams_) {
     args.push_back(stream.key);
@@ -286,7 +294,7 @@ bool RedisEventReader::Deliver(const std::string& hub_key, Stream& stream,
   int64_t ms = 0;
   int64_t seq = 0;
   if (!ParseEntryId(entry_id, &ms, &seq)) return true;  // not ours: ignore
-  if (ms == 1) {                                         // the deletion
+  if (ms == 1) {                                        // the deletion
     SubscriptionHub::Wake(hub_.EndGrid(hub_key));
     streams_.erase(hub_key);
     return false;

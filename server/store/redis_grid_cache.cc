@@ -48,7 +48,8 @@ bool RedisGridCache::MakeRoom(int64_t bytes, const std::string& keep) {
       std::lock_guard<std::mutex> lock(mu_);
       auto oldest = slots_.end();
       for (auto it = slots_.begin(); it != slots_.end(); ++it) {
-        if (it->first != keep && (oldest == slots_.end() || it->second.used < oldest->second.used)) {
+        if (it->first != keep &&
+            (oldest == slots_.end() || it->second.used < oldest->second.used)) {
           oldest = it;
         }
       }
@@ -59,11 +60,6 @@ bool RedisGridCache::MakeRoom(int64_t bytes, const std::string& keep) {
     dropped = true;
   }
   return dropped;
-}
-
-size_t RedisGridCache::size() const {
-  std::lock_guard<std::mutex> lock(mu_);
-  return slots_.size();
 }
 
 }  // namespace splinegrid::server

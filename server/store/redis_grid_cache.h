@@ -40,8 +40,6 @@ class RedisGridCache {
   // budget or nothing else is cached; false if nothing was dropped.
   bool MakeRoom(int64_t bytes, const std::string& keep);
 
-  size_t size() const;
-
  private:
   struct Slot {
     Entry entry;

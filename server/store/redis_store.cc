@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "absl/strings/match.h"
@@ -17,14 +19,14 @@
 #include "proto/convert/archive_convert.h"
 #include "server/store/grid_archive.h"
 #include "server/store/redis_event_reader.h"
-#include "server/store/redis_grid_cache.h"
 #include "server/store/redis_scripts.h"
+#include "server/store/redis_snapshots.h"
 #include "server/store/revision_codec.h"
 
 namespace splinegrid::server {
 namespace {
 
-constexpr int64_t kChunksPerRound = 16;  // source chunks per round trip: 16 MiB
+constexpr int64_t kChunksPerRound = 16;  // source chunks per RPUSH: 16 MiB
 
 std::string WholeSeconds(absl::Duration d) {
   return absl::StrCat(std::max<int64_t>(1, absl::ToInt64Seconds(d)));
@@ -43,50 +45,45 @@ std::string NewGeneration() {
   return absl::StrFormat("%016x", bits);
 }
 
-// The bytes the source points announced by `header` take once read (what the assembler
-// charges as they arrive).
-int64_t AnnouncedSourceBytes(const v1::ArchiveHeader& header) {
-  int64_t bytes = 0;
-  for (const v1::Extents& e : header.source_blocks()) {
-    const int64_t points =
-        int64_t{std::max(e.i(), 1)} * std::max(e.j(), 1) * std::max(e.k(), 1);
-    bytes += points * header.spatial_dim() * int64_t{sizeof(double)} +
-             (header.source_iblank() ? points * int64_t{sizeof(int)} : 0);
-  }
-  return bytes;
-}
-
-// What Redis holds that does not decode: damage (DATA_LOSS), except a budget refusal.
-absl::Status Damaged(const absl::Status& status, const std::string& what) {
-  if (status.ok() || status.code() == absl::StatusCode::kResourceExhausted) return status;
-  return absl::DataLossError(absl::StrCat(what, " in Redis does not decode: ", status.message()));
-}
-
 absl::Status NotFound(const std::string& id, const char* how) {
   return absl::NotFoundError(absl::StrCat("grids/", id, " ", how));
 }
 
-// Warns on stderr unless Redis persists every write before acknowledging it.
+// Warns on stderr (once per process and address) unless Redis persists every write before
+// acknowledging it and never evicts keys.
 void WarnAboutDurability(RedisConnection& connection) {
+  static std::mutex mu;
+  static std::set<std::string>* warned = new std::set<std::string>();
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (!warned->insert(connection.address()).second) return;
+  }
   auto config = [&](const char* name) -> std::string {
     absl::StatusOr<RedisReply> reply = connection.Command({"CONFIG", "GET", name});
     if (!reply.ok() || reply->value().size() != 2) return "?";
     return std::string(reply->value()[1].str());
   };
   const std::string appendonly = config("appendonly");
-  const std::string appendfsync = config("appendfsync");
   if (appendonly == "?") return;  // CONFIG is disabled (a managed Redis): nothing to say
+  const char* address = connection.address().c_str();
   if (appendonly != "yes") {
     std::fprintf(stderr,
                  "splinegrid: Redis at %s has appendonly %s: revisions acknowledged since its "
                  "last snapshot are lost if it stops (run it with appendonly yes, appendfsync "
                  "always)\n",
-                 connection.address().c_str(), appendonly.c_str());
-  } else if (appendfsync != "always") {
+                 address, appendonly.c_str());
+  } else if (const std::string appendfsync = config("appendfsync"); appendfsync != "always") {
     std::fprintf(stderr,
                  "splinegrid: Redis at %s has appendfsync %s: a power loss may lose about the "
                  "last second of acknowledged revisions (appendfsync always loses none)\n",
-                 connection.address().c_str(), appendfsync.c_str());
+                 address, appendfsync.c_str());
+  }
+  const std::string policy = config("maxmemory-policy");
+  if (config("maxmemory") != "0" && policy != "noeviction") {
+    std::fprintf(stderr,
+                 "splinegrid: Redis at %s has maxmemory-policy %s: it may evict grids when "
+                 "full (noeviction makes writes fail with RESOURCE_EXHAUSTED instead)\n",
+                 address, policy.c_str());
   }
 }
 
@@ -98,8 +95,9 @@ absl::Status CheckVersion(RedisConnection& connection) {
     int major = 0;
     const absl::string_view version = line.substr(line.find(':') + 1);
     if (absl::SimpleAtoi(version.substr(0, version.find('.')), &major) && major < 5) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "Redis at ", connection.address(), " is version ", version, "; the store needs 5 or newer"));
+      return absl::FailedPreconditionError(absl::StrCat("Redis at ", connection.address(),
+                                                        " is version ", version,
+                                                        "; the store needs 5 or newer"));
     }
   }
   return absl::OkStatus();
@@ -109,10 +107,9 @@ class RedisStore final : public GridStore {
  public:
   RedisStore(const RedisAddress& address, RedisStoreOptions options, MemoryBudget* budget)
       : options_(std::move(options)),
-        budget_(budget),
         keys_(options_.key_prefix),
         pool_(address, options_.connection, options_.max_connections),
-        cache_(budget),
+        snapshots_(&pool_, &keys_, budget),
         events_(address, options_.connection, keys_, options_.watch_block) {
     health_ = std::thread([this] { FollowHealth(); });
   }
@@ -128,11 +125,12 @@ class RedisStore final : public GridStore {
 
   absl::Status Create(std::shared_ptr<const StoredGrid> grid) override;
   absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) override {
-    SG_ASSIGN_OR_RETURN(Fetched fetched, Fetch(id));
+    SG_ASSIGN_OR_RETURN(RedisSnapshots::Fetched fetched, snapshots_.Fetch(id));
     return std::move(fetched.snapshot);
   }
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
-      const std::string& id, GridRevision revision, int64_t expected_latest) override;
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
+                                                                GridRevision revision,
+                                                                int64_t expected_latest) override;
   absl::Status Delete(const std::string& id) override;
   absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
                                   size_t max_queued) override;
@@ -149,50 +147,19 @@ class RedisStore final : public GridStore {
   }
 
  private:
-  struct Fetched {
-    std::string gen;
-    std::shared_ptr<const StoredGrid> snapshot;
-  };
-
   // Writes `grid`'s header, chunks and `revisions` (number, value) under generation `gen`,
   // every key with the pending TTL.
   absl::Status WriteGeneration(const StoredGrid& grid, const std::string& gen,
                                const std::vector<std::pair<int64_t, std::string>>& revisions,
                                int64_t* num_chunks);
-  // The current snapshot of `id` (one script round trip, plus the source on a cache miss).
-  absl::StatusOr<Fetched> Fetch(const std::string& id);
-  // The snapshot of `id` generation `gen` with revisions `numbers`; `values` hold the ones
-  // neither `cached` (if of `gen`) nor `published` has.
-  absl::StatusOr<Fetched> Assemble(const std::string& id, const std::string& gen,
-                                   RedisValue numbers, RedisValue values,
-                                   const std::optional<RedisGridCache::Entry>& cached,
-                                   const std::shared_ptr<const GridRevision>& published);
-  // `stored` as revision `number` of a grid whose source is `source` (the budget charged).
-  absl::StatusOr<std::shared_ptr<const GridRevision>> DecodeRevision(
-      const std::string& id, int64_t number, std::string_view value, const SourcePoints& source,
-      int64_t room, bool* made_room);
-  // The grid `id` of generation `gen` without revisions: header and source points, read once
-  // per process at a time.
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> LoadShell(const std::string& id,
-                                                              const std::string& gen);
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> ReadSource(RedisConnection& connection,
-                                                               const std::string& id,
-                                                               const std::string& gen,
-                                                               const v1::ArchiveHeader& header);
-  std::shared_ptr<std::mutex> LoaderOf(const std::string& id);
   absl::Status CheckRevisionSize(const std::string& id, int64_t number, size_t bytes) const;
   void FollowHealth();
   absl::Status Ping(std::unique_ptr<RedisConnection>& connection, bool* stale);
 
   const RedisStoreOptions options_;
-  MemoryBudget* const budget_;
   const RedisKeys keys_;
   RedisPool pool_;
-  RedisGridCache cache_;
-
-  std::mutex loaders_mu_;
-  std::map<std::string, std::weak_ptr<std::mutex>> loaders_;
-
+  RedisSnapshots snapshots_;
   RedisEventReader events_;
 
   mutable std::mutex health_mu_;
@@ -208,8 +175,8 @@ absl::Status RedisStore::CheckRevisionSize(const std::string& id, int64_t number
                                            size_t bytes) const {
   if (static_cast<int64_t>(bytes) <= options_.max_revision_bytes) return absl::OkStatus();
   return absl::ResourceExhaustedError(absl::StrCat(
-      "grids/", id, number > 0 ? absl::StrCat(" revision ", number) : " new revision",
-      " takes ", FormatBytes(bytes), " (", bytes, " bytes) stored; the Redis store holds at most ",
+      "grids/", id, number > 0 ? absl::StrCat(" revision ", number) : " new revision", " takes ",
+      FormatBytes(bytes), " (", bytes, " bytes) stored; the Redis store holds at most ",
       FormatBytes(options_.max_revision_bytes), " per revision"));
 }
 
@@ -263,15 +230,16 @@ absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
                       pool_.Run(CreateScript(), keys, {id, gen, latest, chunks, count}));
   switch (committed.value().AsInt().value_or(-2)) {
     case 1:
-      cache_.Put(id, {gen, std::move(grid)});
+      snapshots_.Put(id, {gen, std::move(grid)});
       return absl::OkStatus();
     case 0:
       return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
     default:
-      return absl::AbortedError(absl::StrCat(
-          "grids/", id, ": the data written for it expired in Redis before it was committed "
-          "(writing took longer than ", absl::FormatDuration(options_.pending_ttl),
-          "?); try again"));
+      return absl::AbortedError(
+          absl::StrCat("grids/", id,
+                       ": the data written for it expired in Redis before it was committed "
+                       "(writing took longer than ",
+                       absl::FormatDuration(options_.pending_ttl), "?); try again"));
   }
 }
 
@@ -293,19 +261,16 @@ absl::Status RedisStore::WriteGeneration(
     std::vector<std::string_view> push = {"RPUSH", source_key};
     push.insert(push.end(), batch.begin(), batch.end());
     // Refresh the TTLs: a large source may take a while.
-    SG_RETURN_IF_ERROR(lease->Pipeline({push, {"EXPIRE", source_key, ttl},
-                                        {"EXPIRE", header_key, ttl}})
-                           .status());
+    SG_RETURN_IF_ERROR(
+        lease->Pipeline({push, {"EXPIRE", source_key, ttl}, {"EXPIRE", header_key, ttl}}).status());
     batch.clear();
     return absl::OkStatus();
   };
-  SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid, kSourceChunkValues,
-                                        [&](const v1::SourceChunk& chunk) {
-                                          batch.push_back(chunk.SerializeAsString());
-                                          return std::ssize(batch) == kChunksPerRound
-                                                     ? flush()
-                                                     : absl::OkStatus();
-                                        }));
+  SG_RETURN_IF_ERROR(
+      ForEachSourceChunk(grid.source->grid, kSourceChunkValues, [&](const v1::SourceChunk& chunk) {
+        batch.push_back(chunk.SerializeAsString());
+        return std::ssize(batch) == kChunksPerRound ? flush() : absl::OkStatus();
+      }));
   SG_RETURN_IF_ERROR(flush());
   if (revisions.empty()) return absl::OkStatus();
   const std::string revs = keys_.Gen(id, gen, "revs");
@@ -328,30 +293,27 @@ absl::Status RedisStore::WriteGeneration(
   return lease->Pipeline(commands).status();
 }
 
-absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(
-    const std::string& id, GridRevision revision, int64_t expected_latest) {
+absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(const std::string& id,
+                                                                          GridRevision revision,
+                                                                          int64_t expected_latest) {
   revision.number = 0;  // the script appends the number it assigns
   v1::StoredRevision stored;
   EncodeRevision(revision, &stored);
   const std::string body = stored.SerializeAsString();
   SG_RETURN_IF_ERROR(CheckRevisionSize(id, 0, body.size()));
-  const std::optional<RedisGridCache::Entry> cached = cache_.Find(id);
+  const std::optional<RedisGridCache::Entry> cached = snapshots_.Cached(id);
   std::vector<std::string> args = {keys_.Stem(id),
                                    absl::StrCat(expected_latest),
                                    body,
                                    revision.origin == RevisionOrigin::kDeform ? "1" : "0",
                                    absl::StrCat(options_.max_deform_revisions),
                                    EncodeEventSummary(RevisionSummary::Of(revision)),
-                                   absl::StrCat(kStreamMaxLen),
-                                   cached ? cached->gen : ""};
-  if (cached) {
-    for (const auto& r : cached->snapshot->revisions) args.push_back(absl::StrCat(r->number));
-  }
+                                   absl::StrCat(kStreamMaxLen)};
+  RedisSnapshots::AppendKnown(cached, &args);
   const std::string grid_key = keys_.Grid(id);
-  SG_ASSIGN_OR_RETURN(
-      RedisReply reply,
-      pool_.Run(AddRevisionScript(), {grid_key},
-                std::vector<std::string_view>(args.begin(), args.end())));
+  SG_ASSIGN_OR_RETURN(RedisReply reply,
+                      pool_.Run(AddRevisionScript(), {grid_key},
+                                std::vector<std::string_view>(args.begin(), args.end())));
   const RedisValue result = reply.value();
   switch (result[0].AsInt().value_or(0)) {
     case 1:
@@ -361,14 +323,14 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(
                                              " is stale; the latest revision is ",
                                              result[1].AsInt().value_or(0)));
     default:
-      cache_.Erase(id);
+      snapshots_.Erase(id);
       return NotFound(id, "was deleted");
   }
   revision.number = result[1].AsInt().value_or(0);
   auto published = std::make_shared<const GridRevision>(std::move(revision));
-  SG_ASSIGN_OR_RETURN(Fetched fetched,
-                      Assemble(id, std::string(result[2].str()), result[3], result[4], cached,
-                               published));
+  SG_ASSIGN_OR_RETURN(RedisSnapshots::Fetched fetched,
+                      snapshots_.Assemble(id, std::string(result[2].str()), result[3], result[4],
+                                          cached, published));
   return std::move(fetched.snapshot);
 }
 
@@ -379,169 +341,9 @@ absl::Status RedisStore::Delete(const std::string& id) {
   const std::string ttl = WholeSeconds(options_.deleted_events_ttl);
   SG_ASSIGN_OR_RETURN(RedisReply reply,
                       pool_.Run(DeleteScript(), {grid_key, index}, {stem, id, ttl}));
-  cache_.Erase(id);
+  snapshots_.Erase(id);
   if (reply.value().AsInt().value_or(0) != 1) return NotFound(id, "not found");
   return absl::OkStatus();
-}
-
-// ---- Reading ----
-
-absl::StatusOr<RedisStore::Fetched> RedisStore::Fetch(const std::string& id) {
-  const std::optional<RedisGridCache::Entry> cached = cache_.Find(id);
-  std::vector<std::string> args = {keys_.Stem(id), cached ? cached->gen : ""};
-  if (cached) {
-    for (const auto& r : cached->snapshot->revisions) args.push_back(absl::StrCat(r->number));
-  }
-  const std::string grid_key = keys_.Grid(id);
-  SG_ASSIGN_OR_RETURN(RedisReply reply,
-                      pool_.Run(GetScript(), {grid_key},
-                                std::vector<std::string_view>(args.begin(), args.end())));
-  const RedisValue state = reply.value();
-  if (state.is_nil()) {
-    cache_.Erase(id);
-    return NotFound(id, "not found");
-  }
-  return Assemble(id, std::string(state[0].str()), state[1], state[2], cached, nullptr);
-}
-
-absl::StatusOr<RedisStore::Fetched> RedisStore::Assemble(
-    const std::string& id, const std::string& gen, RedisValue numbers, RedisValue values,
-    const std::optional<RedisGridCache::Entry>& cached,
-    const std::shared_ptr<const GridRevision>& published) {
-  const std::shared_ptr<const StoredGrid> base =
-      cached && cached->gen == gen ? cached->snapshot : nullptr;
-  int64_t new_bytes = 0;  // of the revisions to decode
-  for (size_t i = 0; i < values.size(); ++i) new_bytes += std::ssize(values[i].str());
-  if (base && !published && new_bytes == 0 && numbers.size() == base->revisions.size()) {
-    return Fetched{gen, base};  // nothing changed (the script sends only what is missing)
-  }
-  std::shared_ptr<const StoredGrid> shell = base;
-  if (!shell) {
-    SG_ASSIGN_OR_RETURN(shell, LoadShell(id, gen));
-  }
-  auto snapshot = std::make_shared<StoredGrid>();
-  snapshot->id = id;
-  snapshot->display_name = shell->display_name;
-  snapshot->create_time = shell->create_time;
-  snapshot->source = shell->source;
-  bool made_room = false;
-  for (size_t i = 0; i < numbers.size(); ++i) {
-    const int64_t number = numbers[i].AsInt().value_or(0);
-    const std::string_view value = values[i].str();
-    if (!value.empty()) {
-      SG_ASSIGN_OR_RETURN(std::shared_ptr<const GridRevision> revision,
-                          DecodeRevision(id, number, value, *shell->source, new_bytes,
-                                         &made_room));
-      new_bytes -= std::ssize(value);
-      snapshot->revisions.push_back(std::move(revision));
-      continue;
-    }
-    if (published && published->number == number) {
-      snapshot->revisions.push_back(published);
-      continue;
-    }
-    const auto& known = base ? base->revisions : shell->revisions;
-    const auto it = std::lower_bound(
-        known.begin(), known.end(), number,
-        [](const std::shared_ptr<const GridRevision>& r, int64_t n) { return r->number < n; });
-    if (it == known.end() || (*it)->number != number) {
-      return absl::DataLossError(absl::StrCat("grids/", id, " revision ", number,
-                                              " is listed in Redis but its value is missing"));
-    }
-    snapshot->revisions.push_back(*it);
-  }
-  cache_.Put(id, {gen, snapshot});
-  return Fetched{gen, std::move(snapshot)};
-}
-
-absl::StatusOr<std::shared_ptr<const GridRevision>> RedisStore::DecodeRevision(
-    const std::string& id, int64_t number, std::string_view value, const SourcePoints& source,
-    int64_t room, bool* made_room) {
-  const std::string what = absl::StrCat("grids/", id, " revision ", number);
-  v1::StoredRevision stored;
-  if (!stored.ParseFromArray(value.data(), static_cast<int>(value.size()))) {
-    return absl::DataLossError(absl::StrCat(what, " in Redis is not a StoredRevision"));
-  }
-  absl::StatusOr<std::shared_ptr<const GridRevision>> revision = LoadRevision(stored, budget_);
-  if (revision.status().code() == absl::StatusCode::kResourceExhausted && !*made_room) {
-    *made_room = true;  // once per snapshot
-    cache_.MakeRoom(room, id);
-    revision = LoadRevision(stored, budget_);
-  }
-  SG_RETURN_IF_ERROR(Damaged(revision.status(), what));
-  if ((*revision)->number != number) {
-    return absl::DataLossError(
-        absl::StrCat(what, " in Redis holds revision ", (*revision)->number));
-  }
-  SG_RETURN_IF_ERROR(Damaged(CheckRevisionMatchesSource(**revision, source.grid), what));
-  return revision;
-}
-
-std::shared_ptr<std::mutex> RedisStore::LoaderOf(const std::string& id) {
-  std::lock_guard<std::mutex> lock(loaders_mu_);
-  if (loaders_.size() > 256) {
-    std::erase_if(loaders_, [](const auto& entry) { return entry.second.expired(); });
-  }
-  std::shared_ptr<std::mutex> loader = loaders_[id].lock();
-  if (!loader) {
-    loader = std::make_shared<std::mutex>();
-    loaders_[id] = loader;
-  }
-  return loader;
-}
-
-absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::LoadShell(const std::string& id,
-                                                                        const std::string& gen) {
-  const std::shared_ptr<std::mutex> loader = LoaderOf(id);
-  std::lock_guard<std::mutex> loading(*loader);
-  // Another call may have read it while this one waited.
-  if (std::optional<RedisGridCache::Entry> cached = cache_.Find(id); cached && cached->gen == gen) {
-    return cached->snapshot;
-  }
-  SG_ASSIGN_OR_RETURN(RedisPool::Lease lease, pool_.Acquire());
-  SG_ASSIGN_OR_RETURN(RedisReply reply, lease->Command({"GET", keys_.Gen(id, gen, "header")}));
-  if (reply.value().is_nil()) return NotFound(id, "was deleted while it was read");
-  v1::ArchiveHeader header;
-  const std::string_view bytes = reply.value().str();
-  if (!header.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) {
-    return absl::DataLossError(absl::StrCat("grids/", id, ": the header in Redis does not parse"));
-  }
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> shell = ReadSource(*lease, id, gen, header);
-  if (shell.status().code() == absl::StatusCode::kResourceExhausted &&
-      cache_.MakeRoom(AnnouncedSourceBytes(header), id)) {
-    shell = ReadSource(*lease, id, gen, header);
-  }
-  return shell;
-}
-
-absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::ReadSource(
-    RedisConnection& connection, const std::string& id, const std::string& gen,
-    const v1::ArchiveHeader& header) {
-  const std::string what = absl::StrCat("grids/", id, ": the source points");
-  GridAssembler assembler(budget_, id);
-  SG_RETURN_IF_ERROR(Damaged(assembler.AddHeader(header), what));
-  const std::string key = keys_.Gen(id, gen, "source");
-  const int64_t chunks = header.num_source_chunks();
-  for (int64_t first = 0; first < chunks; first += kChunksPerRound) {
-    const int64_t last = std::min(first + kChunksPerRound, chunks) - 1;
-    SG_ASSIGN_OR_RETURN(RedisReply reply, connection.Command({"LRANGE", key, absl::StrCat(first),
-                                                              absl::StrCat(last)}));
-    const RedisValue batch = reply.value();
-    if (static_cast<int64_t>(batch.size()) != last - first + 1) {
-      return NotFound(id, "was deleted while it was read");
-    }
-    for (size_t c = 0; c < batch.size(); ++c) {
-      v1::SourceChunk chunk;
-      const std::string_view bytes = batch[c].str();
-      if (!chunk.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) {
-        return absl::DataLossError(absl::StrCat(what, ": chunk ", first + c, " does not parse"));
-      }
-      SG_RETURN_IF_ERROR(Damaged(assembler.AddChunk(chunk), what));
-    }
-  }
-  absl::StatusOr<std::shared_ptr<StoredGrid>> grid = assembler.Finish(/*check_counts=*/false);
-  SG_RETURN_IF_ERROR(Damaged(grid.status(), what));
-  return std::shared_ptr<const StoredGrid>(*std::move(grid));
 }
 
 // ---- Watching and listing ----
@@ -549,7 +351,7 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::ReadSource(
 absl::StatusOr<GridStore::Watch> RedisStore::Subscribe(const std::string& id,
                                                        std::weak_ptr<GridWatcher> watcher,
                                                        size_t max_queued) {
-  SG_ASSIGN_OR_RETURN(Fetched fetched, Fetch(id));
+  SG_ASSIGN_OR_RETURN(RedisSnapshots::Fetched fetched, snapshots_.Fetch(id));
   const auto& revisions = fetched.snapshot->revisions;
   const int64_t latest = revisions.empty() ? 0 : revisions.back()->number;
   auto subscription = std::make_shared<GridSubscription>(std::move(watcher), max_queued, latest);
@@ -560,10 +362,10 @@ absl::StatusOr<GridStore::Watch> RedisStore::Subscribe(const std::string& id,
 absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> RedisStore::List(
     const std::string& after, int limit, bool* more) {
   limit = std::max(limit, 1);
-  SG_ASSIGN_OR_RETURN(RedisReply reply,
-                      pool_.Command({"ZRANGEBYLEX", keys_.Index(),
-                                     after.empty() ? "-" : absl::StrCat("(", after), "+", "LIMIT",
-                                     "0", absl::StrCat(limit + 1)}));
+  SG_ASSIGN_OR_RETURN(
+      RedisReply reply,
+      pool_.Command({"ZRANGEBYLEX", keys_.Index(), after.empty() ? "-" : absl::StrCat("(", after),
+                     "+", "LIMIT", "0", absl::StrCat(limit + 1)}));
   const RedisValue ids = reply.value();
   std::vector<std::shared_ptr<const StoredGrid>> page;
   for (size_t i = 0; i < ids.size() && static_cast<int>(i) < limit; ++i) {

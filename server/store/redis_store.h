@@ -32,19 +32,22 @@
 //    freed in the background) and appends the deletion event; the event stream alone stays, for
 //    deleted_events_ttl, so that watchers on other replicas see the deletion.
 //
-// Reading. Each process caches a decoded snapshot per grid (redis_grid_cache.h). Get is one
+// Reading (redis_snapshots.h). Each process caches a decoded snapshot per grid. Get is one
 // script round trip: it sends the cached generation and revision numbers and receives the
 // grid's generation, its numbers and the values of only the revisions the process lacks; so it
-// reflects every revision published anywhere, decodes a revision once per process, and the
-// snapshot is consistent (read in one step). A cache miss on the source (first Get, or a new
-// generation) reads the header and the chunks, 16 per round trip. Memory is charged to the
-// MemoryBudget; when a reservation fails the least recently used grids' snapshots are dropped
-// from the cache and the load is retried once.
+// reflects every revision published through any replica, decodes a revision once per process,
+// and the snapshot is consistent (read in one step). A cache miss on the source (first Get, or
+// a new generation) reads the header and then the chunks, 16 per round trip. AddRevision's
+// script returns the same as Get, so its snapshot needs no further round trip. Memory is
+// charged to the MemoryBudget; when a reservation fails the least recently used grids'
+// snapshots leave the cache (redis_grid_cache.h) and the load is retried once.
 //
 // Watching (redis_event_reader.h): one thread per process reads the watched grids' event
-// streams with XREAD BLOCK on its own connection and feeds a SubscriptionHub. A watch takes the
-// snapshot first and starts the stream after its latest number L; the stream keeps entries
-// after L, so nothing between the snapshot and the first event is lost and nothing is repeated.
+// streams with XREAD BLOCK (100 ms) on its own connection and feeds a SubscriptionHub. A watch
+// takes the snapshot first and is fed the stream from after the snapshot's latest number L
+// (`after` = L): the stream is persistent and addressed by revision number, so nothing between
+// the snapshot and the first event is lost, and nothing is delivered twice. (Registering
+// first, as the memory store does under its lock, is not needed: the stream can be replayed.)
 //
 // Availability. hiredis connections are not thread safe: calls take one from a pool (at most
 // max_connections), each command with a timeout (connection.command_timeout, 2 s). A call
@@ -63,8 +66,9 @@
 // with `appendonly yes` and `appendfsync always` (every write is fsynced before Redis replies).
 // With `appendfsync everysec` (Redis's default once AOF is on) a power loss or kernel crash loses
 // up to about one second of acknowledged revisions (a Redis process crash alone loses
-// nothing); with RDB snapshots only, everything since the last snapshot. OpenRedisStore warns
-// on stderr when Redis is not configured for the first.
+// nothing); with RDB snapshots only, everything since the last snapshot. Redis must also not
+// evict keys (`maxmemory-policy noeviction`, the default; a full Redis then refuses writes:
+// RESOURCE_EXHAUSTED). OpenRedisStore warns on stderr when Redis is configured otherwise.
 //
 // Single Redis endpoint only: no Sentinel, no Cluster (the scripts touch keys they compute,
 // and a failover to an asynchronous replica may lose acknowledged writes); no AUTH or TLS.
