@@ -5,34 +5,14 @@
 
 #include "absl/strings/str_cat.h"
 #include "proto/convert/convert.h"
+#include "server/store/revision_codec.h"
 
 namespace splinegrid::server {
-namespace {
-
-void EncodeTime(absl::Time time, google::protobuf::Timestamp* out) {
-  const int64_t nanos = absl::ToUnixNanos(time);
-  out->set_seconds(nanos / 1000000000);
-  out->set_nanos(static_cast<int32_t>(nanos % 1000000000));
-}
-
-v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
-  switch (origin) {
-    case RevisionOrigin::kFit:
-      return v1::REVISION_ORIGIN_FIT;
-    case RevisionOrigin::kFair:
-      return v1::REVISION_ORIGIN_FAIR;
-    case RevisionOrigin::kDeform:
-      return v1::REVISION_ORIGIN_DEFORM;
-  }
-  return v1::REVISION_ORIGIN_UNSPECIFIED;
-}
-
-}  // namespace
 
 void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out) {
   out->set_revision(revision.number);
-  EncodeTime(revision.create_time, out->mutable_create_time());
-  out->set_origin(EncodeOrigin(revision.origin));
+  EncodeStoredTime(revision.create_time, out->mutable_create_time());
+  out->set_origin(EncodeRevisionOrigin(revision.origin));
   out->set_parent_revision(revision.parent);
   if (revision.origin == RevisionOrigin::kDeform) {
     out->set_time(revision.time);
@@ -75,7 +55,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
                         const std::vector<int>& blocks, v1::Grid* out) {
   out->set_name(absl::StrCat("grids/", grid.id));
   out->set_display_name(grid.display_name);
-  EncodeTime(grid.create_time, out->mutable_create_time());
+  EncodeStoredTime(grid.create_time, out->mutable_create_time());
   const MultiBlockGrid& source = grid.source->grid;
   v1::SourceGrid* src = out->mutable_source();
   src->set_spatial_dim(source.blocks.front().spatial_dim());
@@ -114,8 +94,8 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   v1::Revision* r = out->mutable_revision();
   r->set_revision(rev.number);
-  EncodeTime(rev.create_time, r->mutable_create_time());
-  r->set_origin(EncodeOrigin(rev.origin));
+  EncodeStoredTime(rev.create_time, r->mutable_create_time());
+  r->set_origin(EncodeRevisionOrigin(rev.origin));
   EncodeFitSpec(rev.fit_options, r->mutable_fit_spec());
   r->set_num_control_points(rev.num_control_points());
   r->set_compression_ratio(static_cast<double>(points) /

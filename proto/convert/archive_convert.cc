@@ -17,29 +17,10 @@ using archive_internal::Annotate;
 using archive_internal::CheckNonNegative;
 using archive_internal::Invalid;
 
-v1::BoundaryKind EncodeKind(BoundaryKind kind) {
-  switch (kind) {
-    case BoundaryKind::kWall:
-      return v1::BOUNDARY_KIND_WALL;
-    case BoundaryKind::kInterface:
-      return v1::BOUNDARY_KIND_INTERFACE;
-    case BoundaryKind::kOuter:
-      return v1::BOUNDARY_KIND_OUTER;
-  }
-  return v1::BOUNDARY_KIND_UNSPECIFIED;
-}
-
 absl::StatusOr<BoundaryKind> ParseKind(int value, const std::string& field) {
-  switch (value) {
-    case v1::BOUNDARY_KIND_WALL:
-      return BoundaryKind::kWall;
-    case v1::BOUNDARY_KIND_INTERFACE:
-      return BoundaryKind::kInterface;
-    case v1::BOUNDARY_KIND_OUTER:
-      return BoundaryKind::kOuter;
-    default:
-      return Invalid(field, " = ", value, " is not WALL, INTERFACE or OUTER");
-  }
+  const std::optional<BoundaryKind> kind = ParseBoundaryKind(value);
+  if (!kind) return Invalid(field, " = ", value, " is not WALL, INTERFACE or OUTER");
+  return *kind;
 }
 
 void EncodeCurvatureMetrics(const CurvatureMetrics& metrics, v1::CurvatureReport* out) {
@@ -123,7 +104,7 @@ void EncodeBoundaryKinds(const BoundaryKinds& kinds, v1::StoredBoundaryKinds* ou
     const std::vector<uint8_t>& points = kinds.point_kinds[b];
     block->set_point_kinds(reinterpret_cast<const char*>(points.data()), points.size());
     if (b < kinds.face_kinds.size()) {
-      for (BoundaryKind kind : kinds.face_kinds[b]) block->add_face_kinds(EncodeKind(kind));
+      for (BoundaryKind kind : kinds.face_kinds[b]) block->add_face_kinds(EncodeBoundaryKind(kind));
     }
   }
 }
@@ -198,7 +179,7 @@ void EncodeGridFitOptions(const GridFitOptions& options, v1::StoredFitOptions* o
     v1::FaceKind* entry = out->add_face_kinds();
     entry->set_block(o.face.block);
     entry->set_face(EncodeBlockFace(o.face.normal, o.face.upper));
-    entry->set_kind(EncodeKind(o.kind));
+    entry->set_kind(EncodeBoundaryKind(o.kind));
   }
   out->set_check_quality(options.check_quality);
 }

@@ -17,6 +17,31 @@ void EncodeExtents(const Extents& extents, v1::Extents* out) {
 
 Extents ParseExtents(const v1::Extents& extents) { return {extents.i(), extents.j(), extents.k()}; }
 
+v1::BoundaryKind EncodeBoundaryKind(BoundaryKind kind) {
+  switch (kind) {
+    case BoundaryKind::kWall:
+      return v1::BOUNDARY_KIND_WALL;
+    case BoundaryKind::kInterface:
+      return v1::BOUNDARY_KIND_INTERFACE;
+    case BoundaryKind::kOuter:
+      return v1::BOUNDARY_KIND_OUTER;
+  }
+  return v1::BOUNDARY_KIND_UNSPECIFIED;
+}
+
+std::optional<BoundaryKind> ParseBoundaryKind(int value) {
+  switch (value) {
+    case v1::BOUNDARY_KIND_WALL:
+      return BoundaryKind::kWall;
+    case v1::BOUNDARY_KIND_INTERFACE:
+      return BoundaryKind::kInterface;
+    case v1::BOUNDARY_KIND_OUTER:
+      return BoundaryKind::kOuter;
+    default:
+      return std::nullopt;
+  }
+}
+
 v1::Parametrization EncodeParametrization(Parametrization p) {
   switch (p) {
     case Parametrization::kUniform:
@@ -92,22 +117,12 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
     const v1::FaceKind& entry = spec.face_kinds(q);
     const std::string field = absl::StrCat("spec.face_kinds[", q, "]");
     SG_ASSIGN_OR_RETURN(const Face face, ParseBlockFace(entry.block(), entry.face(), field));
-    FaceKindOverride kind{face};
-    switch (entry.kind()) {
-      case v1::BOUNDARY_KIND_WALL:
-        kind.kind = BoundaryKind::kWall;
-        break;
-      case v1::BOUNDARY_KIND_INTERFACE:
-        kind.kind = BoundaryKind::kInterface;
-        break;
-      case v1::BOUNDARY_KIND_OUTER:
-        kind.kind = BoundaryKind::kOuter;
-        break;
-      default:
-        return absl::InvalidArgumentError(absl::StrCat(
-            field, ".kind = ", static_cast<int>(entry.kind()), " is not WALL, INTERFACE or OUTER"));
+    const std::optional<BoundaryKind> kind = ParseBoundaryKind(entry.kind());
+    if (!kind) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".kind = ", static_cast<int>(entry.kind()), " is not WALL, INTERFACE or OUTER"));
     }
-    options.face_kinds.push_back(kind);
+    options.face_kinds.push_back(FaceKindOverride{face, *kind});
   }
   options.check_quality = !spec.skip_quality_refinement();
   return options;
@@ -146,21 +161,13 @@ absl::StatusOr<BoundarySelection> ParseBoundarySelection(const v1::BoundarySelec
   BoundarySelection out;
   if (selection.kinds_size() > 0) out.kinds = 0;
   for (int q = 0; q < selection.kinds_size(); ++q) {
-    switch (selection.kinds(q)) {
-      case v1::BOUNDARY_KIND_WALL:
-        out.kinds |= static_cast<uint8_t>(BoundaryKind::kWall);
-        break;
-      case v1::BOUNDARY_KIND_INTERFACE:
-        out.kinds |= static_cast<uint8_t>(BoundaryKind::kInterface);
-        break;
-      case v1::BOUNDARY_KIND_OUTER:
-        out.kinds |= static_cast<uint8_t>(BoundaryKind::kOuter);
-        break;
-      default:
-        return absl::InvalidArgumentError(absl::StrCat("boundary.kinds[", q,
-                                                       "] = ", static_cast<int>(selection.kinds(q)),
-                                                       " is not WALL, INTERFACE or OUTER"));
+    const std::optional<BoundaryKind> kind = ParseBoundaryKind(selection.kinds(q));
+    if (!kind) {
+      return absl::InvalidArgumentError(absl::StrCat("boundary.kinds[", q,
+                                                     "] = ", static_cast<int>(selection.kinds(q)),
+                                                     " is not WALL, INTERFACE or OUTER"));
     }
+    out.kinds |= static_cast<uint8_t>(*kind);
   }
   for (int q = 0; q < selection.ranges_size(); ++q) {
     SG_ASSIGN_OR_RETURN(FaceRange range, ParseFaceRange(selection.ranges(q),
@@ -264,9 +271,7 @@ void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
     v1::FaceKind* entry = out->add_face_kinds();
     entry->set_block(o.face.block);
     entry->set_face(EncodeBlockFace(o.face.normal, o.face.upper));
-    entry->set_kind(o.kind == BoundaryKind::kWall        ? v1::BOUNDARY_KIND_WALL
-                    : o.kind == BoundaryKind::kInterface ? v1::BOUNDARY_KIND_INTERFACE
-                                                         : v1::BOUNDARY_KIND_OUTER);
+    entry->set_kind(EncodeBoundaryKind(o.kind));
   }
   out->set_skip_quality_refinement(!options.check_quality);
   for (const auto& [block, counts] : options.block_control_counts) {

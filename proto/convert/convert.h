@@ -5,6 +5,7 @@
 #ifndef SPLINEGRID_PROTO_CONVERT_CONVERT_H_
 #define SPLINEGRID_PROTO_CONVERT_CONVERT_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& b
 void EncodeCurvature(const CurvatureMetrics& metrics, v1::CurvatureReport* out);
 
 void EncodeBoundaryMatch(const BoundaryMatch& match, v1::BoundaryMatch* out);
+
+v1::BoundaryKind EncodeBoundaryKind(BoundaryKind kind);
+// WALL, INTERFACE or OUTER; nullopt for anything else (callers name the field in their error).
+std::optional<BoundaryKind> ParseBoundaryKind(int value);
 
 v1::BlockFace EncodeBlockFace(int normal, bool upper);
 // Face `face` of block `block`, or INVALID_ARGUMENT naming `field`.

@@ -11,18 +11,6 @@ namespace {
 
 constexpr int64_t kNanosPerSecond = 1000000000;
 
-v1::RevisionOrigin EncodeOrigin(RevisionOrigin origin) {
-  switch (origin) {
-    case RevisionOrigin::kFit:
-      return v1::REVISION_ORIGIN_FIT;
-    case RevisionOrigin::kFair:
-      return v1::REVISION_ORIGIN_FAIR;
-    case RevisionOrigin::kDeform:
-      return v1::REVISION_ORIGIN_DEFORM;
-  }
-  return v1::REVISION_ORIGIN_UNSPECIFIED;
-}
-
 absl::StatusOr<RevisionOrigin> ParseOrigin(int value) {
   switch (value) {
     case v1::REVISION_ORIGIN_FIT:
@@ -65,6 +53,18 @@ Extents PointExtents(const FittedBlock& block) {
 
 }  // namespace
 
+v1::RevisionOrigin EncodeRevisionOrigin(RevisionOrigin origin) {
+  switch (origin) {
+    case RevisionOrigin::kFit:
+      return v1::REVISION_ORIGIN_FIT;
+    case RevisionOrigin::kFair:
+      return v1::REVISION_ORIGIN_FAIR;
+    case RevisionOrigin::kDeform:
+      return v1::REVISION_ORIGIN_DEFORM;
+  }
+  return v1::REVISION_ORIGIN_UNSPECIFIED;
+}
+
 void EncodeStoredTime(absl::Time time, google::protobuf::Timestamp* out) {
   const int64_t nanos = absl::ToUnixNanos(time);
   // Floor division: Timestamp wants nanos in [0, 1e9) before 1970 too.
@@ -95,7 +95,7 @@ absl::StatusOr<absl::Time> ParseStoredTime(const google::protobuf::Timestamp& ti
 void EncodeRevision(const GridRevision& revision, v1::StoredRevision* out) {
   out->set_number(revision.number);
   EncodeStoredTime(revision.create_time, out->mutable_create_time());
-  out->set_origin(EncodeOrigin(revision.origin));
+  out->set_origin(EncodeRevisionOrigin(revision.origin));
   EncodeGridFitOptions(revision.fit_options, out->mutable_fit_options());
   out->set_parent(revision.parent);
   out->set_time(revision.time);

@@ -35,6 +35,8 @@ absl::Status CheckRevisionMatchesSource(const GridRevision& revision, const Mult
 // Unix time with nanoseconds, exact for every absl::Time of whole nanoseconds from 1678 to 2262
 // (what ToUnixNanos covers); nanos is always in [0, 1e9), also before 1970.
 void EncodeStoredTime(absl::Time time, google::protobuf::Timestamp* out);
+
+v1::RevisionOrigin EncodeRevisionOrigin(RevisionOrigin origin);
 // INVALID_ARGUMENT naming `field` for nanos outside [0, 1e9) or seconds outside that range.
 absl::StatusOr<absl::Time> ParseStoredTime(const google::protobuf::Timestamp& time,
                                            const std::string& field);
