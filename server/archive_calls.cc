@@ -1,8 +1,8 @@
 // ExportGrid and ImportArchive: a grid with its source points and revisions as archive records
 // (store/grid_archive.h), so a user can move grids between servers and keep them with a case.
 #include <deque>
-#include <optional>
 #include <mutex>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
@@ -19,12 +19,16 @@ namespace {
 // one at a time as the client takes them.
 class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
  public:
-  ExportReactor(ServiceState* state, const v1::ExportGridRequest* request)
-      : state_(state), request_(request), log_("ExportGrid", request->name(),
-                                                state->options.log_calls) {
-    if (state_->draining.load()) {
-      End(absl::UnavailableError("the server is shutting down"));
-    } else if (!state_->pool.TrySubmit([this] { Prepare(); })) {
+  ExportReactor(ServiceState* state, grpc::CallbackServerContext* context,
+                const v1::ExportGridRequest* request)
+      : state_(state),
+        request_(request),
+        log_("ExportGrid", request->name(), state->options.log_calls) {
+    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
+    if (!caller.ok()) {
+      End(caller.status());
+    } else if (caller_ = *std::move(caller);
+               !state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Prepare(); })) {
       End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
     }
   }
@@ -50,8 +54,8 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
     const absl::Status status = [&]() -> absl::Status {
       SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
       SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-      SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(SourceBytes(grid->source->grid),
-                                                          "the export's records"));
+      SG_ASSIGN_OR_RETURN(
+          memory_, state_->budget.Reserve(SourceBytes(grid->source->grid), "the export's records"));
       int64_t bytes = 0;
       SG_RETURN_IF_ERROR(ForEachRecord(*grid, [&](const v1::ArchiveRecord& record) {
         records_.emplace_back();
@@ -89,6 +93,7 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
   ServiceState* state_;
   const v1::ExportGridRequest* request_;
   CallLog log_;
+  Caller caller_;
   MemoryReservation memory_;
   std::deque<v1::ExportGridResponse> records_;
 };
@@ -98,12 +103,15 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
 // arrived and checks out.
 class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveRequest> {
  public:
-  ImportArchiveReactor(ServiceState* state, v1::Grid* response)
+  ImportArchiveReactor(ServiceState* state, grpc::CallbackServerContext* context,
+                       v1::Grid* response)
       : state_(state), response_(response), log_("ImportArchive", "", state->options.log_calls) {
-    if (state_->draining.load()) {
-      End(absl::UnavailableError("the server is shutting down"));
+    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
+    if (!caller.ok()) {
+      End(caller.status());
       return;
     }
+    caller_ = *std::move(caller);
     SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
@@ -111,7 +119,7 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
   void OnReadDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
     if (!ok) {  // the client closed its side: everything has arrived
-      if (!state_->pool.TrySubmit([this] { Complete(); })) {
+      if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); })) {
         End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
       }
       return;
@@ -134,9 +142,9 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
     if (!assembler_) {
       const std::string& id = message_.grid_id();
       if (!id.empty() && !IsValidGridId(id)) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "grid_id = '", id.substr(0, 80),
-            "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+        return absl::InvalidArgumentError(
+            absl::StrCat("grid_id = '", id.substr(0, 80),
+                         "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
       }
       assembler_.emplace(&state_->budget, id);
     } else if (!message_.grid_id().empty()) {
@@ -173,6 +181,7 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
   ServiceState* state_;
   v1::Grid* response_;
   CallLog log_;
+  Caller caller_;
   v1::ImportArchiveRequest message_;
   std::optional<GridAssembler> assembler_;
   int64_t records_ = 0;
@@ -181,13 +190,13 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
 }  // namespace
 
 grpc::ServerWriteReactor<v1::ExportGridResponse>* SplineGridService::ExportGrid(
-    grpc::CallbackServerContext* /*context*/, const v1::ExportGridRequest* request) {
-  return new ExportReactor(state_, request);
+    grpc::CallbackServerContext* context, const v1::ExportGridRequest* request) {
+  return new ExportReactor(state_, context, request);
 }
 
 grpc::ServerReadReactor<v1::ImportArchiveRequest>* SplineGridService::ImportArchive(
-    grpc::CallbackServerContext* /*context*/, v1::Grid* response) {
-  return new ImportArchiveReactor(state_, response);
+    grpc::CallbackServerContext* context, v1::Grid* response) {
+  return new ImportArchiveReactor(state_, context, response);
 }
 
 }  // namespace splinegrid::server

@@ -20,6 +20,7 @@ class CallLog {
         start_(absl::Now()) {}
 
   void set_grid(std::string grid) { grid_ = std::move(grid); }
+  void set_principal(std::string principal) { principal_ = std::move(principal); }
 
   // Writes the line (once per call).
   void Finish(const absl::Status& status) const;
@@ -27,6 +28,7 @@ class CallLog {
  private:
   std::string method_;
   std::string grid_;
+  std::string principal_;
   bool enabled_;
   absl::Time start_;
 };

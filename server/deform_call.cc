@@ -39,101 +39,105 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
                                                         v1::DeformGridResponse* response) {
   CallLog log("DeformGrid", request->name(), state_->options.log_calls);
   CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
-    const auto start = std::chrono::steady_clock::now();
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-    if (request->base_revision() < 0 || request->reference_revision() < 0) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "base_revision = ", request->base_revision(),
-          " and reference_revision = ", request->reference_revision(), " must not be negative"));
-    }
-    if (request->check_level() < 0 || request->check_level() > kMaxCheckLevel) {
-      return absl::InvalidArgumentError(absl::StrCat("check_level = ", request->check_level(),
-                                                     " is outside [0, ", kMaxCheckLevel, "]"));
-    }
-    if (!std::isfinite(request->time())) {
-      return absl::InvalidArgumentError(absl::StrCat("time = ", request->time(), " is not finite"));
-    }
-    if (request->motion_case() == v1::DeformGridRequest::MOTION_NOT_SET) {
-      return absl::InvalidArgumentError("motion is unset: give rigid, controls or boundary_points");
-    }
-    SG_ASSIGN_OR_RETURN(const DeformOptions options, ParseDeformOptions(*request));
-    const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
-    if (request->base_revision() != 0 && request->base_revision() != latest) {
-      return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ",
-                                             request->base_revision(),
-                                             " is stale; the latest revision is ", latest));
-    }
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> reference,
-                        grid->FindRevision(request->reference_revision()));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const Deformer> deformer,
-                        state_->deformers.Get(DeformerKey(*grid, reference->number, *request),
-                                              [&]() -> absl::StatusOr<Deformer> {
-                                                std::vector<FittedBlock> blocks;
-                                                for (const BlockFit& b : reference->blocks)
-                                                  blocks.push_back(b.fitted);
-                                                return Deformer::Create(std::move(blocks),
-                                                                        reference->kinds, options);
-                                              }));
-    std::vector<FittedBlock> moved;
-    switch (request->motion_case()) {
-      case v1::DeformGridRequest::kRigid: {
-        SG_ASSIGN_OR_RETURN(const RigidMotion motion, ParseRigidMotion(request->rigid()));
-        SG_ASSIGN_OR_RETURN(moved, deformer->Rigid(motion));
-        break;
-      }
-      case v1::DeformGridRequest::kControls: {
-        SG_ASSIGN_OR_RETURN(const std::vector<double> displacements,
-                            ParseControlDisplacements(*deformer, request->controls()));
-        SG_ASSIGN_OR_RETURN(moved, deformer->DisplaceControls(displacements));
-        break;
-      }
-      case v1::DeformGridRequest::kBoundaryPoints: {
-        SG_ASSIGN_OR_RETURN(const std::vector<BoundaryPoints> points,
-                            ParseBoundaryPoints(request->boundary_points()));
-        SG_ASSIGN_OR_RETURN(moved, deformer->MoveBoundaryPoints(points));
-        break;
-      }
-      case v1::DeformGridRequest::MOTION_NOT_SET:
-        break;
-    }
-    SG_ASSIGN_OR_RETURN(const DeformationCheck check,
-                        CheckDeformation(deformer->reference(), moved, deformer->kinds(),
-                                         request->check_level(), cancel));
-    if (!check.ok()) {
-      const Extents& c = check.worst_cell;
-      return absl::FailedPreconditionError(
-          absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",
-                       check.level, "; the worst in block ", check.worst_block, " at cell (", c[0],
-                       ", ", c[1], ", ", c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
-                       "; nothing was stored (move less per step, or widen decay_radius)"));
-    }
-    GridRevision revision;
-    revision.create_time = absl::Now();
-    revision.origin = RevisionOrigin::kDeform;
-    revision.parent = reference->number;
-    revision.time = request->time();
-    revision.step = request->step();
-    revision.fit_options = reference->fit_options;
-    revision.kinds = reference->kinds;
-    revision.blocks = reference->blocks;
-    for (size_t b = 0; b < moved.size(); ++b) revision.blocks[b].fitted.spline = moved[b].spline;
-    revision.deform.check = check;
-    revision.deform.moved_controls = static_cast<int>(deformer->moved_controls().size());
-    revision.deform.decay_radius = deformer->decay_radius();
-    revision.deform.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(RevisionBytes(revision),
-                                                                "the deformed revision"));
-    SG_ASSIGN_OR_RETURN(
-        const std::shared_ptr<const StoredGrid> stored,
-        state_->store->AddRevision(id, std::move(revision), request->base_revision()));
-    const GridRevision& published = *stored->revisions.back();
-    response->set_revision(published.number);
-    EncodeDeformReport(published.deform, response->mutable_report());
-    return absl::OkStatus();
-  });
+  return RunOnPool(
+      context, log, Role::kWrite, WorkKind::kCheap,
+      [this, request, response, cancel](const Caller&) -> absl::Status {
+        const auto start = std::chrono::steady_clock::now();
+        SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        if (request->base_revision() < 0 || request->reference_revision() < 0) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              "base_revision = ", request->base_revision(), " and reference_revision = ",
+              request->reference_revision(), " must not be negative"));
+        }
+        if (request->check_level() < 0 || request->check_level() > kMaxCheckLevel) {
+          return absl::InvalidArgumentError(absl::StrCat("check_level = ", request->check_level(),
+                                                         " is outside [0, ", kMaxCheckLevel, "]"));
+        }
+        if (!std::isfinite(request->time())) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("time = ", request->time(), " is not finite"));
+        }
+        if (request->motion_case() == v1::DeformGridRequest::MOTION_NOT_SET) {
+          return absl::InvalidArgumentError(
+              "motion is unset: give rigid, controls or boundary_points");
+        }
+        SG_ASSIGN_OR_RETURN(const DeformOptions options, ParseDeformOptions(*request));
+        const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
+        if (request->base_revision() != 0 && request->base_revision() != latest) {
+          return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ",
+                                                 request->base_revision(),
+                                                 " is stale; the latest revision is ", latest));
+        }
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> reference,
+                            grid->FindRevision(request->reference_revision()));
+        SG_ASSIGN_OR_RETURN(
+            const std::shared_ptr<const Deformer> deformer,
+            state_->deformers.Get(
+                DeformerKey(*grid, reference->number, *request), [&]() -> absl::StatusOr<Deformer> {
+                  std::vector<FittedBlock> blocks;
+                  for (const BlockFit& b : reference->blocks) blocks.push_back(b.fitted);
+                  return Deformer::Create(std::move(blocks), reference->kinds, options);
+                }));
+        std::vector<FittedBlock> moved;
+        switch (request->motion_case()) {
+          case v1::DeformGridRequest::kRigid: {
+            SG_ASSIGN_OR_RETURN(const RigidMotion motion, ParseRigidMotion(request->rigid()));
+            SG_ASSIGN_OR_RETURN(moved, deformer->Rigid(motion));
+            break;
+          }
+          case v1::DeformGridRequest::kControls: {
+            SG_ASSIGN_OR_RETURN(const std::vector<double> displacements,
+                                ParseControlDisplacements(*deformer, request->controls()));
+            SG_ASSIGN_OR_RETURN(moved, deformer->DisplaceControls(displacements));
+            break;
+          }
+          case v1::DeformGridRequest::kBoundaryPoints: {
+            SG_ASSIGN_OR_RETURN(const std::vector<BoundaryPoints> points,
+                                ParseBoundaryPoints(request->boundary_points()));
+            SG_ASSIGN_OR_RETURN(moved, deformer->MoveBoundaryPoints(points));
+            break;
+          }
+          case v1::DeformGridRequest::MOTION_NOT_SET:
+            break;
+        }
+        SG_ASSIGN_OR_RETURN(const DeformationCheck check,
+                            CheckDeformation(deformer->reference(), moved, deformer->kinds(),
+                                             request->check_level(), cancel));
+        if (!check.ok()) {
+          const Extents& c = check.worst_cell;
+          return absl::FailedPreconditionError(absl::StrCat(
+              "the deformation folds ", check.folded, " cells at refinement level ", check.level,
+              "; the worst in block ", check.worst_block, " at cell (", c[0], ", ", c[1], ", ",
+              c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
+              "; nothing was stored (move less per step, or widen decay_radius)"));
+        }
+        GridRevision revision;
+        revision.create_time = absl::Now();
+        revision.origin = RevisionOrigin::kDeform;
+        revision.parent = reference->number;
+        revision.time = request->time();
+        revision.step = request->step();
+        revision.fit_options = reference->fit_options;
+        revision.kinds = reference->kinds;
+        revision.blocks = reference->blocks;
+        for (size_t b = 0; b < moved.size(); ++b)
+          revision.blocks[b].fitted.spline = moved[b].spline;
+        revision.deform.check = check;
+        revision.deform.moved_controls = static_cast<int>(deformer->moved_controls().size());
+        revision.deform.decay_radius = deformer->decay_radius();
+        revision.deform.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        SG_ASSIGN_OR_RETURN(revision.memory, state_->budget.Reserve(RevisionBytes(revision),
+                                                                    "the deformed revision"));
+        SG_ASSIGN_OR_RETURN(
+            const std::shared_ptr<const StoredGrid> stored,
+            state_->store->AddRevision(id, std::move(revision), request->base_revision()));
+        const GridRevision& published = *stored->revisions.back();
+        response->set_revision(published.number);
+        EncodeDeformReport(published.deform, response->mutable_report());
+        return absl::OkStatus();
+      });
 }
 
 }  // namespace splinegrid::server

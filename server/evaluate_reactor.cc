@@ -36,9 +36,13 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
         request_(request),
         cancel_(CallCancelCheck(context)),
         log_("EvaluateGrid", request->name(), state->options.log_calls) {
-    if (state_->draining.load()) {
-      Fail(absl::UnavailableError("the server is shutting down"));
-    } else if (!state_->pool.TrySubmit([this] { Start(); })) {
+    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
+    if (!caller.ok()) {
+      Fail(caller.status());
+      return;
+    }
+    caller_ = *std::move(caller);
+    if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kCheap, [this] { Start(); })) {
       Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
     }
   }
@@ -188,7 +192,8 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       SG_HAPPENS_BEFORE(this);
       StartWrite(next);
     }
-    if (produce && !state_->pool.TrySubmit([this] { Produce(); })) {
+    if (produce &&
+        !state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Produce(); })) {
       {
         std::lock_guard<std::mutex> lock(mu_);
         producing_ = false;
@@ -296,6 +301,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   const v1::EvaluateGridRequest* request_;
   CancelCheck cancel_;
   CallLog log_;
+  Caller caller_;
   std::shared_ptr<const StoredGrid> grid_;
   std::shared_ptr<const GridRevision> revision_;
   std::vector<BlockPlan> plan_;

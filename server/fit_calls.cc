@@ -47,12 +47,14 @@ grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext
                                                      v1::FitGridResponse* response) {
   CallLog log("FitGrid", request->name(), state_->options.log_calls);
   CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-    SG_ASSIGN_OR_RETURN(const GridFitOptions options, ParseFitSpec(request->spec()));
-    return FitAndStore(*grid, options, RevisionOrigin::kFit, 0, cancel, response);
-  });
+  return RunOnPool(
+      context, log, Role::kWrite, WorkKind::kLong,
+      [this, request, response, cancel](const Caller&) -> absl::Status {
+        SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        SG_ASSIGN_OR_RETURN(const GridFitOptions options, ParseFitSpec(request->spec()));
+        return FitAndStore(*grid, options, RevisionOrigin::kFit, 0, cancel, response);
+      });
 }
 
 grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContext* context,
@@ -60,31 +62,33 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
                                                       v1::FitGridResponse* response) {
   CallLog log("FairGrid", request->name(), state_->options.log_calls);
   CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-    if (request->revision() < 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("revision = ", request->revision(), " is negative"));
-    }
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
-                        grid->FindRevision(request->revision()));
-    GridFitOptions options = parent->fit_options;
-    if (request->has_fairing()) {
-      SG_ASSIGN_OR_RETURN(options.fairing, ParseFairing(request->fairing(), "fairing"));
-    } else if (options.tolerance_mode()) {
-      options.fairing = FairingOptions{FairingMode::kToTolerance};
-    } else {
-      return absl::InvalidArgumentError(
-          absl::StrCat("fairing is unset and revision ", parent->number,
-                       " was fitted with control counts: give a fairing weight (mode WEIGHT)"));
-    }
-    if (options.fairing.mode == FairingMode::kOff) {
-      return absl::InvalidArgumentError(
-          "fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
-    }
-    return FitAndStore(*grid, options, RevisionOrigin::kFair, parent->number, cancel, response);
-  });
+  return RunOnPool(
+      context, log, Role::kWrite, WorkKind::kLong,
+      [this, request, response, cancel](const Caller&) -> absl::Status {
+        SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        if (request->revision() < 0) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("revision = ", request->revision(), " is negative"));
+        }
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
+                            grid->FindRevision(request->revision()));
+        GridFitOptions options = parent->fit_options;
+        if (request->has_fairing()) {
+          SG_ASSIGN_OR_RETURN(options.fairing, ParseFairing(request->fairing(), "fairing"));
+        } else if (options.tolerance_mode()) {
+          options.fairing = FairingOptions{FairingMode::kToTolerance};
+        } else {
+          return absl::InvalidArgumentError(
+              absl::StrCat("fairing is unset and revision ", parent->number,
+                           " was fitted with control counts: give a fairing weight (mode WEIGHT)"));
+        }
+        if (options.fairing.mode == FairingMode::kOff) {
+          return absl::InvalidArgumentError(
+              "fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
+        }
+        return FitAndStore(*grid, options, RevisionOrigin::kFair, parent->number, cancel, response);
+      });
 }
 
 }  // namespace splinegrid::server

@@ -47,8 +47,7 @@ absl::StatusOr<GridFitOptions> GeneratedFitOptions(const v1::GenerateGridRequest
 // The wall points of block `block`'s j = 0 edge of a stored revision, evaluated at the original
 // resolution: the one run of points whose kind includes wall, in Selig orientation
 // (counter-clockwise).
-absl::StatusOr<ProfileSource> StoredWallProfile(GridStore& store,
-                                                const v1::StoredWall& wall) {
+absl::StatusOr<ProfileSource> StoredWallProfile(GridStore& store, const v1::StoredWall& wall) {
   SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(wall.name(), "stored_wall.name"));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, store.Get(id));
   if (wall.revision() < 0) {
@@ -113,8 +112,7 @@ absl::StatusOr<ProfileSource> StoredWallProfile(GridStore& store,
   return out;
 }
 
-absl::StatusOr<ProfileSource> ProfileOf(GridStore& store,
-                                        const v1::GenerateGridRequest& request) {
+absl::StatusOr<ProfileSource> ProfileOf(GridStore& store, const v1::GenerateGridRequest& request) {
   ProfileSource out;
   switch (request.profile_case()) {
     case v1::GenerateGridRequest::kPoints: {
@@ -213,9 +211,10 @@ grpc::ServerUnaryReactor* SplineGridService::GenerateGrid(grpc::CallbackServerCo
   CallLog log("GenerateGrid", request->grid_id().empty() ? "" : "grids/" + request->grid_id(),
               state_->options.log_calls);
   CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel] {
-    return Generate(*request, cancel, response);
-  });
+  return RunOnPool(context, log, Role::kWrite, WorkKind::kLong,
+                   [this, request, response, cancel](const Caller&) {
+                     return Generate(*request, cancel, response);
+                   });
 }
 
 }  // namespace splinegrid::server

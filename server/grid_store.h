@@ -196,8 +196,7 @@ class GridStore {
     std::shared_ptr<const StoredGrid> snapshot;
     std::shared_ptr<GridSubscription> subscription;
   };
-  virtual absl::StatusOr<Watch> Subscribe(const std::string& id,
-                                          std::weak_ptr<GridWatcher> watcher,
+  virtual absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
                                           size_t max_queued) = 0;
 
   // Stops queuing on `subscription` (a watch that ended); a no-op when it is gone already.

@@ -14,12 +14,14 @@ namespace {
 
 class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
  public:
-  ImportReactor(ServiceState* state, v1::Grid* response)
+  ImportReactor(ServiceState* state, grpc::CallbackServerContext* context, v1::Grid* response)
       : state_(state), response_(response), log_("ImportGrid", "", state->options.log_calls) {
-    if (state_->draining.load()) {
-      Fail(absl::UnavailableError("the server is shutting down"));
+    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
+    if (!caller.ok()) {
+      Fail(caller.status());
       return;
     }
+    caller_ = *std::move(caller);
     SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
@@ -27,7 +29,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
   void OnReadDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
     if (!ok) {  // the client closed its side: everything has arrived
-      if (!state_->pool.TrySubmit([this] { Complete(); })) {
+      if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); })) {
         Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
       }
       return;
@@ -185,8 +187,8 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     bytes_ = std::string();
     if (source->grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
     upload_ = MemoryReservation();
-    SG_ASSIGN_OR_RETURN(source->memory, state_->budget.Reserve(SourceBytes(source->grid),
-                                                               "the imported grid"));
+    SG_ASSIGN_OR_RETURN(source->memory,
+                        state_->budget.Reserve(SourceBytes(source->grid), "the imported grid"));
     SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
     auto grid = std::make_shared<StoredGrid>();
     grid->display_name = header_.display_name();
@@ -207,6 +209,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
   ServiceState* state_;
   v1::Grid* response_;
   CallLog log_;
+  Caller caller_;
   v1::ImportGridRequest message_;
   bool have_header_ = false;
   v1::ImportHeader header_;
@@ -219,8 +222,8 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
 }  // namespace
 
 grpc::ServerReadReactor<v1::ImportGridRequest>* SplineGridService::ImportGrid(
-    grpc::CallbackServerContext* /*context*/, v1::Grid* response) {
-  return new ImportReactor(state_, response);
+    grpc::CallbackServerContext* context, v1::Grid* response) {
+  return new ImportReactor(state_, context, response);
 }
 
 }  // namespace splinegrid::server

@@ -66,11 +66,11 @@ void Server::FollowStoreHealth() {
     if (available.ok() == serving) continue;
     serving = available.ok();
     SetServing(serving);
-    std::fprintf(stderr, "splinegrid: %s\n",
-                 serving ? "the store is available again: SERVING"
-                         : absl::StrCat("the store is unavailable (", available.message(),
-                                        "): NOT_SERVING")
-                               .c_str());
+    std::fprintf(
+        stderr, "splinegrid: %s\n",
+        serving ? "the store is available again: SERVING"
+                : absl::StrCat("the store is unavailable (", available.message(), "): NOT_SERVING")
+                      .c_str());
   }
 }
 

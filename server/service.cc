@@ -75,24 +75,37 @@ absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::st
   return name.substr(sizeof(kPrefix) - 1);
 }
 
+absl::StatusOr<Caller> AdmitCall(const ServiceState& state, grpc::CallbackServerContext* context,
+                                 Role needed, CallLog* log) {
+  if (state.draining.load()) return absl::UnavailableError("the server is shutting down");
+  SG_ASSIGN_OR_RETURN(Caller caller, state.authenticator.Authenticate(*context));
+  log->set_principal(caller.principal);
+  if (caller.role < needed) {
+    return absl::PermissionDeniedError(absl::StrCat("this call needs the role ", RoleName(needed),
+                                                    "; the caller has ", RoleName(caller.role)));
+  }
+  return caller;
+}
+
 grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerContext* context,
-                                                       CallLog log,
-                                                       std::function<absl::Status()> work) {
+                                                       CallLog log, Role needed, WorkKind kind,
+                                                       Work work) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  if (state_->draining.load()) {
-    const absl::Status status = absl::UnavailableError("the server is shutting down");
-    log.Finish(status);
-    reactor->Finish(ToGrpcStatus(status));
+  absl::StatusOr<Caller> caller = AdmitCall(*state_, context, needed, &log);
+  if (!caller.ok()) {
+    log.Finish(caller.status());
+    reactor->Finish(ToGrpcStatus(caller.status()));
     return reactor;
   }
   SG_HAPPENS_BEFORE(reactor);
-  auto task = [reactor, context, log, work = std::move(work)] {
+  const std::string principal = caller->principal;
+  auto task = [reactor, context, log, caller = *std::move(caller), work = std::move(work)] {
     SG_HAPPENS_AFTER(reactor);
-    const absl::Status status = ExplainCancellation(context, work());
+    const absl::Status status = ExplainCancellation(context, work(caller));
     log.Finish(status);
     reactor->Finish(ToGrpcStatus(status));
   };
-  if (!state_->pool.TrySubmit(std::move(task))) {
+  if (!state_->pool.TrySubmit(principal, kind, std::move(task))) {
     const absl::Status status =
         absl::ResourceExhaustedError("the server is busy: its work queue is full; retry later");
     log.Finish(status);
@@ -102,11 +115,10 @@ grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerConte
 }
 
 grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerContext* context,
-                                                       CallLog log,
-                                                       const std::function<absl::Status()>& work) {
+                                                       CallLog log, Role needed, const Work& work) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  const absl::Status status =
-      state_->draining.load() ? absl::UnavailableError("the server is shutting down") : work();
+  absl::StatusOr<Caller> caller = AdmitCall(*state_, context, needed, &log);
+  const absl::Status status = caller.ok() ? work(*caller) : caller.status();
   log.Finish(status);
   reactor->Finish(ToGrpcStatus(status));
   return reactor;
@@ -116,7 +128,7 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
                                                      const v1::GetGridRequest* request,
                                                      v1::Grid* response) {
   CallLog log("GetGrid", request->name(), state_->options.log_calls);
-  auto work = [this, request, response]() -> absl::Status {
+  auto work = [this, request, response](const Caller&) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
     if (request->revision() < 0) {
@@ -133,15 +145,17 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
     return EncodeGrid(*grid, revision, request->view(), blocks, response);
   };
   // Encoding a FULL view copies control nets: pool work; the basic view is a lookup.
-  if (request->view() == v1::GRID_VIEW_FULL) return RunOnPool(context, log, work);
-  return RunInline(context, log, work);
+  if (request->view() == v1::GRID_VIEW_FULL) {
+    return RunOnPool(context, log, Role::kRead, WorkKind::kCheap, work);
+  }
+  return RunInline(context, log, Role::kRead, work);
 }
 
 grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerContext* context,
                                                        const v1::ListGridsRequest* request,
                                                        v1::ListGridsResponse* response) {
   CallLog log("ListGrids", "", state_->options.log_calls);
-  return RunInline(context, log, [this, request, response]() -> absl::Status {
+  auto work = [this, request, response](const Caller&) -> absl::Status {
     const int size = request->page_size();
     if (size < 0 || size > 1000) {
       return absl::InvalidArgumentError(
@@ -162,14 +176,15 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
       response->set_next_page_token(absl::WebSafeBase64Escape(page.back()->id));
     }
     return absl::OkStatus();
-  });
+  };
+  return RunInline(context, log, Role::kRead, work);
 }
 
 grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerContext* context,
                                                         const v1::DeleteGridRequest* request,
                                                         google::protobuf::Empty* /*response*/) {
   CallLog log("DeleteGrid", request->name(), state_->options.log_calls);
-  return RunInline(context, log, [this, request]() -> absl::Status {
+  return RunInline(context, log, Role::kWrite, [this, request](const Caller&) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
     SG_RETURN_IF_ERROR(state_->store->Delete(id));
     state_->deformers.Forget(DeformerKeyPrefix(id));

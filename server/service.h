@@ -11,6 +11,8 @@
 
 #include "absl/status/status.h"
 #include "grpcpp/grpcpp.h"
+#include "server/auth/authenticator.h"
+#include "server/auth/caller.h"
 #include "server/call_log.h"
 #include "server/deformer_cache.h"
 #include "server/grid_store.h"
@@ -28,11 +30,17 @@ struct ServiceState {
 
   ServerOptions options;
   MemoryBudget budget;
+  Authenticator authenticator;
   std::unique_ptr<GridStore> store;
   WorkerPool pool;
   DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
 };
+
+// Admits a call that needs `needed`: UNAVAILABLE while draining, UNAUTHENTICATED without valid
+// credentials, PERMISSION_DENIED for a role below `needed`; sets the log's principal.
+absl::StatusOr<Caller> AdmitCall(const ServiceState& state, grpc::CallbackServerContext* context,
+                                 Role needed, CallLog* log);
 
 // absl::Status -> grpc::Status (the codes are the same numbers).
 grpc::Status ToGrpcStatus(const absl::Status& status);
@@ -108,13 +116,14 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
       grpc::CallbackServerContext* context, v1::Grid* response) override;
 
  private:
-  // Runs `work` on the worker pool and finishes the call with its status (UNAVAILABLE while
-  // draining, RESOURCE_EXHAUSTED when the pool's queue is full).
+  using Work = std::function<absl::Status(const Caller& caller)>;
+  // Admits the call (AdmitCall with `needed`), runs `work` on the worker pool as `kind` and
+  // finishes the call with its status (RESOURCE_EXHAUSTED when the pool refuses it).
   grpc::ServerUnaryReactor* RunOnPool(grpc::CallbackServerContext* context, CallLog log,
-                                      std::function<absl::Status()> work);
-  // Runs cheap, non-numeric `work` right here and finishes the call.
+                                      Role needed, WorkKind kind, Work work);
+  // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
-                                      const std::function<absl::Status()>& work);
+                                      Role needed, const Work& work);
 
   // Fits `source` with `options` into a revision of `origin` (and `parent`), not yet numbered
   // or stored; its memory is reserved.

@@ -81,11 +81,13 @@ grpc::ServerUnaryReactor* SplineGridService::GetWallCurvature(
     v1::GetWallCurvatureResponse* response) {
   CallLog log("GetWallCurvature", request->name(), state_->options.log_calls);
   CancelCheck cancel = CallCancelCheck(context);
-  return RunOnPool(context, log, [this, request, response, cancel]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-    return WallCurvature(*grid, *request, cancel, response);
-  });
+  return RunOnPool(
+      context, log, Role::kRead, WorkKind::kLong,
+      [this, request, response, cancel](const Caller&) -> absl::Status {
+        SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        return WallCurvature(*grid, *request, cancel, response);
+      });
 }
 
 }  // namespace splinegrid::server

@@ -97,7 +97,9 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
 
  private:
   absl::Status Subscribe() {
-    if (state_->draining.load()) return absl::UnavailableError("the server is shutting down");
+    absl::StatusOr<Caller> caller = AdmitCall(*state_, context_, Role::kRead, &log_);
+    if (!caller.ok()) return caller.status();
+    caller_ = *std::move(caller);
     absl::StatusOr<std::string> id = ParseGridName(request_->name(), "name");
     if (!id.ok()) return id.status();
     id_ = *std::move(id);
@@ -200,6 +202,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   grpc::CallbackServerContext* context_;
   const v1::WatchGridRequest* request_;
   CallLog log_;
+  Caller caller_;
   std::shared_ptr<WatchReactor> self_;  // this, until OnDone
   // Set by Start before anything else can run.
   std::string id_;

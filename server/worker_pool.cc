@@ -20,7 +20,8 @@ void WorkerPool::Stop() {
   }
 }
 
-bool WorkerPool::TrySubmit(std::function<void()> task) {
+bool WorkerPool::TrySubmit(const std::string& /*principal*/, WorkKind /*kind*/,
+                           std::function<void()> task) {
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (stopping_ || static_cast<int>(queue_.size()) >= max_queued_) return false;

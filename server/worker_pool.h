@@ -8,10 +8,15 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
 namespace splinegrid::server {
+
+// How a task is scheduled: cheap tasks (lookups, point evaluations, small grid evaluations)
+// must never wait behind long ones (fits, fairing, generation, large evaluations).
+enum class WorkKind { kCheap, kLong };
 
 class WorkerPool {
  public:
@@ -22,8 +27,9 @@ class WorkerPool {
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  // Queues `task`; false (and the task is dropped) when the queue is full or the pool stopped.
-  bool TrySubmit(std::function<void()> task);
+  // Queues `task` of `principal` (who is charged for it) and `kind`; false (and the task is
+  // dropped) when the queue is full or the pool stopped.
+  bool TrySubmit(const std::string& principal, WorkKind kind, std::function<void()> task);
 
   // Refuses new tasks, runs the queued ones to the end and joins the workers. Idempotent.
   void Stop();

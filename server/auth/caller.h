@@ -1,0 +1,29 @@
+// Who is calling and what they may do. Without tokens every caller is an admin named by its
+// peer address (one principal per connection); with `serve --tokens` the token names both.
+#ifndef SPLINEGRID_SERVER_AUTH_CALLER_H_
+#define SPLINEGRID_SERVER_AUTH_CALLER_H_
+
+#include <string>
+
+namespace splinegrid::server {
+
+// Ordered: each role may do everything the roles before it may.
+//   read:  GetGrid, ListGrids, EvaluateGrid, EvaluatePoints, GetWallCurvature, WatchGrid,
+//          ExportGrid (and health, which is open to everyone).
+//   write: also ImportGrid, ImportArchive, FitGrid, FairGrid, DeformGrid, GenerateGrid, and
+//          DeleteGrid of grids the same principal created.
+//   admin: everything, including DeleteGrid of any grid.
+enum class Role { kRead = 0, kWrite = 1, kAdmin = 2 };
+
+// "read", "write" or "admin".
+const char* RoleName(Role role);
+
+struct Caller {
+  // The token's principal, or the peer ("ipv4:127.0.0.1:40312") when the server has no tokens.
+  std::string principal;
+  Role role = Role::kAdmin;
+};
+
+}  // namespace splinegrid::server
+
+#endif  // SPLINEGRID_SERVER_AUTH_CALLER_H_
