@@ -253,8 +253,9 @@ class TopologyTest : public ::testing::Test {
   }
 
   // nginx with the configuration deploy/nginx/render.sh renders for the replicas, run as the
-  // template says: nginx -p RUNDIR -c RUNDIR/nginx.conf -g 'daemon off;'.
-  void StartNginx() {
+  // template says: nginx -p RUNDIR -c RUNDIR/nginx.conf -g 'daemon off;'. Waits until a health
+  // check through it answers SERVING, unless `wait_serving` is false.
+  void StartNginx(bool wait_serving = true) {
     nginx_port_ = FreePort();
     const fs::path run = dir_ / "nginx";
     fs::create_directories(run);
@@ -280,6 +281,10 @@ class TopologyTest : public ::testing::Test {
         std::vector<std::string>{nginx_binary_, "-p", run.string(), "-c", conf.string(), "-g",
                                  "daemon off;"},
         (dir_ / "nginx.log").string());
+    if (!wait_serving) {
+      ASSERT_TRUE(WaitForPort(nginx_port_, absl::Seconds(10))) << nginx_->ReadLog();
+      return;
+    }
     ASSERT_TRUE(WaitServing(nginx_port_, absl::Seconds(10)))
         << nginx_->ReadLog() << ReadFileToString((run / "error.log").string()).value_or("");
   }
@@ -312,6 +317,22 @@ std::map<int, int64_t> ReadAcked(const fs::path& path) {
 int AckedLines(const fs::path& path) {
   const std::string text = ReadFileToString(path.string()).value_or("");
   return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// With every replica down, a call through nginx ends the way a gRPC server would end it:
+// UNAVAILABLE with a message (which clients retry), not an HTML 502 page.
+TEST_F(TopologyTest, NginxWithoutAReplicaAnswersUnavailable) {
+  if (MissingPrograms(/*need_nginx=*/true)) {
+    GTEST_SKIP() << "redis-server or nginx is not installed (.ci/setup installs them: "
+                    "redis-server nginx-light)";
+  }
+  replica_ports_ = {FreePort()};  // nothing listens there
+  ASSERT_NO_FATAL_FAILURE(StartNginx(/*wait_serving=*/false));
+  auto through_nginx = DirectClient(nginx_port_, absl::Seconds(5));
+  const absl::Status status = through_nginx->Get("grids/absent").status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kUnavailable) << status;
+  EXPECT_THAT(std::string(status.message()),
+              ::testing::HasSubstr("no splinegrid replica could be reached"));
 }
 
 TEST_F(TopologyTest, PitchingRunSurvivesKillingTheServingReplica) {
