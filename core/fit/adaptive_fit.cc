@@ -20,10 +20,7 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
   }
   SG_RETURN_IF_ERROR(ValidateParametrization(options.parametrization));
   SG_RETURN_IF_ERROR(options.features.Validate());
-  if (options.max_controls_per_direction < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "max_controls_per_direction = ", options.max_controls_per_direction, " is negative"));
-  }
+  SG_RETURN_IF_ERROR(ValidateControlCap(options.max_controls_per_direction, options.order));
   if (tolerance.size() != 1 && static_cast<int64_t>(tolerance.size()) != block.num_points()) {
     return absl::InvalidArgumentError(absl::StrCat("tolerance: ", tolerance.size(), " values for ",
                                                    block.num_points(),

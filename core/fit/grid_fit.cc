@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/fit/segment_model.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -18,23 +19,24 @@ absl::Status InBlock(int b, const absl::Status& status) {
   return absl::Status(status.code(), absl::StrCat("block ", b, ": ", status.message()));
 }
 
+// The index in options.block_control_counts of block b's override, or -1.
+int OverrideOf(const GridFitOptions& options, int b) {
+  for (size_t q = 0; q < options.block_control_counts.size(); ++q) {
+    if (options.block_control_counts[q].first == b) return static_cast<int>(q);
+  }
+  return -1;
+}
+
 // The control-count fit options of block b: its override if it has one, else the grid-wide
-// counts clamped to the block's points (so one request suits blocks of different sizes).
-FitOptions BlockOptions(const GridFitOptions& options, const StructuredBlock& block, int b) {
+// counts, as given (Validate refuses counts that do not suit the block; nothing is clamped).
+FitOptions BlockOptions(const GridFitOptions& options, int b) {
   FitOptions fit_options;
   fit_options.order = options.order;
   fit_options.parametrization = options.parametrization;
   if (options.fairing.mode == FairingMode::kWeight) fit_options.fairing = options.fairing.weight;
-  for (const auto& [index, counts] : options.block_control_counts) {
-    if (index == b) {
-      fit_options.control_counts = counts;
-      return fit_options;
-    }
-  }
-  for (int d = 0; d < 3; ++d) {
-    fit_options.control_counts[d] =
-        block.extent(d) == 1 ? 0 : std::min(options.control_counts[d], block.extent(d));
-  }
+  const int q = OverrideOf(options, b);
+  fit_options.control_counts =
+      q >= 0 ? options.block_control_counts[q].second : options.control_counts;
   return fit_options;
 }
 
@@ -42,7 +44,7 @@ FitOptions BlockOptions(const GridFitOptions& options, const StructuredBlock& bl
 absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options,
                        const CancelCheck& cancel, GridFit& result) {
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
-    FitOptions fit_options = BlockOptions(options, grid.blocks[b], b);
+    FitOptions fit_options = BlockOptions(options, b);
     fit_options.cancel = cancel;
     absl::StatusOr<FittedBlock> fit = FitBlock(grid.blocks[b], fit_options);
     if (!fit.ok()) return InBlock(b, fit.status());
@@ -130,10 +132,7 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
           absl::StrCat("tolerance = ", *tolerance, "; must be positive and finite"));
     }
     if (boundary_tolerances) SG_RETURN_IF_ERROR(boundary_tolerances->Validate());
-    if (max_controls_per_direction < 0) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "max_controls_per_direction = ", max_controls_per_direction, " is negative"));
-    }
+    SG_RETURN_IF_ERROR(ValidateControlCap(max_controls_per_direction, order));
     if (!block_control_counts.empty()) {
       return absl::InvalidArgumentError("block_control_counts cannot be combined with a tolerance");
     }
@@ -143,23 +142,26 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
     return absl::InvalidArgumentError(
         "fairing to tolerance needs a tolerance; with control counts give a fairing weight");
   }
-  for (const auto& [block, counts] : block_control_counts) {
+  for (size_t q = 0; q < block_control_counts.size(); ++q) {
+    const int block = block_control_counts[q].first;
+    const std::string field = absl::StrCat("block_control_counts[", q, "].block = ", block);
     if (block < 0 || block >= num_blocks) {
-      return absl::InvalidArgumentError(absl::StrCat("block_control_counts: block ", block,
-                                                     " is outside [0, ", num_blocks - 1, "]"));
-    }
-  }
-  for (int d = 0; d < 3; ++d) {
-    if (control_counts[d] < 0) {
       return absl::InvalidArgumentError(
-          absl::StrCat("control_counts[", d, "] = ", control_counts[d], " is negative"));
+          absl::StrCat(field, " is outside [0, ", num_blocks - 1, "]"));
+    }
+    if (const int first = OverrideOf(*this, block); first != static_cast<int>(q)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, " repeats block_control_counts[", first, "]; give one entry per block"));
     }
   }
+  // Every block against the counts it gets, named as the request names them.
   for (int b = 0; b < num_blocks; ++b) {
-    const FitOptions block_options = BlockOptions(*this, grid.blocks[b], b);
-    if (absl::Status s = block_options.Validate(grid.blocks[b].extents()); !s.ok()) {
-      return InBlock(b, s);
-    }
+    const int q = OverrideOf(*this, b);
+    const std::string field = q >= 0 ? absl::StrCat("block_control_counts[", q, "].control_counts")
+                                     : std::string("control_counts");
+    const Extents& counts = q >= 0 ? block_control_counts[q].second : control_counts;
+    SG_RETURN_IF_ERROR(ValidateControlCounts(counts, order, grid.blocks[b].extents(), field,
+                                             absl::StrCat("block ", b)));
   }
   return absl::OkStatus();
 }
@@ -168,11 +170,20 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
                                 const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
   SG_RETURN_IF_ERROR(options.Validate(grid));
+  for (size_t b = 0; b < grid.blocks.size(); ++b) {
+    if (absl::Status s = ValidateFittable(grid.blocks[b], absl::StrCat("block ", b)); !s.ok()) {
+      return absl::FailedPreconditionError(s.message());
+    }
+  }
   GridFit result;
   if (options.tolerance_mode()) {
     SG_RETURN_IF_ERROR(FitToTolerances(grid, options, cancel, result));
   } else {
     SG_RETURN_IF_ERROR(FitBlocks(grid, options, cancel, result));
+    // Nothing was measured against a tolerance: the report must not say one was met.
+    result.report.tolerance_met = false;
+    result.report.unmet_reason =
+        "no tolerance was given (a fit to control counts): see max_deviation";
   }
   // The report (FitMultiBlock makes its own): deviations by kind, cell quality, gaps, walls.
   const bool report = !options.tolerance_mode();
@@ -180,6 +191,7 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
   CellQualityOptions quality_options;
   quality_options.cancel = cancel;
   std::vector<FittedBlock> fitted;
+  result.report.quality_met = true;
   for (size_t b = 0; b < result.blocks.size(); ++b) {
     BlockFit& block = result.blocks[b];
     if (report) {
@@ -192,7 +204,8 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
       if (!q.ok()) return InBlock(static_cast<int>(b), q.status());
       block.quality = *std::move(q);
     }
-    result.report.quality_met = result.report.quality_met && block.quality.ok();
+    result.report.quality_met =
+        result.report.quality_met && block.quality.ok() && block.quality.measured();
     result.report.num_points += block.fitted.summary.num_points;
     result.report.num_control_points += block.fitted.summary.num_control_points;
     result.report.max_deviation =
@@ -204,6 +217,17 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
     result.report.wall_curvature = WallCurvatureMetrics(fitted, result.kinds, kCurvatureLevel);
   }
   result.report.num_matches = static_cast<int>(result.connectivity.matches.size());
+  for (size_t b = 0; b < result.blocks.size(); ++b) {
+    const Extents points = grid.blocks[b].extents();
+    for (int d = 0; d < 3; ++d) {
+      const int order = result.blocks[b].fitted.spline.knots(d).order();
+      if (points[d] > 1 && order < options.order) {
+        result.report.adjustments.push_back(absl::StrCat(
+            "block ", b, " direction ", std::string(1, "ijk"[d]), ": ", points[d],
+            " points, fitted through them at order ", order, " instead of ", options.order));
+      }
+    }
+  }
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

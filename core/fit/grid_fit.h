@@ -39,9 +39,11 @@ struct GridFitOptions {
   std::optional<BoundaryTolerances> boundary_tolerances;
   // Control points per direction for every block; 0 = as many as points.
   Extents control_counts = {0, 0, 0};
-  // Per-block overrides of control_counts: (block index, counts).
+  // Per-block overrides of control_counts: (block index, counts), at most one per block. Counts
+  // must suit every block they apply to (ValidateControlCounts); nothing is clamped.
   std::vector<std::pair<int, Extents>> block_control_counts;
-  // Tolerance mode: the most control points per direction (0: the point count).
+  // Tolerance mode: the most control points per direction (0: the point count); at least the
+  // order when given (a direction of fewer points than that is capped by its points).
   int max_controls_per_direction = 0;
   // kWeight in either mode; kToTolerance needs the tolerance mode.
   FairingOptions fairing;
@@ -62,7 +64,7 @@ struct GridFitOptions {
 // A block's fit and what the report says about it.
 struct BlockFit {
   FittedBlock fitted;
-  bool tolerance_met = true;  // tolerance mode: every point within its tolerance
+  bool tolerance_met = false;  // tolerance mode: every point within its tolerance (measured)
   std::string unmet_reason;
   KindDeviation deviation_by_kind;
   CellQuality quality;  // levels 0..2
@@ -73,9 +75,13 @@ struct GridFitReport {
   int64_t num_points = 0;
   int64_t num_control_points = 0;
   double max_deviation = 0.0;
-  bool tolerance_met = true;  // tolerance mode: every block's
-  std::string unmet_reason;   // the first block's reason
-  bool quality_met = true;    // no folded or resized cell in any block
+  // True only when measured: tolerance mode, every block's points within their tolerances.
+  // A fit to control counts has no tolerance: false, and unmet_reason says so.
+  bool tolerance_met = false;
+  std::string unmet_reason;  // the first block's reason
+  // True only when measured: no folded or resized cell in any block, and no block with cells
+  // whose every cell was skipped as collapsed (CellQuality::measured()).
+  bool quality_met = false;
   int num_matches = 0;        // of the connectivity
   // Largest distance between coinciding points of matched boundaries at levels 0..2 (0 when
   // watertight: the tolerance mode).
@@ -88,6 +94,10 @@ struct GridFitReport {
   int knots_removed = 0;
   int quality_rounds = 0;
   double seconds = 0.0;
+  // Where the fit differs from the options, one sentence each: a direction with more than one
+  // but fewer points than the order is fitted through its points at a lower order (the only
+  // fit there is). Empty: as asked.
+  std::vector<std::string> adjustments;
 };
 
 struct GridFit {
@@ -97,9 +107,13 @@ struct GridFit {
   GridFitReport report;
 };
 
-// Fits every block of `grid`. Errors: INVALID_ARGUMENT (options, non-finite points; the message
-// names the block), FAILED_PRECONDITION (data leave control points undetermined, blocks that
-// touch inconsistently), CANCELLED.
+// Fits every block of `grid`, as asked: no count, order or tolerance is changed silently (the
+// one exception, forced by the data, is a direction with fewer points than the order: it
+// interpolates them at a lower order, see FitOptions::order). Errors: INVALID_ARGUMENT
+// (options, naming the field, value, block and limit), FAILED_PRECONDITION (a block that cannot
+// be fitted: non-finite points, all points equal, a direction of zero length, cells of zero
+// measure, see ValidateFittable; data that leave control points undetermined; blocks that touch
+// inconsistently), CANCELLED.
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
                                 const CancelCheck& cancel = {});
 

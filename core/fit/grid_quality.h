@@ -109,6 +109,10 @@ struct CellQuality {
 
   // No folded and no out-of-size cell.
   bool ok() const { return folded == 0 && out_of_size == 0; }
+  // Whether the check measured anything: some cell was checked, or the block has no cells at all
+  // (curves, points). A block whose every cell was skipped as collapsed was not measured, so
+  // ok() says nothing about it.
+  bool measured() const { return cells_checked > 0 || cells_skipped == 0; }
 };
 
 // Checks the cells of `fitted` (a fit of `original`: its distribution has original's extents)

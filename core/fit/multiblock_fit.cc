@@ -196,10 +196,7 @@ absl::Status MultiBlockFitOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
   }
-  if (max_controls_per_direction < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("max_controls_per_direction = ", max_controls_per_direction, " is negative"));
-  }
+  SG_RETURN_IF_ERROR(ValidateControlCap(max_controls_per_direction, order));
   if (max_iterations < 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("max_iterations = ", max_iterations, " is negative"));
@@ -298,7 +295,7 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
     SG_ASSIGN_OR_RETURN(report.max_deviation,
                         DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
     SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
-    result.quality_met = result.quality_met && report.quality.ok();
+    result.quality_met = result.quality_met && report.quality.ok() && report.quality.measured();
     const Deviation& dev = fitted.summary.deviation;
     report.tolerance_met = dev.max_ratio <= 1.0;
     if (!report.tolerance_met) {

@@ -58,6 +58,21 @@ int SegmentModel::Member::ClassCoord(int r) const {
   return reversed ? stride * (r1 - r0) - offset : offset;
 }
 
+absl::Status ValidateControlCap(int max_controls, int order) {
+  if (max_controls < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_controls_per_direction = ", max_controls, " is negative"));
+  }
+  if (max_controls > 0 && max_controls < order) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_controls_per_direction = ", max_controls, " is below order = ", order,
+        ": a direction of order k starts with k control points; give at least ", order,
+        ", or 0 for no cap",
+        max_controls >= 2 ? absl::StrCat(", or order <= ", max_controls) : std::string()));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<SegmentModel> SegmentModel::Build(
     const MultiBlockGrid& grid, const std::vector<std::array<std::vector<double>, 3>>& params,
     const Connectivity& connectivity, const std::vector<std::array<std::vector<int>, 3>>& features,

@@ -32,6 +32,12 @@
 
 namespace splinegrid {
 
+// OK if `max_controls` (the cap on control points per direction of a fit to tolerances; 0: no
+// cap) is 0 or at least `order`: a direction of order k starts with k controls, so a lower cap
+// cannot be honoured. Otherwise INVALID_ARGUMENT naming max_controls_per_direction, its value
+// and the order.
+absl::Status ValidateControlCap(int max_controls, int order);
+
 class SegmentModel {
  public:
   // A segment of a block direction, data indices [r0, r1], as a member of a class: class

@@ -40,6 +40,46 @@ void SquaredDistances(const double* __restrict a, const double* __restrict b, in
 
 }  // namespace
 
+absl::Status ValidateControlCounts(const Extents& counts, int order, const Extents& points,
+                                   const std::string& field, const std::string& block) {
+  for (int d = 0; d < 3; ++d) {
+    const int n = counts[d], m = points[d];
+    const std::string name = absl::StrCat(field, "[", d, "] = ", n);
+    const std::string dir(1, kDirectionNames[d]);
+    if (n < 0) return absl::InvalidArgumentError(absl::StrCat(name, " is negative"));
+    if (m == 1) {
+      if (n > 1) {
+        return absl::InvalidArgumentError(absl::StrCat(name, " but ", block,
+                                                       " has a single point in ", dir,
+                                                       " (direction ", dir, "); use 0 or 1"));
+      }
+      continue;
+    }
+    if (n == 0) continue;
+    if (n == 1) {
+      return absl::InvalidArgumentError(absl::StrCat(name, " is below 2: ", block, " has ", m,
+                                                     " points in ", dir,
+                                                     ", and a direction of several points needs "
+                                                     "at least 2 control points"));
+    }
+    if (n > m) {
+      return absl::InvalidArgumentError(absl::StrCat(name, " exceeds the ", m, " points of ", block,
+                                                     " in ", dir, "; give at most ", m,
+                                                     " (0: as many as points)"));
+    }
+    // A direction of order k needs k controls, unless it has fewer points than k: then it
+    // interpolates them at order m (the only fit there is; see FitOptions::order).
+    const int least = std::min(std::max(order, 2), m);
+    if (n < least) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          name, " is below order = ", order, ": a B-spline of order k needs at least k control ",
+          "points per direction; give at least ", least, " (", block, " has ", m, " points in ",
+          dir, "), or order <= ", n));
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::Status FitOptions::Validate(const Extents& points) const {
   if (order < 2 || order > kMaxOrder) {
     return absl::InvalidArgumentError(
@@ -50,24 +90,7 @@ absl::Status FitOptions::Validate(const Extents& points) const {
     return absl::InvalidArgumentError(
         absl::StrCat("fairing = ", fairing, " is not a finite number >= 0"));
   }
-  for (int d = 0; d < 3; ++d) {
-    const int n = control_counts[d];
-    if (points[d] == 1) {
-      if (n > 1) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("control_counts[", d, "] = ", n, " but direction ",
-                         std::string(1, kDirectionNames[d]), " has a single point; use 0 or 1"));
-      }
-      continue;
-    }
-    if (n == 0) continue;
-    if (n < 2 || n > points[d]) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "control_counts[", d, "] = ", n, " is outside [2, ", points[d], "] (the ", points[d],
-          " points of direction ", std::string(1, kDirectionNames[d]), ")"));
-    }
-  }
-  return absl::OkStatus();
+  return ValidateControlCounts(control_counts, order, points, "control_counts", "the block");
 }
 
 absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,

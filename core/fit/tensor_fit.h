@@ -17,6 +17,7 @@
 #define SPLINEGRID_CORE_FIT_TENSOR_FIT_H_
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -31,10 +32,13 @@
 namespace splinegrid {
 
 struct FitOptions {
-  // Spline order k (degree k - 1); a direction with fewer control points gets their count.
+  // Spline order k (degree k - 1), in [2, kMaxOrder]. The only exception, forced by the data: a
+  // direction with m < k points interpolates them at order m (its SplineDirection says so);
+  // asking for fewer than k controls where there are at least k points is an error.
   int order = 4;
   // Control points per direction (i, j, k); 0 means as many as data points (interpolation).
-  // Directions with one data point always get one control point.
+  // Directions with one data point always get one control point. Nothing is clamped: a count
+  // above the points or below the order is refused (ValidateControlCounts).
   Extents control_counts = {0, 0, 0};
   Parametrization parametrization = Parametrization::kChordLength;
   KnotPlacement knot_placement = KnotPlacement::kAveraged;
@@ -49,6 +53,13 @@ struct FitOptions {
   // OK if the options suit a block of `points`; INVALID_ARGUMENT naming the field otherwise.
   absl::Status Validate(const Extents& points) const;
 };
+
+// OK if `counts` (control points per direction, 0: as many as points) suit a block of `points`
+// fitted at `order`: each nonzero count in [min(order, m), m] for a direction of m > 1 points,
+// 0 or 1 for a direction of one point. Otherwise INVALID_ARGUMENT naming `field` and the
+// direction ("control_counts[0] = 1000"), `block` (e.g. "block 3"), its points and the limit.
+absl::Status ValidateControlCounts(const Extents& counts, int order, const Extents& points,
+                                   const std::string& field, const std::string& block);
 
 // How far a spline is from the data it was fitted to, at the data parameters.
 struct Deviation {

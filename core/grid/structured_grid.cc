@@ -1,9 +1,12 @@
 #include "core/grid/structured_grid.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/util/check.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid {
 
@@ -52,6 +55,126 @@ absl::Status ValidateFinite(const StructuredBlock& block, const std::string& wha
           what, ": point (", p % ni, ", ", (p / ni) % nj, ", ", p / (ni * nj), ") coordinate ",
           std::string(1, "xyz"[c % s]), " is ", coords[c], "; coordinates must be finite"));
     }
+  }
+  return absl::OkStatus();
+}
+
+namespace {
+
+// Relative size below which a length, area or volume counts as zero (of L, L^2, L^3).
+constexpr double kDegenerate = 1e-12;
+
+using Vec = std::array<double, 3>;
+
+// (b - a) / scale, zero-padded to three coordinates.
+Vec Difference(const double* a, const double* b, int s, double scale) {
+  Vec v = {0.0, 0.0, 0.0};
+  for (int c = 0; c < s; ++c) v[c] = (b[c] - a[c]) / scale;
+  return v;
+}
+
+// |det| of the edge vectors `e` (count = active directions): length, area or volume.
+double Measure(const std::array<Vec, 3>& e, int count) {
+  switch (count) {
+    case 1:
+      return std::sqrt(e[0][0] * e[0][0] + e[0][1] * e[0][1] + e[0][2] * e[0][2]);
+    case 2: {
+      const Vec c = {e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                     e[0][0] * e[1][1] - e[0][1] * e[1][0]};
+      return std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    default:
+      return std::abs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                      e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                      e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]));
+  }
+}
+
+}  // namespace
+
+absl::Status ValidateFittable(const StructuredBlock& block, const std::string& what) {
+  static constexpr char kNames[] = "ijk";
+  SG_RETURN_IF_ERROR(ValidateFinite(block, what));
+  const int s = block.spatial_dim();
+  const Extents& n = block.extents();
+  std::vector<int> active;
+  for (int d = 0; d < 3; ++d) {
+    if (n[d] > 1) active.push_back(d);
+  }
+  if (active.empty()) return absl::OkStatus();  // a single point: nothing to span
+  const int dims = static_cast<int>(active.size());
+  if (dims == 3 && s == 2) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": ", n[0], " x ", n[1], " x ", n[2],
+        " points with 2 coordinates: a volume block needs 3 (x, y, z) coordinates"));
+  }
+  // L: the diagonal of the bounding box.
+  const auto coords = block.coords();
+  Vec lo = {coords[0], coords[1], s == 3 ? coords[2] : 0.0}, hi = lo;
+  for (size_t x = 0; x < coords.size(); ++x) {
+    lo[x % s] = std::min(lo[x % s], coords[x]);
+    hi[x % s] = std::max(hi[x % s], coords[x]);
+  }
+  double diagonal = 0.0;
+  for (int c = 0; c < s; ++c) diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  diagonal = std::sqrt(diagonal);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": all ", block.num_points(), " points are equal (",
+        absl::StrJoin(std::vector<double>(coords.begin(), coords.begin() + s), ", "),
+        "): a grid collapsed to a point cannot be fitted"));
+  }
+  // A direction of zero length: no two neighbours along it differ.
+  for (int d : active) {
+    bool spans = false;
+    for (int k = 0; k < n[2] && !spans; ++k) {
+      for (int j = 0; j < n[1] && !spans; ++j) {
+        for (int i = 0; i < n[0] && !spans; ++i) {
+          Extents q = {i, j, k};
+          if (q[d] + 1 >= n[d]) continue;
+          const double* a = block.Point(i, j, k);
+          ++q[d];
+          const Vec v = Difference(a, block.Point(q[0], q[1], q[2]), s, diagonal);
+          spans = Measure({v, Vec{}, Vec{}}, 1) > kDegenerate;
+        }
+      }
+    }
+    if (!spans) {
+      const std::string dir(1, kNames[d]);
+      return absl::InvalidArgumentError(absl::StrCat(
+          what, ": direction ", dir, " has zero length: each of its ", dir,
+          "-lines of ", n[d], " points is a single repeated point (the block is collapsed in ",
+          dir, "); give the direction one point or spread its points"));
+    }
+  }
+  // The cells' measure: a corner's edge vectors along the active directions, at every corner.
+  double total = 0.0;
+  const double threshold = kDegenerate;  // in units of L^dims (vectors are scaled by 1 / L)
+  Extents last = n;
+  for (int d : active) --last[d];
+  for (int k = 0; k < last[2] && total <= threshold; ++k) {
+    for (int j = 0; j < last[1] && total <= threshold; ++j) {
+      for (int i = 0; i < last[0] && total <= threshold; ++i) {
+        for (int corner = 0; corner < (1 << dims); ++corner) {
+          Extents c = {i, j, k};
+          for (int a = 0; a < dims; ++a) c[active[a]] += (corner >> a) & 1;
+          std::array<Vec, 3> edges;
+          for (int a = 0; a < dims; ++a) {
+            Extents o = c;
+            o[active[a]] += ((corner >> a) & 1) ? -1 : 1;
+            edges[a] = Difference(block.Point(c[0], c[1], c[2]), block.Point(o[0], o[1], o[2]), s,
+                                  diagonal);
+          }
+          total += Measure(edges, dims);
+        }
+      }
+    }
+  }
+  if (total <= threshold) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": its points lie on ", dims == 2 ? "one line" : "one plane", ": the ",
+        dims == 2 ? "surface" : "volume", " block of ", n[0], " x ", n[1], " x ", n[2],
+        " points has cells of zero ", dims == 2 ? "area" : "volume", " and cannot be fitted"));
   }
   return absl::OkStatus();
 }

@@ -79,6 +79,17 @@ absl::Status ValidateExtents(const Extents& extents, const std::string& what,
 // `what`, the point index (i, j, k) and the value.
 absl::Status ValidateFinite(const StructuredBlock& block, const std::string& what);
 
+// OK when `block` can be fitted: finite coordinates, a volume (three directions with more than
+// one point) only with spatial_dim 3, no active direction of zero length (every grid line of
+// that direction a single repeated point), and cells that span as many dimensions as the block
+// has active directions: the sum over cells and cell corners of |det| of the corner's edge
+// vectors along the active directions (length, area, volume) exceeds 1e-12 L^D, L the diagonal
+// of the bounding box, D the active directions. So a block whose points are all equal, lie on one
+// line (a surface) or one plane (a volume) is refused; collapsed edges and faces (polar axes,
+// wing-tip caps) leave other cells with a measure and pass. Otherwise INVALID_ARGUMENT naming
+// `what` and what is degenerate. Cost O(points), one pass per direction and one over the cells.
+absl::Status ValidateFittable(const StructuredBlock& block, const std::string& what);
+
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_GRID_STRUCTURED_GRID_H_

@@ -219,12 +219,16 @@ TEST(FitBlockTest, RejectsBadOptionsAndData) {
   StructuredBlock block({10, 6, 1}, 3);
   for (size_t i = 0; i < block.coords().size(); ++i) block.coords()[i] = std::sin(double(i));
   FitOptions options;
-  options.control_counts = {3, 4, 0};
+  options.control_counts = {4, 4, 0};
   options.order = 4;
-  EXPECT_TRUE(FitBlock(block, options).ok());  // order drops to 3 in i
+  EXPECT_TRUE(FitBlock(block, options).ok());
+  // Fewer controls than the order: refused, not fitted at a lower order.
+  options.control_counts = {3, 4, 0};
+  EXPECT_THAT(FitBlock(block, options).status().message(),
+              HasSubstr("control_counts[0] = 3 is below order = 4"));
   options.control_counts = {11, 4, 0};
   EXPECT_THAT(FitBlock(block, options).status().message(),
-              HasSubstr("control_counts[0] = 11 is outside [2, 10]"));
+              HasSubstr("control_counts[0] = 11 exceeds the 10 points of the block in i"));
   options.control_counts = {5, 1, 0};
   EXPECT_THAT(FitBlock(block, options).status().message(), HasSubstr("control_counts[1] = 1"));
   options.control_counts = {5, 4, 3};
