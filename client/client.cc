@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/file_util.h"
 #include "core/util/status_macros.h"
 #include "third_party/grpc_health/health.grpc.pb.h"
 
@@ -140,17 +141,56 @@ std::unique_ptr<Client> Client::Connect(const std::string& target, ClientOptions
     args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, ms(options.retry.initial_backoff));
     args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, ms(options.retry.max_backoff));
   }
-  return std::make_unique<Client>(
-      grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), args), options);
+  std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+  if (options.use_tls) {
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = options.tls_root_certs;
+    ssl.pem_cert_chain = options.tls_cert_chain;
+    ssl.pem_private_key = options.tls_private_key;
+    credentials = grpc::SslCredentials(ssl);
+    if (!options.tls_server_name.empty()) {
+      args.SetSslTargetNameOverride(options.tls_server_name);
+    }
+  }
+  return std::make_unique<Client>(grpc::CreateCustomChannel(target, credentials, args), options);
+}
+
+absl::Status LoadTlsFiles(const std::string& ca_file, const std::string& cert_file,
+                          const std::string& key_file, ClientOptions* options) {
+  if (cert_file.empty() != key_file.empty()) {
+    return absl::InvalidArgumentError(
+        "a client certificate needs both --tls_cert and --tls_key (or neither)");
+  }
+  const auto read = [](const std::string& path, const char* flag,
+                       std::string* pem) -> absl::Status {
+    if (path.empty()) return absl::OkStatus();
+    absl::StatusOr<std::string> text = ReadFileToString(path);
+    if (!text.ok()) {
+      return absl::Status(text.status().code(),
+                          absl::StrCat("--", flag, ": ", text.status().message()));
+    }
+    *pem = *std::move(text);
+    return absl::OkStatus();
+  };
+  SG_RETURN_IF_ERROR(read(ca_file, "tls_ca", &options->tls_root_certs));
+  SG_RETURN_IF_ERROR(read(cert_file, "tls_cert", &options->tls_cert_chain));
+  SG_RETURN_IF_ERROR(read(key_file, "tls_key", &options->tls_private_key));
+  if (!ca_file.empty() || !cert_file.empty()) options->use_tls = true;
+  return absl::OkStatus();
 }
 
 std::unique_ptr<grpc::ClientContext> Client::NewContext(absl::Time deadline,
-                                                        const std::string& grid) {
+                                                        const std::string& grid,
+                                                        const std::string& token) {
   auto context = std::make_unique<grpc::ClientContext>();
   if (deadline != absl::InfiniteFuture()) context->set_deadline(absl::ToChronoTime(deadline));
   if (!grid.empty() &&
       std::all_of(grid.begin(), grid.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
     context->AddMetadata(kGridRoutingHeader, grid);
+  }
+  if (!token.empty() &&
+      std::all_of(token.begin(), token.end(), [](char c) { return c > 0x20 && c < 0x7F; })) {
+    context->AddMetadata("authorization", absl::StrCat("Bearer ", token));
   }
   return context;
 }
@@ -159,7 +199,7 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
   const absl::Time deadline = absl::Now() + options_.timeout;
   Backoff backoff(options_.retry);
   for (int attempts = 1;; ++attempts) {
-    auto context = NewContext(deadline, grid);
+    auto context = NewContext(deadline, grid, options_.token);
     bool responded = false;
     const grpc::Status status = attempt(context.get(), &responded);
     std::optional<absl::Duration> wait;
@@ -425,10 +465,10 @@ std::unique_ptr<RevisionStream> Client::Watch(const std::string& name, int64_t a
   if (cancel == nullptr) cancel = std::make_shared<WatchCancel>();
   // The stream may outlive this client: it keeps a stub of its own (sharing the channel).
   std::shared_ptr<v1::SplineGrid::Stub> stub = v1::SplineGrid::NewStub(channel_);
-  auto open = [stub, request] {
+  auto open = [stub, request, token = options_.token] {
     RevisionStream::Call call;
     // No deadline: a watch lasts.
-    call.context = NewContext(absl::InfiniteFuture(), GridId(request.name()));
+    call.context = NewContext(absl::InfiniteFuture(), GridId(request.name()), token);
     call.reader = stub->WatchGrid(call.context.get(), request);
     return call;
   };
@@ -463,7 +503,8 @@ absl::StatusOr<v1::EvaluatePointsResponse> Client::EvaluatePoints(
 
 absl::StatusOr<std::string> Client::Health(const std::string& service) {
   auto stub = grpc::health::v1::Health::NewStub(channel_);
-  auto context = NewContext(absl::Now() + options_.timeout, "");  // not retried: a probe
+  // Not retried: a probe answers for now.
+  auto context = NewContext(absl::Now() + options_.timeout, "", options_.token);
   grpc::health::v1::HealthCheckRequest request;
   request.set_service(service);
   grpc::health::v1::HealthCheckResponse response;

@@ -40,7 +40,29 @@ struct ClientOptions {
   // and FairGrid may store a second revision; imports and GenerateGrid with an id answer
   // ALREADY_EXISTS, DeleteGrid NOT_FOUND. Set retry.max_attempts = 1 to see every UNAVAILABLE.
   RetryPolicy retry;
+
+  // ---- Security (serve --tokens, --tls_cert) ----
+  // Sent with every call as `authorization: Bearer TOKEN` (empty: none). Printable ASCII
+  // without blanks; anything else is not sent (the server then answers UNAUTHENTICATED).
+  std::string token;
+  // Connect() over TLS instead of plaintext.
+  bool use_tls = false;
+  // PEM of the CA(s) the server's certificate must chain to; empty: the system's roots.
+  std::string tls_root_certs;
+  // PEM of this client's certificate chain and private key, for a server that requires client
+  // certificates (mTLS); both or neither.
+  std::string tls_cert_chain;
+  std::string tls_private_key;
+  // The name the server's certificate must carry, when it is not the target's host.
+  std::string tls_server_name;
 };
+
+// Reads the PEM files of a TLS connection into `options` and sets use_tls when any is given:
+// `ca_file` (--tls_ca) the CA to trust, `cert_file`/`key_file` (--tls_cert/--tls_key) the
+// client's certificate for mTLS. Empty paths are skipped. NOT_FOUND naming the flag and the path
+// for a file that cannot be read; INVALID_ARGUMENT for a cert without a key or vice versa.
+absl::Status LoadTlsFiles(const std::string& ca_file, const std::string& cert_file,
+                          const std::string& key_file, ClientOptions* options);
 
 // Progress of a transfer: bytes done and the total (0 when unknown).
 using ProgressFn = std::function<void(int64_t done, int64_t total)>;
@@ -154,7 +176,7 @@ bool PauseBeforeRetry(grpc::Channel& channel, absl::Duration wait,
 class Client {
  public:
   Client(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
-  // An insecure channel to host:port.
+  // A channel to host:port: plaintext, or TLS with options.use_tls.
   static std::unique_ptr<Client> Connect(const std::string& target, ClientOptions options = {});
 
   // Uploads a Plot3D file's bytes as a new grid. grid_id may be empty (the server picks one).
@@ -230,10 +252,12 @@ class Client {
   // arrived (a streaming call is not retried past that).
   using Attempt = std::function<grpc::Status(grpc::ClientContext* context, bool* responded)>;
 
-  // A context with `deadline` (InfiniteFuture: none) and, for a non-empty `grid` of printable
-  // ASCII (anything else is no grid id the server accepts), the routing header naming it.
+  // A context with `deadline` (InfiniteFuture: none), for a non-empty `grid` of printable
+  // ASCII (anything else is no grid id the server accepts) the routing header naming it, and
+  // for a non-empty `token` the authorization header.
   static std::unique_ptr<grpc::ClientContext> NewContext(absl::Time deadline,
-                                                         const std::string& grid);
+                                                         const std::string& grid,
+                                                         const std::string& token);
   // Runs `attempt` on a fresh context (deadline options_.timeout from now, shared by all
   // attempts; routing header `grid`) until it does not fail with UNAVAILABLE, has responded,
   // or options_.retry gives up; the last attempt's status (annotated with the attempt count

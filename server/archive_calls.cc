@@ -5,9 +5,11 @@
 #include <optional>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
+#include "server/idle_watchdog.h"
 #include "server/service.h"
 #include "server/store/grid_archive.h"
 
@@ -22,21 +24,32 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
   ExportReactor(ServiceState* state, grpc::CallbackServerContext* context,
                 const v1::ExportGridRequest* request)
       : state_(state),
+        context_(context),
         request_(request),
-        log_("ExportGrid", request->name(), state->options.log_calls) {
+        log_("ExportGrid", request->name(), state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
     if (!caller.ok()) {
       End(caller.status());
-    } else if (caller_ = *std::move(caller);
-               !state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Prepare(); })) {
-      End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+      return;
+    }
+    caller_ = *std::move(caller);
+    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
+    if (!slot.ok()) {
+      End(slot.status());
+      return;
+    }
+    stream_ = *std::move(slot);
+    if (absl::Status status =
+            state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Prepare(); });
+        !status.ok()) {
+      End(status);
     }
   }
 
   void OnWriteDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
     if (!ok) {
-      End(absl::CancelledError("the client stopped reading the export"));
+      End(WhyCallEnded(*state_, context_));
       return;
     }
     records_.pop_front();
@@ -75,6 +88,7 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
 
   void WriteNext() {
     if (records_.empty()) {
+      stream_.Release();  // the call is over for its principal once its status goes out
       log_.Finish(absl::OkStatus());
       SG_HAPPENS_BEFORE(this);
       Finish(grpc::Status::OK);
@@ -85,15 +99,19 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
   }
 
   void End(const absl::Status& status) {
+    stream_.Release();  // the call is over for its principal once its status goes out
     log_.Finish(status);
     SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
   }
 
   ServiceState* state_;
+  grpc::CallbackServerContext* context_;
   const v1::ExportGridRequest* request_;
   CallLog log_;
   Caller caller_;
+  // This call's place among its principal's open streams.
+  StreamSlot stream_;
   MemoryReservation memory_;
   std::deque<v1::ExportGridResponse> records_;
 };
@@ -101,17 +119,24 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
 // Assembles the records as they arrive (memory charged as data comes, not as the header
 // announces), then stores the grid on the pool: nothing is stored unless the whole archive
 // arrived and checks out.
-class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveRequest> {
+class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>> {
  public:
   ImportArchiveReactor(ServiceState* state, grpc::CallbackServerContext* context,
                        v1::Grid* response)
-      : state_(state), response_(response), log_("ImportArchive", "", state->options.log_calls) {
+      : state_(state), response_(response), log_("ImportArchive", "", state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
     if (!caller.ok()) {
       End(caller.status());
       return;
     }
     caller_ = *std::move(caller);
+    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
+    if (!slot.ok()) {
+      End(slot.status());
+      return;
+    }
+    stream_ = *std::move(slot);
+    idle_.Start(state_->options.import_idle_timeout, [this] { OnIdle(); });
     SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
@@ -119,12 +144,20 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
   void OnReadDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
     if (!ok) {  // the client closed its side: everything has arrived
-      if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); })) {
-        End(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+      idle_.Stop();  // from here on the call is the pool's
+      if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
+      if (absl::Status status =
+              state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
+          !status.ok()) {
+        End(status);
       }
       return;
     }
+    idle_.Touch();
+    std::lock_guard<std::mutex> lock(mu_);
+    if (ended_) return;  // the idle timeout ended the call meanwhile
     if (absl::Status status = Accept(); !status.ok()) {
+      ended_ = true;
       End(status);
       return;
     }
@@ -134,23 +167,34 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
 
   void OnDone() override {
     SG_HAPPENS_AFTER(this);
+    idle_.Stop();
     delete this;
   }
 
  private:
+  // On the watchdog's thread: nothing arrived for import_idle_timeout (a read is pending).
+  void OnIdle() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (ended_) return;
+    ended_ = true;
+    End(IdleTimeoutError("ImportArchive", state_->options.import_idle_timeout));
+  }
+
   absl::Status Accept() {
+    if (!message_.status.ok()) return message_.status;
+    const v1::ImportArchiveRequest& message = message_.message;
     if (!assembler_) {
-      const std::string& id = message_.grid_id();
+      const std::string& id = message.grid_id();
       if (!id.empty() && !IsValidGridId(id)) {
         return absl::InvalidArgumentError(
-            absl::StrCat("grid_id = '", id.substr(0, 80),
-                         "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+            absl::StrCat("grid_id = ", QuoteClientString(id),
+                         " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
       }
       assembler_.emplace(&state_->budget, id);
-    } else if (!message_.grid_id().empty()) {
+    } else if (!message.grid_id().empty()) {
       return absl::InvalidArgumentError("grid_id is set after the first message");
     }
-    const absl::Status added = assembler_->Add(message_.record());
+    const absl::Status added = assembler_->Add(message.record());
     if (!added.ok()) {
       return absl::Status(added.code(), absl::StrCat("record ", records_, ": ", added.message()));
     }
@@ -164,6 +208,7 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
       if (!assembler_) return absl::InvalidArgumentError("the archive is empty: no records came");
       SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
                           assembler_->Finish(/*check_counts=*/true));
+      grid->owner = caller_.owner();  // the importer's, not the exporter's
       log_.set_grid(absl::StrCat("grids/", grid->id));
       SG_RETURN_IF_ERROR(state_->store->Create(grid));
       return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
@@ -173,6 +218,7 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
   }
 
   void End(const absl::Status& status) {
+    stream_.Release();  // the call is over for its principal once its status goes out
     log_.Finish(status);
     SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
@@ -182,9 +228,14 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<v1::ImportArchiveReq
   v1::Grid* response_;
   CallLog log_;
   Caller caller_;
-  v1::ImportArchiveRequest message_;
+  // This call's place among its principal's open streams.
+  StreamSlot stream_;
+  Decoded<v1::ImportArchiveRequest> message_;
   std::optional<GridAssembler> assembler_;
   int64_t records_ = 0;
+  IdleWatch idle_;      // ends the call when nothing arrives for import_idle_timeout
+  std::mutex mu_;       // orders the reads' Finish/StartRead against the idle watch's Finish
+  bool ended_ = false;  // guarded by mu_: Finish was called from OnReadDone or OnIdle
 };
 
 }  // namespace
@@ -194,8 +245,9 @@ grpc::ServerWriteReactor<v1::ExportGridResponse>* SplineGridService::ExportGrid(
   return new ExportReactor(state_, context, request);
 }
 
-grpc::ServerReadReactor<v1::ImportArchiveRequest>* SplineGridService::ImportArchive(
-    grpc::CallbackServerContext* context, v1::Grid* response) {
+grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>>*
+SplineGridService::ImportArchiveStream(grpc::CallbackServerContext* context,
+                                       v1::Grid* response) {
   return new ImportArchiveReactor(state_, context, response);
 }
 

@@ -37,14 +37,25 @@ std::string DeformerKey(const StoredGrid& grid, int64_t reference,
 grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerContext* context,
                                                         const v1::DeformGridRequest* request,
                                                         v1::DeformGridResponse* response) {
-  CallLog log("DeformGrid", request->name(), state_->options.log_calls);
+  CallLog log("DeformGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
+  // A deform with a kept deformer costs about a millisecond: cheap work. Building the deformer
+  // (the grid's first deform, or after its 16 most recent were evicted) factorises the boundary
+  // fits, up to seconds: long work. Whether this grid has one kept is the hint (a new boundary
+  // or reference on a grid that has one is built on the cheap lane, once).
+  const absl::StatusOr<std::string> grid_id = ParseGridName(request->name(), "name");
+  const WorkKind kind = grid_id.ok() && state_->deformers.HasAny(DeformerKeyPrefix(*grid_id))
+                            ? WorkKind::kCheap
+                            : WorkKind::kLong;
   return RunOnPool(
-      context, log, Role::kWrite, WorkKind::kCheap,
+      context, log, Role::kWrite, kind,
       [this, request, response, cancel](const Caller&) -> absl::Status {
         const auto start = std::chrono::steady_clock::now();
         SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        // The base is checked again, atomically, when the revision is added.
+        SG_ASSIGN_OR_RETURN(
+            const std::shared_ptr<const StoredGrid> grid,
+            state_->store->GetHolding(id, {request->base_revision(), request->reference_revision()}));
         if (request->base_revision() < 0 || request->reference_revision() < 0) {
           return absl::InvalidArgumentError(absl::StrCat(
               "base_revision = ", request->base_revision(), " and reference_revision = ",

@@ -21,6 +21,14 @@ absl::StatusOr<std::shared_ptr<const Deformer>> DeformerCache::Get(
   return deformer;
 }
 
+bool DeformerCache::HasAny(const std::string& prefix) {
+  std::lock_guard<std::mutex> lock(mu_);
+  for (const auto& entry : entries_) {
+    if (entry.first.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
 void DeformerCache::Forget(const std::string& prefix) {
   std::lock_guard<std::mutex> lock(mu_);
   entries_.remove_if([&](const auto& e) { return e.first.rfind(prefix, 0) == 0; });

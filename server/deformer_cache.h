@@ -28,6 +28,10 @@ class DeformerCache {
   // Drops every entry whose key starts with `prefix` (a deleted grid's).
   void Forget(const std::string& prefix);
 
+  // Whether an entry whose key starts with `prefix` is kept (a hint for the scheduler: the
+  // next call may still miss, e.g. with another boundary).
+  bool HasAny(const std::string& prefix);
+
  private:
   const int capacity_;
   std::mutex mu_;

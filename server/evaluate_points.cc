@@ -55,12 +55,13 @@ absl::StatusOr<int64_t> CheckRequest(const v1::EvaluatePointsRequest& request,
 grpc::ServerUnaryReactor* SplineGridService::EvaluatePoints(
     grpc::CallbackServerContext* context, const v1::EvaluatePointsRequest* request,
     v1::EvaluatePointsResponse* response) {
-  CallLog log("EvaluatePoints", request->name(), state_->options.log_calls);
+  CallLog log("EvaluatePoints", request->name(), state_->options);
   return RunOnPool(
       context, log, Role::kRead, WorkKind::kCheap,
       [this, request, response](const Caller&) -> absl::Status {
         SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
-        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                            state_->store->GetHolding(id, {request->revision()}));
         SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> rev,
                             grid->FindRevision(request->revision(), OptionalStep(*request)));
         SG_ASSIGN_OR_RETURN(const int64_t n,

@@ -20,6 +20,9 @@ namespace {
 
 constexpr int64_t kChunkBytes = 256 << 10;
 constexpr size_t kMaxReady = 8;  // messages evaluated ahead of the network
+// Evaluations of at most this many points in all are cheap work for the scheduler (about a
+// millisecond: the points of a 225 x 65 grid); larger ones are long work, shared fairly.
+constexpr int64_t kMaxCheapPoints = int64_t{1} << 16;
 
 struct BlockPlan {
   int block;
@@ -35,15 +38,23 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
         context_(context),
         request_(request),
         cancel_(CallCancelCheck(context)),
-        log_("EvaluateGrid", request->name(), state->options.log_calls) {
+        log_("EvaluateGrid", request->name(), state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
     if (!caller.ok()) {
       Fail(caller.status());
       return;
     }
     caller_ = *std::move(caller);
-    if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kCheap, [this] { Start(); })) {
-      Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
+    if (!slot.ok()) {
+      Fail(slot.status());
+      return;
+    }
+    stream_ = *std::move(slot);
+    if (absl::Status status =
+            state_->pool.TrySubmit(caller_.principal, WorkKind::kCheap, [this] { Start(); });
+        !status.ok()) {
+      Fail(status);
     }
   }
 
@@ -53,7 +64,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       std::lock_guard<std::mutex> lock(mu_);
       writing_ = false;
       ready_.pop_front();
-      if (!ok && status_.ok()) status_ = absl::CancelledError("the client went away");
+      if (!ok && status_.ok()) status_ = WhyCallEnded(*state_, context_);
     }
     Pump();
   }
@@ -89,7 +100,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
 
   absl::StatusOr<std::unique_ptr<v1::EvaluateGridResponse>> Plan() {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
-    SG_ASSIGN_OR_RETURN(grid_, state_->store->Get(id));
+    SG_ASSIGN_OR_RETURN(grid_, state_->store->GetHolding(id, {request_->revision()}));
     if (request_->revision() < 0) {
       return absl::InvalidArgumentError(
           absl::StrCat("revision = ", request_->revision(), " is negative"));
@@ -105,7 +116,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     auto header = std::make_unique<v1::EvaluateGridResponse>();
     v1::EvaluationHeader* h = header->mutable_header();
     const int s = revision_->blocks.front().fitted.spline.spatial_dim();
-    int64_t total = 0, work_bytes = 0;
+    int64_t total = 0, work_bytes = 0, param_bytes = 0;
     std::vector<bool> seen(num_blocks, false);
     for (size_t q = 0; q < blocks.size(); ++q) {
       const int b = blocks[q];
@@ -139,16 +150,24 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       eb->set_block(b);
       EncodeExtents(*extents, eb->mutable_extents());
       plan_.push_back({b, *extents, {}});
-      SG_ASSIGN_OR_RETURN(plan_.back().params, SampleParameters(fitted.distribution, resolution));
+      param_bytes +=
+          (int64_t{(*extents)[0]} + (*extents)[1] + (*extents)[2]) * int64_t{sizeof(double)};
     }
-    SG_ASSIGN_OR_RETURN(memory_,
-                        state_->budget.Reserve(work_bytes + int64_t{kMaxReady + 4} * kChunkBytes,
-                                               "the evaluation"));
+    // Reserved before the parameters are sampled: a small request may ask for 2^30 of them.
+    SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(
+                                     work_bytes + param_bytes + int64_t{kMaxReady + 4} * kChunkBytes,
+                                     "the evaluation"));
+    for (BlockPlan& block : plan_) {
+      SG_ASSIGN_OR_RETURN(block.params,
+                          SampleParameters(revision_->blocks[block.block].fitted.distribution,
+                                           resolution));
+    }
     h->set_revision(revision_->number);
     h->set_spatial_dim(s);
     h->set_precision(float_values() ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
     h->set_derivatives(request_->derivatives());
     h->set_total_points(total);
+    produce_kind_ = total <= kMaxCheapPoints ? WorkKind::kCheap : WorkKind::kLong;
     spatial_dim_ = s;
     points_per_chunk_ = std::max<int64_t>(
         1,
@@ -183,6 +202,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       }
     }
     if (finish) {
+      stream_.Release();  // the call is over for its principal once its status goes out
       log_.Finish(final_status);
       SG_HAPPENS_BEFORE(this);
       Finish(ToGrpcStatus(final_status));
@@ -192,13 +212,15 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       SG_HAPPENS_BEFORE(this);
       StartWrite(next);
     }
-    if (produce &&
-        !state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Produce(); })) {
+    if (!produce) return;
+    if (absl::Status status = state_->pool.TrySubmit(
+            caller_.principal, produce_kind_, [this] { Produce(); }, Admission::kContinuation);
+        !status.ok()) {
       {
         std::lock_guard<std::mutex> lock(mu_);
         producing_ = false;
       }
-      Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+      Fail(status);
     }
   }
 
@@ -211,8 +233,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
         if (!status_.ok() || ready_.size() + num_fields() > kMaxReady) break;
       }
       if (cancel_()) {
-        status = ExplainCancellation(
-            context_, absl::CancelledError("EvaluateGrid was cancelled by the client"));
+        status = WhyCallEnded(*state_, context_);
         break;
       }
       std::vector<std::unique_ptr<v1::EvaluateGridResponse>> step;
@@ -302,6 +323,9 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   CancelCheck cancel_;
   CallLog log_;
   Caller caller_;
+  // This call's place among its principal's open streams.
+  StreamSlot stream_;
+  WorkKind produce_kind_ = WorkKind::kLong;  // set by Plan()
   std::shared_ptr<const StoredGrid> grid_;
   std::shared_ptr<const GridRevision> revision_;
   std::vector<BlockPlan> plan_;

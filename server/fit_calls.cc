@@ -6,12 +6,27 @@
 #include "server/service.h"
 
 namespace splinegrid::server {
+namespace {
+
+// The request field the options of a revision of `origin` came from, in front of the kernel's
+// field names: "spec." (FitGrid, GenerateGrid) or the fit spec of the refaired revision.
+std::string SpecField(RevisionOrigin origin, int64_t parent) {
+  return origin == RevisionOrigin::kFair ? absl::StrCat("revision ", parent, " fit_spec.")
+                                         : std::string("spec.");
+}
+
+}  // namespace
 
 absl::StatusOr<GridRevision> SplineGridService::FitRevision(const SourcePoints& source,
                                                             const GridFitOptions& options,
                                                             RevisionOrigin origin, int64_t parent,
                                                             const CancelCheck& cancel) {
-  SG_RETURN_IF_ERROR(options.Validate(source.grid));
+  // Options that do not suit the grid are refused, naming the request's field, value and limit
+  // ("spec.control_counts[0] = 1000 exceeds the 113 points of block 0 in i"); nothing is
+  // clamped, and nothing is stored.
+  if (absl::Status s = options.Validate(source.grid); !s.ok()) {
+    return absl::Status(s.code(), absl::StrCat(SpecField(origin, parent), s.message()));
+  }
   // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,
@@ -45,7 +60,7 @@ absl::Status SplineGridService::FitAndStore(const StoredGrid& grid, const GridFi
 grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext* context,
                                                      const v1::FitGridRequest* request,
                                                      v1::FitGridResponse* response) {
-  CallLog log("FitGrid", request->name(), state_->options.log_calls);
+  CallLog log("FitGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(
       context, log, Role::kWrite, WorkKind::kLong,
@@ -60,7 +75,7 @@ grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext
 grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContext* context,
                                                       const v1::FairGridRequest* request,
                                                       v1::FitGridResponse* response) {
-  CallLog log("FairGrid", request->name(), state_->options.log_calls);
+  CallLog log("FairGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(
       context, log, Role::kWrite, WorkKind::kLong,

@@ -11,6 +11,7 @@
 #include "core/generate/profile_grid.h"
 #include "core/grid/sampling.h"
 #include "core/io/airfoil.h"
+#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "proto/convert/generate_convert.h"
@@ -137,13 +138,14 @@ absl::StatusOr<ProfileSource> ProfileOf(GridStore& store, const v1::GenerateGrid
 }  // namespace
 
 absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
-                                         const CancelCheck& cancel,
+                                         const std::string& owner, const CancelCheck& cancel,
                                          v1::GenerateGridResponse* response) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& id = request.grid_id();
   if (!id.empty() && !IsValidGridId(id)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "grid_id = '", id, "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+        "grid_id = ", QuoteClientString(id),
+        " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
   }
   if (request.display_name().size() > 1024) {
     return absl::InvalidArgumentError("display_name is longer than 1024 bytes");
@@ -193,6 +195,7 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
   revision.number = 1;
   auto grid = std::make_shared<StoredGrid>();
   grid->display_name = request.display_name().empty() ? profile.name : request.display_name();
+  grid->owner = owner;
   grid->create_time = absl::Now();
   grid->source = std::move(source);
   grid->revisions.push_back(std::make_shared<const GridRevision>(std::move(revision)));
@@ -209,11 +212,11 @@ grpc::ServerUnaryReactor* SplineGridService::GenerateGrid(grpc::CallbackServerCo
                                                           const v1::GenerateGridRequest* request,
                                                           v1::GenerateGridResponse* response) {
   CallLog log("GenerateGrid", request->grid_id().empty() ? "" : "grids/" + request->grid_id(),
-              state_->options.log_calls);
+              state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, Role::kWrite, WorkKind::kLong,
-                   [this, request, response, cancel](const Caller&) {
-                     return Generate(*request, cancel, response);
+                   [this, request, response, cancel](const Caller& caller) {
+                     return Generate(*request, caller.owner(), cancel, response);
                    });
 }
 

@@ -33,6 +33,7 @@ void EncodeFitResponse(const GridRevision& revision, v1::FitGridResponse* out) {
   out->set_max_deviation(report.max_deviation);
   out->set_seconds(report.seconds);
   EncodeFitReport(report, revision.blocks, out->mutable_report());
+  out->mutable_report()->set_tolerances_given(revision.fit_options.tolerance_mode());
 }
 
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
@@ -55,6 +56,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
                         const std::vector<int>& blocks, v1::Grid* out) {
   out->set_name(absl::StrCat("grids/", grid.id));
   out->set_display_name(grid.display_name);
+  out->set_owner(grid.owner);
   EncodeStoredTime(grid.create_time, out->mutable_create_time());
   const MultiBlockGrid& source = grid.source->grid;
   v1::SourceGrid* src = out->mutable_source();
@@ -103,6 +105,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   r->set_max_deviation(rev.max_deviation());
   if (rev.origin != RevisionOrigin::kDeform) {
     EncodeFitReport(rev.report, rev.blocks, r->mutable_report());
+    r->mutable_report()->set_tolerances_given(rev.fit_options.tolerance_mode());
   } else {
     r->set_time(rev.time);
     r->set_step(rev.step);

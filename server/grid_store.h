@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <deque>
+#include <initializer_list>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -87,6 +88,9 @@ struct SourcePoints {
 struct StoredGrid {
   std::string id;  // grids/{id}
   std::string display_name;
+  // The principal whose token created the grid; empty when it was created without tokens (then
+  // only an admin may delete it on a server with tokens).
+  std::string owner;
   absl::Time create_time;
   std::shared_ptr<const SourcePoints> source;
   std::vector<std::shared_ptr<const GridRevision>> revisions;  // ascending numbers
@@ -177,6 +181,17 @@ class GridStore {
 
   // The current snapshot, or NOT_FOUND.
   virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) = 0;
+
+  // A snapshot that holds every revision in `numbers` (revisions are immutable), possibly older
+  // than Get's: for reads of given revisions, and for writes whose base the store checks
+  // atomically anyway (AddRevision's expected_latest). A number <= 0 (the latest) needs Get's.
+  // A store with a per-process cache of a shared store (redis) answers from it when the cached
+  // snapshot holds them and was confirmed recently, which saves a round trip per call; the
+  // others answer Get.
+  virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> GetHolding(
+      const std::string& id, std::initializer_list<int64_t> /*numbers*/) {
+    return Get(id);
+  }
 
   // Publishes `revision` (its number is assigned here: latest + 1) as the grid's newest, drops
   // deformed revisions beyond the retention limit, tells the grid's watchers and returns the new

@@ -1,27 +1,43 @@
 // SplineGridService::ImportGrid: a client stream of a header and then Plot3D bytes or points.
 // Data are appended on gRPC's thread (copies only); parsing and validation run on the pool.
+// Memory is allocated and charged to the budget as data arrive, never from the header's
+// announced sizes; a stream that sends nothing for --import_idle_timeout is ended.
+#include <algorithm>
+#include <mutex>
+#include <vector>
+
 #include "absl/strings/str_cat.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
+#include "core/io/plot3d_memory.h"
+#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
+#include "server/idle_watchdog.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
 namespace {
 
-class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
+class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridRequest>> {
  public:
   ImportReactor(ServiceState* state, grpc::CallbackServerContext* context, v1::Grid* response)
-      : state_(state), response_(response), log_("ImportGrid", "", state->options.log_calls) {
+      : state_(state), response_(response), log_("ImportGrid", "", state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
     if (!caller.ok()) {
       Fail(caller.status());
       return;
     }
     caller_ = *std::move(caller);
+    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
+    if (!slot.ok()) {
+      Fail(slot.status());
+      return;
+    }
+    stream_ = *std::move(slot);
+    idle_.Start(state_->options.import_idle_timeout, [this] { OnIdle(); });
     SG_HAPPENS_BEFORE(this);
     StartRead(&message_);
   }
@@ -29,12 +45,21 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
   void OnReadDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
     if (!ok) {  // the client closed its side: everything has arrived
-      if (!state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); })) {
-        Fail(absl::ResourceExhaustedError("the server is busy: its work queue is full"));
+      idle_.Stop();  // from here on the call is the pool's
+      if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
+      if (absl::Status status =
+              state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
+          !status.ok()) {
+        Fail(status);
       }
       return;
     }
-    if (absl::Status status = Accept(message_); !status.ok()) {
+    idle_.Touch();
+    std::lock_guard<std::mutex> lock(mu_);
+    if (ended_) return;  // the idle timeout ended the call meanwhile
+    if (absl::Status status = message_.status.ok() ? Accept(message_.message) : message_.status;
+        !status.ok()) {
+      ended_ = true;
       Fail(status);
       return;
     }
@@ -44,14 +69,40 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
 
   void OnDone() override {
     SG_HAPPENS_AFTER(this);
+    idle_.Stop();
     delete this;
   }
 
  private:
   void Fail(const absl::Status& status) {
+    stream_.Release();  // the call is over for its principal once its status goes out
     log_.Finish(status);
     SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
+  }
+
+  // On the watchdog's thread: nothing arrived for import_idle_timeout (a read is pending).
+  void OnIdle() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (ended_) return;
+    ended_ = true;
+    Fail(IdleTimeoutError("ImportGrid", state_->options.import_idle_timeout));
+  }
+
+  // Makes room for `more` elements in `into` (growing by doubling, capped at `limit` elements:
+  // at most twice what arrived, never more than announced), charging the growth first. While
+  // the elements move both buffers exist, so both are charged until the old one is freed.
+  template <typename Container>
+  absl::Status MakeRoom(Container& into, size_t more, size_t limit, const char* what) {
+    const size_t needed = into.size() + more;
+    if (needed <= into.capacity()) return absl::OkStatus();
+    constexpr int64_t kSize = sizeof(typename Container::value_type);
+    const size_t capacity = std::min(limit, std::max(needed, 2 * into.capacity()));
+    const int64_t old_bytes = static_cast<int64_t>(into.capacity()) * kSize;
+    SG_RETURN_IF_ERROR(
+        state_->budget.Extend(&upload_, static_cast<int64_t>(capacity) * kSize, what));
+    into.reserve(capacity);
+    return state_->budget.Resize(&upload_, upload_.bytes() - old_bytes, what);  // a release
   }
 
   absl::Status Accept(const v1::ImportGridRequest& message) {
@@ -76,8 +127,8 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     header_ = header;
     if (!header.grid_id().empty() && !IsValidGridId(header.grid_id())) {
       return absl::InvalidArgumentError(
-          absl::StrCat("header.grid_id = '", header.grid_id(),
-                       "' is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+          absl::StrCat("header.grid_id = ", QuoteClientString(header.grid_id()),
+                       " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
     }
     log_.set_grid(header.grid_id().empty() ? "" : absl::StrCat("grids/", header.grid_id()));
     if (header.display_name().size() > 1024) {
@@ -89,9 +140,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
         return absl::InvalidArgumentError(
             absl::StrCat("header.plot3d.total_bytes = ", total, "; must be positive"));
       }
-      SG_ASSIGN_OR_RETURN(upload_, state_->budget.Reserve(total, "the Plot3D upload"));
-      bytes_.reserve(total);
-      return absl::OkStatus();
+      return absl::OkStatus();  // charged as the bytes arrive (AcceptBytes)
     }
     if (!header.has_points()) {
       return absl::InvalidArgumentError("header: set plot3d or points as the source");
@@ -104,18 +153,18 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     if (header.points().blocks_size() == 0) {
       return absl::InvalidArgumentError("header.points.blocks is empty: a grid needs a block");
     }
-    int64_t values = 0;
-    for (int b = 0; b < header.points().blocks_size(); ++b) {
+    const int num_blocks = header.points().blocks_size();
+    SG_RETURN_IF_ERROR(state_->budget.Extend(
+        &upload_, num_blocks * int64_t{sizeof(Extents) + sizeof(std::vector<double>)},
+        "the header's blocks"));
+    for (int b = 0; b < num_blocks; ++b) {
       const Extents extents = ParseExtents(header.points().blocks(b));
       SG_RETURN_IF_ERROR(ValidateExtents(extents, absl::StrCat("header.points.blocks[", b, "]")));
-      values += s * NumPoints(extents);
+      extents_.push_back(extents);
     }
-    SG_ASSIGN_OR_RETURN(upload_,
-                        state_->budget.Reserve(values * int64_t{sizeof(double)}, "the points"));
-    for (int b = 0; b < header.points().blocks_size(); ++b) {
-      points_.blocks.emplace_back(ParseExtents(header.points().blocks(b)), s);
-    }
-    filled_.assign(points_.blocks.size(), 0);
+    coords_.resize(extents_.size());  // empty: they grow as points arrive (AcceptPoints)
+    header_.mutable_points()->clear_blocks();  // kept in extents_
+    message_.message = v1::ImportGridRequest();  // drops the header's capacity
     return absl::OkStatus();
   }
 
@@ -128,6 +177,9 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
           "plot3d_chunk: more than header.plot3d.total_bytes = ", header_.plot3d().total_bytes(),
           " bytes arrived"));
     }
+    SG_RETURN_IF_ERROR(MakeRoom(bytes_, chunk.size(),
+                                static_cast<size_t>(header_.plot3d().total_bytes()),
+                                "the Plot3D upload"));
     bytes_.append(chunk);
     return absl::OkStatus();
   }
@@ -137,18 +189,24 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
       return absl::InvalidArgumentError("points sent, but the header announced a Plot3D file");
     }
     const int b = chunk.block();
-    if (b < 0 || b >= static_cast<int>(points_.blocks.size())) {
+    if (b < 0 || b >= static_cast<int>(extents_.size())) {
       return absl::InvalidArgumentError(
-          absl::StrCat("points.block = ", b, " is outside [0, ", points_.blocks.size() - 1, "]"));
+          absl::StrCat("points.block = ", b, " is outside [0, ", extents_.size() - 1, "]"));
     }
-    std::span<double> coords = points_.blocks[b].coords();
-    if (filled_[b] + chunk.coordinates_size() > static_cast<int64_t>(coords.size())) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "points: block ", b, " receives more than its ", coords.size(), " coordinates"));
+    std::vector<double>& coords = coords_[b];
+    const size_t total = static_cast<size_t>(BlockValues(b));
+    if (coords.size() + chunk.coordinates_size() > total) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("points: block ", b, " receives more than its ", total, " coordinates"));
     }
-    std::copy(chunk.coordinates().begin(), chunk.coordinates().end(), coords.begin() + filled_[b]);
-    filled_[b] += chunk.coordinates_size();
+    SG_RETURN_IF_ERROR(MakeRoom(coords, chunk.coordinates_size(), total, "the points"));
+    coords.insert(coords.end(), chunk.coordinates().begin(), chunk.coordinates().end());
     return absl::OkStatus();
+  }
+
+  // Coordinates block `b` of a points source has (spatial_dim per point).
+  int64_t BlockValues(size_t b) const {
+    return header_.points().spatial_dim() * NumPoints(extents_[b]);
   }
 
   // Builds the source grid from what arrived (on the pool).
@@ -161,24 +219,44 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
                                                        header_.plot3d().total_bytes()));
       }
       Plot3dFormat detected;
+      // The parser's memory, bounded from the bytes before it allocates (text repeats "n*x"
+      // make a few bytes stand for gigabytes); then exactly the grid's.
+      SG_RETURN_IF_ERROR(state_->budget.Resize(&grid_memory_, Plot3dParseBytesBound(bytes_),
+                                               "parsing the Plot3D upload"));
       SG_ASSIGN_OR_RETURN(MultiBlockGrid grid, ParsePlot3d(bytes_, "upload", &detected));
+      SG_RETURN_IF_ERROR(
+          state_->budget.Resize(&grid_memory_, SourceBytes(grid), "the imported grid"));
       *format = absl::StrCat("plot3d ", DescribePlot3dFormat(detected));
       if (header_.plot3d().planar_view()) {
+        SG_RETURN_IF_ERROR(
+            state_->budget.Resize(&grid_memory_, 2 * SourceBytes(grid), "the planar view"));
         SG_ASSIGN_OR_RETURN(grid, PlanarView(grid));
         absl::StrAppend(format, ", planar view");
       }
       return grid;
     }
-    for (size_t b = 0; b < points_.blocks.size(); ++b) {
-      if (filled_[b] != static_cast<int64_t>(points_.blocks[b].coords().size())) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("points: block ", b, " received ", filled_[b], " of its ",
-                         points_.blocks[b].coords().size(), " coordinates"));
+    MultiBlockGrid grid;
+    const int s = header_.points().spatial_dim();
+    for (size_t b = 0; b < extents_.size(); ++b) {
+      const int64_t total = BlockValues(b);
+      if (static_cast<int64_t>(coords_[b].size()) != total) {
+        return absl::InvalidArgumentError(absl::StrCat("points: block ", b, " received ",
+                                                       coords_[b].size(), " of its ", total,
+                                                       " coordinates"));
       }
-      SG_RETURN_IF_ERROR(ValidateFinite(points_.blocks[b], absl::StrCat("points: block ", b)));
+      // The block allocates its own coordinates: one copy, then the arrived ones are freed.
+      SG_RETURN_IF_ERROR(state_->budget.Extend(&grid_memory_, total * int64_t{sizeof(double)},
+                                               "the imported grid"));
+      StructuredBlock block(extents_[b], s);
+      std::copy(coords_[b].begin(), coords_[b].end(), block.coords().begin());
+      const int64_t freed = static_cast<int64_t>(coords_[b].capacity() * sizeof(double));
+      coords_[b] = std::vector<double>();
+      SG_RETURN_IF_ERROR(state_->budget.Resize(&upload_, upload_.bytes() - freed, "the points"));
+      SG_RETURN_IF_ERROR(ValidateFinite(block, absl::StrCat("points: block ", b)));
+      grid.blocks.push_back(std::move(block));
     }
     *format = "points";
-    return std::move(points_);
+    return grid;
   }
 
   absl::Status Store() {
@@ -186,12 +264,19 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
     SG_ASSIGN_OR_RETURN(source->grid, BuildSource(&source->format));
     bytes_ = std::string();
     if (source->grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+    // A grid that cannot be fitted (all points equal, a direction of zero length, cells of no
+    // area or volume) is refused here, naming the block, not stored for every fit to fail.
+    for (size_t b = 0; b < source->grid.blocks.size(); ++b) {
+      SG_RETURN_IF_ERROR(ValidateFittable(source->grid.blocks[b], absl::StrCat("block ", b)));
+    }
     upload_ = MemoryReservation();
-    SG_ASSIGN_OR_RETURN(source->memory,
-                        state_->budget.Reserve(SourceBytes(source->grid), "the imported grid"));
+    SG_RETURN_IF_ERROR(
+        state_->budget.Resize(&grid_memory_, SourceBytes(source->grid), "the imported grid"));
+    source->memory = std::move(grid_memory_);
     SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
     auto grid = std::make_shared<StoredGrid>();
     grid->display_name = header_.display_name();
+    grid->owner = caller_.owner();
     grid->create_time = absl::Now();
     grid->source = std::move(source);
     SG_RETURN_IF_ERROR(CreateGrid(*state_->store, header_.grid_id(), grid));
@@ -201,6 +286,7 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
 
   void Complete() {
     const absl::Status status = Store();
+    stream_.Release();  // the call is over for its principal once its status goes out
     log_.Finish(status);
     SG_HAPPENS_BEFORE(this);
     Finish(ToGrpcStatus(status));
@@ -210,18 +296,24 @@ class ImportReactor : public grpc::ServerReadReactor<v1::ImportGridRequest> {
   v1::Grid* response_;
   CallLog log_;
   Caller caller_;
-  v1::ImportGridRequest message_;
+  // This call's place among its principal's open streams.
+  StreamSlot stream_;
+  Decoded<v1::ImportGridRequest> message_;
   bool have_header_ = false;
   v1::ImportHeader header_;
-  MemoryReservation upload_;
-  std::string bytes_;            // Plot3D file
-  MultiBlockGrid points_;        // points source
-  std::vector<int64_t> filled_;  // coordinates received per block
+  MemoryReservation upload_;       // what arrived (capacity), charged as it grows
+  MemoryReservation grid_memory_;  // the grid being built: the parser's bound, then its size
+  std::string bytes_;                         // Plot3D file
+  std::vector<Extents> extents_;              // points source: the header's blocks
+  std::vector<std::vector<double>> coords_;   // and their coordinates so far
+  IdleWatch idle_;  // ends the call when nothing arrives for import_idle_timeout
+  std::mutex mu_;   // orders the reads' Finish/StartRead against the idle watch's Finish
+  bool ended_ = false;  // guarded by mu_: Finish was called from OnReadDone or OnIdle
 };
 
 }  // namespace
 
-grpc::ServerReadReactor<v1::ImportGridRequest>* SplineGridService::ImportGrid(
+grpc::ServerReadReactor<Decoded<v1::ImportGridRequest>>* SplineGridService::ImportGridStream(
     grpc::CallbackServerContext* context, v1::Grid* response) {
   return new ImportReactor(state_, context, response);
 }

@@ -53,4 +53,16 @@ absl::Status MemoryBudget::Extend(MemoryReservation* reservation, int64_t bytes,
   return absl::OkStatus();
 }
 
+absl::Status MemoryBudget::Resize(MemoryReservation* reservation, int64_t bytes,
+                                  const std::string& what) {
+  if (bytes < 0) bytes = 0;
+  if (bytes >= reservation->bytes_) return Extend(reservation, bytes - reservation->bytes_, what);
+  if (reservation->budget_ != this) {
+    return absl::InternalError("a reservation was resized in another budget");
+  }
+  Release(reservation->bytes_ - bytes);
+  reservation->bytes_ = bytes;
+  return absl::OkStatus();
+}
+
 }  // namespace splinegrid::server

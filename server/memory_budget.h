@@ -42,6 +42,9 @@ class MemoryBudget {
   // Adds `bytes` to `reservation` (which then holds against this budget), or RESOURCE_EXHAUSTED
   // leaving it as it was: for data charged as it arrives.
   absl::Status Extend(MemoryReservation* reservation, int64_t bytes, const std::string& what);
+  // Makes `reservation` hold exactly `bytes`: releases the excess at once, or Extends by the
+  // shortfall (RESOURCE_EXHAUSTED leaving it as it was).
+  absl::Status Resize(MemoryReservation* reservation, int64_t bytes, const std::string& what);
 
   int64_t used() const { return used_.load(); }
   int64_t limit() const { return limit_; }

@@ -8,13 +8,16 @@
 #include "absl/strings/str_cat.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
 #include "grpcpp/health_check_service_interface.h"
+#include "server/auth/transport.h"
+#include "server/listen_address.h"
+#include "server/memory_limit.h"
 #include "server/store/open_store.h"
 
 namespace splinegrid::server {
 
 absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& options) {
   if (options.worker_threads < 0 || options.max_queued_tasks < 1 ||
-      options.memory_budget_bytes < 1 || options.max_output_points < 1 ||
+      options.memory_budget_bytes < 0 || options.max_output_points < 1 ||
       options.max_deform_revisions < 1 || options.max_watch_lag < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "server options out of range: worker_threads = ", options.worker_threads,
@@ -23,10 +26,42 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
         ", max_deform_revisions = ", options.max_deform_revisions,
         ", max_watch_lag = ", options.max_watch_lag));
   }
+  if (options.max_running_long_tasks < 0 ||
+      (options.worker_threads > 0 && options.max_running_long_tasks > options.worker_threads) ||
+      options.max_queued_long_calls_per_principal < 1 || options.max_streams_per_principal < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "scheduling options out of range: max_running_long_tasks = ",
+        options.max_running_long_tasks, " (0 or [1, worker_threads = ", options.worker_threads,
+        "]), max_queued_long_calls_per_principal = ", options.max_queued_long_calls_per_principal,
+        " (>= 1), max_streams_per_principal = ", options.max_streams_per_principal, " (>= 1)"));
+  }
+  if (!options.address.empty()) {
+    const absl::StatusOr<int> port = ParseListenPort(options.address, /*min_port=*/0);
+    if (!port.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("address: ", port.status().message()));
+    }
+  }
+  if (options.drain_notice < absl::ZeroDuration() ||
+      options.shutdown_grace < absl::ZeroDuration()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("drain_notice = ", absl::FormatDuration(options.drain_notice),
+                     " and shutdown_grace = ", absl::FormatDuration(options.shutdown_grace),
+                     " must not be negative"));
+  }
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
+      MakeServerCredentials(options);
+  if (!credentials.ok()) return credentials.status();
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   std::unique_ptr<Server> server(new Server());
-  server->state_ = std::make_unique<ServiceState>(options);
+  // 0: the default budget, a share of the memory limit (server/memory_limit.h).
+  ServerOptions resolved = options;
+  resolved.memory_budget_bytes = ResolveMemoryBudget(options.memory_budget_bytes).bytes;
+  server->state_ = std::make_unique<ServiceState>(resolved);
+  if (!options.tokens_file.empty()) {
+    absl::StatusOr<int> tokens = server->state_->authenticator.LoadTokens(options.tokens_file);
+    if (!tokens.ok()) return tokens.status();
+  }
   absl::StatusOr<std::unique_ptr<GridStore>> store = OpenStore(options, &server->state_->budget);
   if (!store.ok()) return store.status();
   server->state_->store = *std::move(store);
@@ -36,7 +71,7 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   // its connections with the first: refuse the port instead.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   if (!options.address.empty()) {
-    builder.AddListeningPort(options.address, grpc::InsecureServerCredentials(), &server->port_);
+    builder.AddListeningPort(options.address, *credentials, &server->port_);
   }
   builder.RegisterService(server->service_.get());
   server->server_ = builder.BuildAndStart();
@@ -52,6 +87,8 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
 
 Server::~Server() { Shutdown(); }
 
+absl::StatusOr<int> Server::ReloadTokens() { return state_->authenticator.Reload(); }
+
 void Server::SetServing(bool serving) {
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();
   health->SetServingStatus(serving);
@@ -62,6 +99,7 @@ void Server::FollowStoreHealth() {
   bool serving = state_->store->Available().ok();
   std::unique_lock<std::mutex> lock(health_mu_);
   while (!health_cv_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stopping_; })) {
+    if (drain_begun_) continue;  // NOT_SERVING until the end
     const absl::Status available = state_->store->Available();
     if (available.ok() == serving) continue;
     serving = available.ok();
@@ -101,9 +139,31 @@ void Server::Shutdown() {
   });
 }
 
+void Server::BeginDrain() {
+  std::lock_guard<std::mutex> lock(health_mu_);
+  if (!server_ || drain_begun_ || stopping_) return;
+  drain_begun_ = true;
+  SetServing(false);
+}
+
 void Server::Wait() {
   if (server_) server_->Wait();
 }
+
+namespace {
+
+// Waits up to `timeout` for SIGTERM or SIGINT among the blocked `signals` (others that arrive
+// meanwhile are taken and ignored).
+void WaitForStopSignal(const sigset_t& signals, absl::Duration timeout) {
+  const absl::Time end = absl::Now() + timeout;
+  for (absl::Duration left = timeout; left > absl::ZeroDuration(); left = end - absl::Now()) {
+    const timespec wait = absl::ToTimespec(left);
+    const int received = sigtimedwait(&signals, nullptr, &wait);
+    if (received == SIGTERM || received == SIGINT) return;
+  }
+}
+
+}  // namespace
 
 absl::Status RunServerUntilSignal(const ServerOptions& options) {
   // Block the signals in every thread (gRPC's and the pool's inherit the mask) and take them
@@ -112,19 +172,49 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);  // reloads the tokens file
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   absl::StatusOr<std::unique_ptr<Server>> server = Server::Start(options);
   if (!server.ok()) return server.status();
   std::fprintf(stderr,
-               "splinegrid serving on port %d (%s), store %s, %d workers, memory budget %lld MiB\n",
+               "splinegrid serving on port %d (%s), store %s, %d workers, memory budget %s, "
+               "import idle timeout %s\n",
                (*server)->port(), options.address.c_str(), options.store.c_str(),
                (*server)->state().pool.num_threads(),
-               static_cast<long long>(options.memory_budget_bytes >> 20));
+               ResolveMemoryBudget(options.memory_budget_bytes).description.c_str(),
+               options.import_idle_timeout > absl::ZeroDuration()
+                   ? absl::FormatDuration(options.import_idle_timeout).c_str()
+                   : "none");
+  const int num_tokens = (*server)->state().authenticator.num_tokens();
+  std::fprintf(stderr, "splinegrid: %s, %s\n", TransportName(options).c_str(),
+               num_tokens == 0 ? "no tokens (every caller is an admin)"
+                               : absl::StrCat(num_tokens, " tokens from ", options.tokens_file,
+                                              " (SIGHUP reloads)")
+                                     .c_str());
   int received = 0;
-  sigwait(&signals, &received);
-  std::fprintf(stderr, "splinegrid: %s received: draining (up to %s) and shutting down\n",
-               received == SIGTERM ? "SIGTERM" : "SIGINT",
-               absl::FormatDuration(options.shutdown_grace).c_str());
+  while (sigwait(&signals, &received) == 0 && received == SIGHUP) {
+    const absl::StatusOr<int> tokens = (*server)->ReloadTokens();
+    const std::string outcome = tokens.ok()
+                                    ? absl::StrCat("tokens reloaded: ", *tokens, " tokens")
+                                    : absl::StrCat("tokens not reloaded, the previous ones stay: ",
+                                                   tokens.status().message());
+    std::fprintf(stderr, "splinegrid: SIGHUP received: %s\n", outcome.c_str());
+  }
+  // The notice is for orchestrators and load balancers, which stop a server with SIGTERM; an
+  // interactive Ctrl-C (SIGINT) stops at once.
+  const char* signal_name = received == SIGTERM ? "SIGTERM" : "SIGINT";
+  if (received == SIGTERM && options.drain_notice > absl::ZeroDuration()) {
+    (*server)->BeginDrain();
+    std::fprintf(stderr,
+                 "splinegrid: SIGTERM received: NOT_SERVING, still accepting calls for %s "
+                 "(--drain_notice; a second signal ends it)\n",
+                 absl::FormatDuration(options.drain_notice).c_str());
+    WaitForStopSignal(signals, options.drain_notice);
+  }
+  std::fprintf(stderr,
+               "splinegrid: %s received: refusing new calls, in-flight ones get up to %s, then "
+               "stopping\n",
+               signal_name, absl::FormatDuration(options.shutdown_grace).c_str());
   (*server)->Shutdown();
   server->reset();
   std::fprintf(stderr, "splinegrid: stopped\n");

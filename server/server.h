@@ -38,7 +38,16 @@ class Server {
   // Blocks until Shutdown has completed.
   void Wait();
 
+  // The drain notice before Shutdown: health turns NOT_SERVING (overall and for kServiceName)
+  // and stays so (the store's health no longer changes it), while calls are still accepted and
+  // served, so that load balancers and probes stop sending new ones. Idempotent.
+  void BeginDrain();
+
   const ServiceState& state() const { return *state_; }
+
+  // Reads the tokens file again (ServerOptions::tokens_file); on error the previous tokens stay.
+  // The number of tokens, or why the file was refused.
+  absl::StatusOr<int> ReloadTokens();
 
  private:
   Server() = default;
@@ -56,10 +65,13 @@ class Server {
   std::mutex health_mu_;
   std::condition_variable health_cv_;
   bool stopping_ = false;
+  bool drain_begun_ = false;  // BeginDrain was called: health stays NOT_SERVING
   std::thread health_thread_;
 };
 
-// Starts a server and runs it until SIGTERM or SIGINT, then shuts down gracefully.
+// Starts a server and runs it until SIGTERM or SIGINT, then drains: NOT_SERVING while calls are
+// still accepted for options.drain_notice (Server::BeginDrain; a second SIGTERM or SIGINT cuts
+// it short), then Shutdown (new calls refused, in-flight ones get options.shutdown_grace).
 // Returns OK after a clean shutdown.
 absl::Status RunServerUntilSignal(const ServerOptions& options);
 

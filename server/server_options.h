@@ -6,8 +6,12 @@
 #include <string>
 
 #include "absl/time/time.h"
+#include "server/scheduler.h"
 
 namespace splinegrid::server {
+
+// The call log's lines: "text" (one line of fields) or "json" (one JSON object per line).
+enum class LogFormat { kText, kJson };
 
 struct ServerOptions {
   // host:port to listen on; port 0 picks a free port (see Server::port()); empty: no network
@@ -19,8 +23,21 @@ struct ServerOptions {
   int worker_threads = 0;
   // Tasks that may wait for a worker before calls are refused with RESOURCE_EXHAUSTED.
   int max_queued_tasks = 4096;
-  // Bytes the stored grids and in-flight work may hold (RESOURCE_EXHAUSTED beyond).
-  int64_t memory_budget_bytes = int64_t{4} << 30;
+  // Fair scheduling (server/scheduler.h): long tasks (fits, fairing, generation, imports, large
+  // evaluations) running at once, in [1, worker threads]; 0: worker threads - 1, at least 1,
+  // so that a worker is always free for cheap calls.
+  int max_running_long_tasks = SchedulerOptions{}.max_running_long;
+  // Long calls one principal may have waiting for a worker (RESOURCE_EXHAUSTED beyond). >= 1.
+  int max_queued_long_calls_per_principal = SchedulerOptions{}.max_queued_long_calls_per_principal;
+  // Streaming calls (WatchGrid, EvaluateGrid, ImportGrid, ExportGrid, ImportArchive) one
+  // principal may hold open (RESOURCE_EXHAUSTED beyond). >= 1.
+  int max_streams_per_principal = 64;
+  // Bytes the stored grids and in-flight work may hold (RESOURCE_EXHAUSTED beyond); 0: a share
+  // of the process's memory limit, cgroup or physical (server/memory_limit.h).
+  int64_t memory_budget_bytes = 0;
+  // An ImportGrid or ImportArchive stream that receives no message for this long is ended with
+  // DEADLINE_EXCEEDED, releasing what it holds; zero or negative: never.
+  absl::Duration import_idle_timeout = absl::Seconds(60);
   // The most points one EvaluateGrid or EvaluatePoints call may ask for (OUT_OF_RANGE beyond).
   int64_t max_output_points = int64_t{1} << 30;
   // Deformed revisions kept per grid: publishing a revision drops the older ones (fitted and
@@ -33,6 +50,27 @@ struct ServerOptions {
   absl::Duration shutdown_grace = absl::Seconds(10);
   // One line per call on stderr.
   bool log_calls = true;
+  // The form of those lines (server/call_log.h).
+  LogFormat log_format = LogFormat::kText;
+  // On SIGTERM, health reports NOT_SERVING this long while calls are still accepted (so load
+  // balancers and probes stop sending new ones) before the server refuses new calls and drains
+  // for shutdown_grace. Zero: refuse at once.
+  absl::Duration drain_notice = absl::Seconds(5);
+
+  // ---- Transport security and tokens ----
+  // PEM files of the server's certificate chain and private key: TLS when both are set (one
+  // without the other is INVALID_ARGUMENT).
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  // PEM file of the CA that signs client certificates: mutual TLS, a client without a valid
+  // certificate is refused at the handshake. Needs tls_cert_file.
+  std::string tls_client_ca_file;
+  // Plaintext on an address that is not loopback (e.g. 0.0.0.0:50051) is refused unless this is
+  // set (behind a TLS-terminating proxy, inside a private network).
+  bool insecure = false;
+  // The tokens file (server/auth/token_file.h): calls need `authorization: Bearer TOKEN` and
+  // the token's role. Empty: no tokens, every caller is an admin. Reloaded on SIGHUP.
+  std::string tokens_file;
 };
 
 }  // namespace splinegrid::server

@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/bspline/evaluation.h"
+#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/grid_encoding.h"
@@ -26,10 +27,23 @@ int DefaultThreads(int requested) {
 ServiceState::ServiceState(const ServerOptions& opts)
     : options(opts),
       budget(opts.memory_budget_bytes),
-      pool(DefaultThreads(opts.worker_threads), opts.max_queued_tasks) {}
+      streams(opts.max_streams_per_principal),
+      pool(SchedulerOptions{
+          .threads = DefaultThreads(opts.worker_threads),
+          .max_running_long = opts.max_running_long_tasks,
+          .max_queued_tasks = opts.max_queued_tasks,
+          .max_queued_long_calls_per_principal = opts.max_queued_long_calls_per_principal}) {}
 
 grpc::Status ToGrpcStatus(const absl::Status& status) {
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
+  // Echoes of client strings are cut already (QuoteClientString); this bounds whatever else
+  // (e.g. many of them), so that a message never exceeds gRPC's metadata limit.
+  constexpr size_t kMaxMessage = 4096;
+  std::string message(status.message());
+  if (message.size() > kMaxMessage) {
+    message = absl::StrCat(message.substr(0, kMaxMessage), "... (", status.message().size(),
+                           " bytes)");
+  }
+  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::move(message));
 }
 
 CancelCheck CallCancelCheck(grpc::CallbackServerContext* context) {
@@ -39,12 +53,18 @@ CancelCheck CallCancelCheck(grpc::CallbackServerContext* context) {
   };
 }
 
-absl::Status ExplainCancellation(grpc::CallbackServerContext* context, absl::Status status) {
-  if (status.code() == absl::StatusCode::kCancelled &&
-      std::chrono::system_clock::now() > context->deadline()) {
+absl::Status WhyCallEnded(const ServiceState& state, grpc::CallbackServerContext* context) {
+  if (state.draining.load()) return absl::UnavailableError("the server is shutting down");
+  if (std::chrono::system_clock::now() > context->deadline()) {
     return absl::DeadlineExceededError("the call's deadline passed before the work was done");
   }
-  return status;
+  return absl::CancelledError("the client cancelled");
+}
+
+absl::Status ExplainCancellation(const ServiceState& state, grpc::CallbackServerContext* context,
+                                 absl::Status status) {
+  if (status.code() != absl::StatusCode::kCancelled) return status;
+  return WhyCallEnded(state, context);
 }
 
 bool IsValidGridId(const std::string& id) {
@@ -69,8 +89,9 @@ absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field) {
   constexpr char kPrefix[] = "grids/";
   if (name.rfind(kPrefix, 0) != 0 || !IsValidGridId(name.substr(sizeof(kPrefix) - 1))) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        field, " = '", name, "' is not a grid name (grids/{id}, id of [a-z0-9-], 1-63 chars)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " = ", QuoteClientString(name),
+                     " is not a grid name (grids/{id}, id of [a-z0-9-], 1-63 chars)"));
   }
   return name.substr(sizeof(kPrefix) - 1);
 }
@@ -99,15 +120,15 @@ grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerConte
   }
   SG_HAPPENS_BEFORE(reactor);
   const std::string principal = caller->principal;
-  auto task = [reactor, context, log, caller = *std::move(caller), work = std::move(work)] {
+  auto task = [state = state_, reactor, context, log, caller = *std::move(caller),
+               work = std::move(work)] {
     SG_HAPPENS_AFTER(reactor);
-    const absl::Status status = ExplainCancellation(context, work(caller));
+    const absl::Status status = ExplainCancellation(*state, context, work(caller));
     log.Finish(status);
     reactor->Finish(ToGrpcStatus(status));
   };
-  if (!state_->pool.TrySubmit(principal, kind, std::move(task))) {
-    const absl::Status status =
-        absl::ResourceExhaustedError("the server is busy: its work queue is full; retry later");
+  if (absl::Status status = state_->pool.TrySubmit(principal, kind, std::move(task));
+      !status.ok()) {
     log.Finish(status);
     reactor->Finish(ToGrpcStatus(status));
   }
@@ -127,7 +148,7 @@ grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerConte
 grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext* context,
                                                      const v1::GetGridRequest* request,
                                                      v1::Grid* response) {
-  CallLog log("GetGrid", request->name(), state_->options.log_calls);
+  CallLog log("GetGrid", request->name(), state_->options);
   auto work = [this, request, response](const Caller&) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
@@ -154,7 +175,7 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
 grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerContext* context,
                                                        const v1::ListGridsRequest* request,
                                                        v1::ListGridsResponse* response) {
-  CallLog log("ListGrids", "", state_->options.log_calls);
+  CallLog log("ListGrids", "", state_->options);
   auto work = [this, request, response](const Caller&) -> absl::Status {
     const int size = request->page_size();
     if (size < 0 || size > 1000) {
@@ -164,8 +185,9 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
     std::string after;
     if (!request->page_token().empty() &&
         (!absl::WebSafeBase64Unescape(request->page_token(), &after) || !IsValidGridId(after))) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("page_token = '", request->page_token(), "' is not a token of ListGrids"));
+      return absl::InvalidArgumentError(absl::StrCat("page_token = ",
+                                                     QuoteClientString(request->page_token()),
+                                                     " is not a token of ListGrids"));
     }
     bool more = false;
     SG_ASSIGN_OR_RETURN(const auto page, state_->store->List(after, size == 0 ? 50 : size, &more));
@@ -183,13 +205,18 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
 grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerContext* context,
                                                         const v1::DeleteGridRequest* request,
                                                         google::protobuf::Empty* /*response*/) {
-  CallLog log("DeleteGrid", request->name(), state_->options.log_calls);
-  return RunInline(context, log, Role::kWrite, [this, request](const Caller&) -> absl::Status {
+  CallLog log("DeleteGrid", request->name(), state_->options);
+  auto work = [this, request](const Caller& caller) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    if (caller.role < Role::kAdmin) {  // a writer deletes only its own grids
+      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
+      SG_RETURN_IF_ERROR(MayDeleteGrid(caller, grid->owner, request->name()));
+    }
     SG_RETURN_IF_ERROR(state_->store->Delete(id));
     state_->deformers.Forget(DeformerKeyPrefix(id));
     return absl::OkStatus();
-  });
+  };
+  return RunInline(context, log, Role::kWrite, work);
 }
 
 }  // namespace splinegrid::server

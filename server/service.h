@@ -14,16 +14,18 @@
 #include "server/auth/authenticator.h"
 #include "server/auth/caller.h"
 #include "server/call_log.h"
+#include "server/decoded_request.h"
 #include "server/deformer_cache.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
+#include "server/scheduler.h"
 #include "server/server_options.h"
-#include "server/worker_pool.h"
+#include "server/stream_limits.h"
 #include "splinegrid/v1/splinegrid_service.grpc.pb.h"
 
 namespace splinegrid::server {
 
-// What every call may use: the store, the pool, the budget and the configuration.
+// What every call may use: the store, the scheduler, the budget and the configuration.
 struct ServiceState {
   // The store is opened by the server (store/open_store.h), with this state's budget.
   explicit ServiceState(const ServerOptions& opts);
@@ -32,7 +34,8 @@ struct ServiceState {
   MemoryBudget budget;
   Authenticator authenticator;
   std::unique_ptr<GridStore> store;
-  WorkerPool pool;
+  StreamLimits streams;  // open streaming calls per principal
+  Scheduler pool;        // the worker threads, cheap work first, long work fair across callers
   DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
 };
@@ -48,9 +51,14 @@ grpc::Status ToGrpcStatus(const absl::Status& status);
 // A check for the kernel's cancellation polls: the call was cancelled or its deadline passed.
 CancelCheck CallCancelCheck(grpc::CallbackServerContext* context);
 
-// `status`, except that a CANCELLED caused by the call's expired deadline becomes
-// DEADLINE_EXCEEDED (the kernel only knows "stop").
-absl::Status ExplainCancellation(grpc::CallbackServerContext* context, absl::Status status);
+// Why a call that stopped early (a failed write, OnCancel, a cancelled kernel) ended:
+// UNAVAILABLE "the server is shutting down" while draining, DEADLINE_EXCEEDED when its deadline
+// passed, else CANCELLED "the client cancelled".
+absl::Status WhyCallEnded(const ServiceState& state, grpc::CallbackServerContext* context);
+
+// `status`, except that a CANCELLED one (the kernel only knows "stop") says why: WhyCallEnded.
+absl::Status ExplainCancellation(const ServiceState& state, grpc::CallbackServerContext* context,
+                                 absl::Status status);
 
 // "grids/{id}" -> id, or INVALID_ARGUMENT naming `field` and the value.
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field);
@@ -76,10 +84,16 @@ std::optional<int64_t> OptionalStep(const Request& request) {
 
 class SplineGridService final : public v1::SplineGrid::CallbackService {
  public:
-  explicit SplineGridService(ServiceState* state) : state_(state) {}
+  // Registers every method with a handler that decodes its requests (server/decoded_request.h).
+  explicit SplineGridService(ServiceState* state) : state_(state) { DecodeRequests(); }
 
-  grpc::ServerReadReactor<v1::ImportGridRequest>* ImportGrid(grpc::CallbackServerContext* context,
-                                                             v1::Grid* response) override;
+  // The client streams read Decoded<Request> messages: not overrides of the generated
+  // ImportGrid and ImportArchive, but registered in their place by DecodeRequests.
+  grpc::ServerReadReactor<Decoded<v1::ImportGridRequest>>* ImportGridStream(
+      grpc::CallbackServerContext* context, v1::Grid* response);
+  grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>>* ImportArchiveStream(
+      grpc::CallbackServerContext* context, v1::Grid* response);
+
   grpc::ServerUnaryReactor* FitGrid(grpc::CallbackServerContext* context,
                                     const v1::FitGridRequest* request,
                                     v1::FitGridResponse* response) override;
@@ -112,13 +126,27 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
                                            v1::EvaluatePointsResponse* response) override;
   grpc::ServerWriteReactor<v1::ExportGridResponse>* ExportGrid(
       grpc::CallbackServerContext* context, const v1::ExportGridRequest* request) override;
-  grpc::ServerReadReactor<v1::ImportArchiveRequest>* ImportArchive(
-      grpc::CallbackServerContext* context, v1::Grid* response) override;
 
  private:
   using Work = std::function<absl::Status(const Caller& caller)>;
+
+  // Puts a handler over Decoded<Request> in front of each method (request_decoding.cc).
+  void DecodeRequests();
+  template <typename Request, typename Response>
+  void DecodeUnary(const char* method,
+                   grpc::ServerUnaryReactor* (SplineGridService::*handler)(
+                       grpc::CallbackServerContext*, const Request*, Response*));
+  template <typename Request, typename Response>
+  void DecodeServerStream(const char* method,
+                          grpc::ServerWriteReactor<Response>* (SplineGridService::*handler)(
+                              grpc::CallbackServerContext*, const Request*));
+  // The status of a call to `method` whose request did not decode (`decode_status`), after
+  // admission (a caller that may not call gets UNAUTHENTICATED first), logged.
+  absl::Status RefuseUndecodable(grpc::CallbackServerContext* context, const char* method,
+                                 const absl::Status& decode_status);
   // Admits the call (AdmitCall with `needed`), runs `work` on the worker pool as `kind` and
-  // finishes the call with its status (RESOURCE_EXHAUSTED when the pool refuses it).
+  // finishes the call with its status (RESOURCE_EXHAUSTED naming the limit when the scheduler
+  // refuses it).
   grpc::ServerUnaryReactor* RunOnPool(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, WorkKind kind, Work work);
   // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.
@@ -131,9 +159,9 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
                                            const GridFitOptions& options, RevisionOrigin origin,
                                            int64_t parent, const CancelCheck& cancel);
 
-  // GenerateGrid's work, on the pool.
-  absl::Status Generate(const v1::GenerateGridRequest& request, const CancelCheck& cancel,
-                        v1::GenerateGridResponse* response);
+  // GenerateGrid's work, on the pool; the new grid belongs to `owner` (Caller::owner()).
+  absl::Status Generate(const v1::GenerateGridRequest& request, const std::string& owner,
+                        const CancelCheck& cancel, v1::GenerateGridResponse* response);
 
   // Fits `grid`'s source with `options`, stores the result as a new revision (origin, parent)
   // and fills `response`.

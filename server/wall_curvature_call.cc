@@ -79,7 +79,7 @@ absl::Status WallCurvature(const StoredGrid& grid, const v1::GetWallCurvatureReq
 grpc::ServerUnaryReactor* SplineGridService::GetWallCurvature(
     grpc::CallbackServerContext* context, const v1::GetWallCurvatureRequest* request,
     v1::GetWallCurvatureResponse* response) {
-  CallLog log("GetWallCurvature", request->name(), state_->options.log_calls);
+  CallLog log("GetWallCurvature", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(
       context, log, Role::kRead, WorkKind::kLong,

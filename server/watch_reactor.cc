@@ -40,7 +40,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
       : state_(state),
         context_(context),
         request_(request),
-        log_("WatchGrid", request->name(), state->options.log_calls) {}
+        log_("WatchGrid", request->name(), state->options) {}
 
   // Validates the request, subscribes and writes the first revision; `self` owns this reactor
   // until OnDone.
@@ -70,7 +70,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
     {
       std::lock_guard<std::mutex> lock(mu_);
       writing_ = false;
-      if (!ok && status_.ok()) status_ = absl::CancelledError("the client went away");
+      if (!ok && status_.ok()) status_ = WhyCallEnded(*state_, context_);
     }
     Pump();
   }
@@ -78,13 +78,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   void OnCancel() override {
     {
       std::lock_guard<std::mutex> lock(mu_);
-      if (status_.ok()) {
-        status_ =
-            state_->draining.load()
-                ? absl::UnavailableError("the server is shutting down")
-                : ExplainCancellation(
-                      context_, absl::CancelledError("WatchGrid was cancelled by the client"));
-      }
+      if (status_.ok()) status_ = WhyCallEnded(*state_, context_);
     }
     Pump();
   }
@@ -100,6 +94,9 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context_, Role::kRead, &log_);
     if (!caller.ok()) return caller.status();
     caller_ = *std::move(caller);
+    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
+    if (!slot.ok()) return slot.status();
+    stream_ = *std::move(slot);
     absl::StatusOr<std::string> id = ParseGridName(request_->name(), "name");
     if (!id.ok()) return id.status();
     id_ = *std::move(id);
@@ -187,6 +184,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
     }
     if (finish) {
       if (subscription_) state_->store->Unsubscribe(id_, subscription_.get());
+      stream_.Release();  // the call is over for its principal once its status goes out
       log_.Finish(final_status);
       SG_HAPPENS_BEFORE(this);
       Finish(ToGrpcStatus(final_status));
@@ -203,6 +201,8 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   const v1::WatchGridRequest* request_;
   CallLog log_;
   Caller caller_;
+  // This call's place among its principal's open streams.
+  StreamSlot stream_;
   std::shared_ptr<WatchReactor> self_;  // this, until OnDone
   // Set by Start before anything else can run.
   std::string id_;

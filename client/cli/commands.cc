@@ -3,9 +3,11 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -21,6 +23,7 @@
 #include "absl/strings/str_split.h"
 #include "client/cli/flags.h"
 #include "client/cli/output.h"
+#include "client/cli/serve_flags.h"
 #include "client/client.h"
 #include "core/fit/airfoil_fit.h"
 #include "core/io/airfoil.h"
@@ -37,8 +40,14 @@ namespace {
 
 absl::Status Usage(const std::string& message) { return absl::InvalidArgumentError(message); }
 
+// The token and TLS settings of the client commands (set by PrepareConnection).
+client::ClientOptions& ConnectionOptions() {
+  static client::ClientOptions* const options = new client::ClientOptions();
+  return *options;
+}
+
 std::unique_ptr<client::Client> Connect() {
-  client::ClientOptions options;
+  client::ClientOptions options = ConnectionOptions();
   options.timeout = absl::GetFlag(FLAGS_timeout);
   return client::Client::Connect(absl::GetFlag(FLAGS_server), options);
 }
@@ -153,17 +162,50 @@ absl::StatusOr<int64_t> WriteEvaluatedGrid(const std::string& out,
 
 }  // namespace
 
+absl::Status PrepareConnection() {
+  client::ClientOptions options;
+  std::string token = absl::GetFlag(FLAGS_token);
+  if (token.empty()) {
+    if (const char* env = std::getenv("SPLINEGRID_TOKEN")) token = env;
+  }
+  if (!std::all_of(token.begin(), token.end(), [](char c) { return c > 0x20 && c < 0x7F; })) {
+    return Usage("the token (--token or SPLINEGRID_TOKEN) must be printable ASCII without blanks");
+  }
+  options.token = token;
+  SG_RETURN_IF_ERROR(client::LoadTlsFiles(absl::GetFlag(FLAGS_tls_ca),
+                                          absl::GetFlag(FLAGS_tls_cert),
+                                          absl::GetFlag(FLAGS_tls_key), &options));
+  options.tls_server_name = absl::GetFlag(FLAGS_tls_server_name);
+  if (!options.tls_server_name.empty()) options.use_tls = true;
+  ConnectionOptions() = options;
+  return absl::OkStatus();
+}
+
 absl::Status Serve(const Args& args) {
   if (!args.empty()) return Usage("serve takes no arguments, only flags");
   server::ServerOptions options;
+  SG_RETURN_IF_ERROR(CheckServeFlags(&options.log_format));  // before << 20 can overflow
+  options.drain_notice = absl::GetFlag(FLAGS_drain_notice);
   options.address = absl::GetFlag(FLAGS_address);
   options.store = absl::GetFlag(FLAGS_store);
   options.worker_threads = absl::GetFlag(FLAGS_threads);
   options.memory_budget_bytes = absl::GetFlag(FLAGS_memory_budget_mb) << 20;
+  options.import_idle_timeout = absl::GetFlag(FLAGS_import_idle_timeout);
   options.max_output_points = absl::GetFlag(FLAGS_max_output_points);
   options.shutdown_grace = absl::GetFlag(FLAGS_shutdown_grace);
   options.log_calls = absl::GetFlag(FLAGS_log_calls);
   options.max_deform_revisions = absl::GetFlag(FLAGS_keep_revisions);
+  // Transport security and tokens.
+  options.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  options.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  options.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
+  options.insecure = absl::GetFlag(FLAGS_insecure);
+  options.tokens_file = absl::GetFlag(FLAGS_tokens);
+  // Fair scheduling and per-principal limits.
+  options.max_running_long_tasks = absl::GetFlag(FLAGS_max_running_long_tasks);
+  options.max_queued_long_calls_per_principal =
+      absl::GetFlag(FLAGS_max_queued_long_calls_per_principal);
+  options.max_streams_per_principal = absl::GetFlag(FLAGS_max_streams_per_principal);
   return server::RunServerUntilSignal(options);
 }
 

@@ -13,6 +13,10 @@ namespace splinegrid::cli {
 
 using Args = std::vector<std::string>;
 
+// Reads the client commands' --token (or $SPLINEGRID_TOKEN) and --tls_* flags, with the PEM
+// files they name; every later client command connects with them. Errors name the flag.
+absl::Status PrepareConnection();
+
 absl::Status Serve(const Args& args);
 absl::Status Fit(const Args& args);
 absl::Status Get(const Args& args);

@@ -7,6 +7,27 @@ ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to 
 ABSL_FLAG(bool, json, false, "print results as JSON");
 ABSL_FLAG(absl::Duration, timeout, absl::Minutes(10), "deadline of each call");
 
+// Security: tokens and TLS. --tls_cert/--tls_key are the client's certificate (mTLS) for client
+// commands and the server's certificate for serve.
+ABSL_FLAG(std::string, token, "",
+          "bearer token sent with every call (default: $SPLINEGRID_TOKEN; prefer the variable: "
+          "command lines are visible to other users)");
+ABSL_FLAG(std::string, tls_ca, "",
+          "connect over TLS, trusting the CA in this PEM file (implies TLS)");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate chain: serve: the server's (enables TLS, with --tls_key); client "
+          "commands: the client's, for mutual TLS");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, tls_server_name, "",
+          "the name the server's certificate must carry (default: the host of --server)");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "serve: require client certificates signed by the CA in this PEM file (mutual TLS)");
+ABSL_FLAG(bool, insecure, false,
+          "serve: allow plaintext on an address that is not loopback (e.g. 0.0.0.0:50051)");
+ABSL_FLAG(std::string, tokens, "",
+          "serve: tokens file, lines 'TOKEN PRINCIPAL ROLE' (ROLE read, write or admin; # "
+          "comments); calls then need a token; SIGHUP reloads it");
+
 ABSL_FLAG(std::string, name, "",
           "fit/offset: id of the new grid (default: from the file name); import: (default: the "
           "archive's)");
@@ -93,12 +114,35 @@ ABSL_FLAG(std::string, store, "memory",
           "serve: where grids live: memory (default), dir:PATH (durable) or "
           "redis://HOST:PORT[/DB] (shared by replicas)");
 ABSL_FLAG(int, threads, 0, "serve: worker threads (0: one per core)");
-ABSL_FLAG(int64_t, memory_budget_mb, 4096, "serve: memory budget for grids and work, MiB");
+ABSL_FLAG(int64_t, memory_budget_mb, 0,
+          "serve: memory budget for grids and work, MiB (0: half of the cgroup memory limit, or "
+          "of the physical memory when there is none; printed at start)");
+ABSL_FLAG(absl::Duration, import_idle_timeout, absl::Seconds(60),
+          "serve: an ImportGrid or ImportArchive stream that sends nothing for this long is "
+          "ended (DEADLINE_EXCEEDED) and its memory released (0: never)");
 ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,
           "serve: the most points one evaluation may ask for");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(10),
           "serve: time in-flight calls get on SIGTERM before they are cancelled");
 ABSL_FLAG(bool, log_calls, true, "serve: one log line per call on stderr");
+ABSL_FLAG(std::string, log_format, "text",
+          "serve: the call log's lines: text, or json (one object per call: time, method, grid, "
+          "principal, status, ms, message)");
+ABSL_FLAG(absl::Duration, drain_notice, splinegrid::server::ServerOptions().drain_notice,
+          "serve: on SIGTERM, health reports NOT_SERVING this long while calls are still served "
+          "(for load balancers and probes), before new calls are refused (0: refuse at once)");
 ABSL_FLAG(int, keep_revisions, splinegrid::server::ServerOptions().max_deform_revisions,
           "serve: deformed revisions kept per grid (older ones are dropped; fitted and faired "
           "revisions are always kept)");
+
+// serve: fair scheduling and per-principal limits (server/scheduler.h, server/stream_limits.h).
+ABSL_FLAG(int, max_running_long_tasks, splinegrid::server::ServerOptions().max_running_long_tasks,
+          "serve: long calls (fits, fairing, generation, imports, large evaluations) running at "
+          "once (0: worker threads - 1, at least 1; the other workers keep to quick calls)");
+ABSL_FLAG(int, max_queued_long_calls_per_principal,
+          splinegrid::server::ServerOptions().max_queued_long_calls_per_principal,
+          "serve: long calls one caller may have waiting (RESOURCE_EXHAUSTED beyond)");
+ABSL_FLAG(int, max_streams_per_principal,
+          splinegrid::server::ServerOptions().max_streams_per_principal,
+          "serve: streaming calls (watch, eval, import, export) one caller may hold open "
+          "(RESOURCE_EXHAUSTED beyond)");

@@ -13,6 +13,16 @@
 ABSL_DECLARE_FLAG(std::string, server);
 ABSL_DECLARE_FLAG(bool, json);
 ABSL_DECLARE_FLAG(absl::Duration, timeout);
+// Security: tokens and TLS (client side; --tls_cert/--tls_key are the server's with serve).
+ABSL_DECLARE_FLAG(std::string, token);
+ABSL_DECLARE_FLAG(std::string, tls_ca);
+ABSL_DECLARE_FLAG(std::string, tls_cert);
+ABSL_DECLARE_FLAG(std::string, tls_key);
+ABSL_DECLARE_FLAG(std::string, tls_server_name);
+// serve: security
+ABSL_DECLARE_FLAG(std::string, tls_client_ca);
+ABSL_DECLARE_FLAG(bool, insecure);
+ABSL_DECLARE_FLAG(std::string, tokens);
 // fit
 ABSL_DECLARE_FLAG(std::string, name);
 ABSL_DECLARE_FLAG(double, tol);
@@ -70,9 +80,16 @@ ABSL_DECLARE_FLAG(std::string, address);
 ABSL_DECLARE_FLAG(std::string, store);
 ABSL_DECLARE_FLAG(int, threads);
 ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);
+ABSL_DECLARE_FLAG(absl::Duration, import_idle_timeout);
 ABSL_DECLARE_FLAG(int64_t, max_output_points);
 ABSL_DECLARE_FLAG(absl::Duration, shutdown_grace);
 ABSL_DECLARE_FLAG(bool, log_calls);
+ABSL_DECLARE_FLAG(std::string, log_format);
+ABSL_DECLARE_FLAG(absl::Duration, drain_notice);
 ABSL_DECLARE_FLAG(int, keep_revisions);
+// serve: fair scheduling and per-principal limits
+ABSL_DECLARE_FLAG(int, max_running_long_tasks);
+ABSL_DECLARE_FLAG(int, max_queued_long_calls_per_principal);
+ABSL_DECLARE_FLAG(int, max_streams_per_principal);
 
 #endif  // SPLINEGRID_CLIENT_CLI_FLAGS_H_

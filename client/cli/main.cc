@@ -52,7 +52,10 @@ constexpr char kUsage[] =
     "  splinegrid export NAME -o FILE.sgrid   the grid with its source and revisions (archive)\n"
     "  splinegrid import FILE.sgrid [--name NEW]   a grid from an archive, revisions keep their\n"
     "      numbers (a Plot3D file is not an archive: use fit)\n"
-    "Client commands use --server host:port (default localhost:50051) and --json.";
+    "Client commands use --server host:port (default localhost:50051) and --json.\n"
+    "Security: serve [--tls_cert C.pem --tls_key K.pem [--tls_client_ca CA.pem]] [--tokens FILE]\n"
+    "      [--insecure] (plaintext on a non-loopback address); client commands [--tls_ca CA.pem]\n"
+    "      [--tls_cert C.pem --tls_key K.pem] [--token T | $SPLINEGRID_TOKEN]";
 
 }  // namespace
 
@@ -79,7 +82,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const splinegrid::cli::Args args(positional.begin() + 2, positional.end());
-  const absl::Status status = command->second(args);
+  absl::Status status =
+      command->first == "serve" ? absl::OkStatus() : splinegrid::cli::PrepareConnection();
+  if (status.ok()) status = command->second(args);
   if (!status.ok()) {
     std::fprintf(stderr, "splinegrid %s: %s\n", positional[1], status.ToString().c_str());
     return status.code() == absl::StatusCode::kInvalidArgument ? 2 : 1;

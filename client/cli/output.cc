@@ -99,9 +99,16 @@ std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c)
 
 std::string FormatReport(const v1::FitReport& r) {
   std::string out;
-  absl::StrAppend(&out,
-                  absl::StrFormat("  tolerances: %s%s\n", r.tolerance_met() ? "met" : "NOT MET",
-                                  r.unmet_reason().empty() ? "" : ": " + r.unmet_reason()));
+  if (!r.tolerances_given()) {
+    absl::StrAppend(&out, "  tolerances: none given (a fit to control counts)\n");
+  } else {
+    absl::StrAppend(&out,
+                    absl::StrFormat("  tolerances: %s%s\n", r.tolerance_met() ? "met" : "NOT MET",
+                                    r.unmet_reason().empty() ? "" : ": " + r.unmet_reason()));
+  }
+  for (const std::string& adjustment : r.adjustments()) {
+    absl::StrAppend(&out, "  not as asked: ", adjustment, "\n");
+  }
   absl::StrAppend(&out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original "
                                         "cells folded or resized beyond 2x; worst Jacobian ratio "
                                         "%.3g, largest size ratio %.3g\n",

@@ -30,6 +30,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -63,6 +64,11 @@ ABSL_FLAG(int, attempts, 8,
           "attempts per call while the server is UNAVAILABLE (8: about 5 s of backoff, enough "
           "for a balancer to find another replica or a server to restart)");
 ABSL_FLAG(double, timeout, 120.0, "deadline of each call in seconds, retries included");
+// Connection security, as the `splinegrid` tool's.
+ABSL_FLAG(std::string, token, "", "bearer token of every call (default: $SPLINEGRID_TOKEN)");
+ABSL_FLAG(std::string, tls_ca, "", "connect over TLS, trusting the CA in this PEM file");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain of this client, for mutual TLS");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 
 namespace splinegrid {
 namespace {
@@ -253,6 +259,17 @@ int Run() {
   options.timeout = absl::Seconds(absl::GetFlag(FLAGS_timeout));
   if (options.retry.max_attempts < 1 || !(absl::GetFlag(FLAGS_timeout) > 0.0)) {
     std::fprintf(stderr, "--attempts must be >= 1 and --timeout positive\n");
+    return 2;
+  }
+  options.token = absl::GetFlag(FLAGS_token);
+  if (const char* env = std::getenv("SPLINEGRID_TOKEN"); options.token.empty() && env) {
+    options.token = env;
+  }
+  if (const absl::Status tls =
+          client::LoadTlsFiles(absl::GetFlag(FLAGS_tls_ca), absl::GetFlag(FLAGS_tls_cert),
+                               absl::GetFlag(FLAGS_tls_key), &options);
+      !tls.ok()) {
+    std::fprintf(stderr, "%s\n", std::string(tls.message()).c_str());
     return 2;
   }
   std::FILE* acked_file = nullptr;

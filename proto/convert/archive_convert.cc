@@ -62,6 +62,7 @@ void EncodeFitReport(const GridFitReport& report, v1::StoredFitReport* out) {
   out->set_knots_removed(report.knots_removed);
   out->set_quality_rounds(report.quality_rounds);
   out->set_seconds(report.seconds);
+  for (const std::string& adjustment : report.adjustments) out->add_adjustments(adjustment);
 }
 
 absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
@@ -83,6 +84,7 @@ absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
       ParseCurvatureMetrics(stored.unfaired_wall_curvature(), field + ".unfaired_wall_curvature"));
   report.iterations = stored.iterations();
   report.knots_inserted = stored.knots_inserted();
+  report.adjustments.assign(stored.adjustments().begin(), stored.adjustments().end());
   report.knots_removed = stored.knots_removed();
   report.quality_rounds = stored.quality_rounds();
   report.seconds = stored.seconds();

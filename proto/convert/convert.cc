@@ -344,6 +344,7 @@ void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& b
   out->set_knots_inserted(report.knots_inserted);
   out->set_knots_removed(report.knots_removed);
   out->set_quality_rounds(report.quality_rounds);
+  for (const std::string& adjustment : report.adjustments) out->add_adjustments(adjustment);
   double min_ratio = std::numeric_limits<double>::infinity(), size_ratio = 0.0;
   int64_t folded = 0, bad = 0;
   for (const BlockFit& b : blocks) {

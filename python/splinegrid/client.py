@@ -350,19 +350,37 @@ def grid_name(name_or_id: str) -> str:
 
 
 class Client:
-    """A connection to a splinegrid server (an insecure channel to ``target``).
+    """A connection to a splinegrid server (a plaintext or TLS channel to ``target``).
 
     Use it as a context manager, or call :meth:`close`. ``timeout`` is the deadline of every
     call in seconds; ``retry`` says how calls failing with UNAVAILABLE are retried within it
     (see the module's "Retries"; the channel also reconnects at that pace). ``stub`` is the
     generated ``SplineGridStub`` for anything not wrapped here (its calls get neither
-    deadlines, retries, routing header nor error translation).
+    deadlines, retries, routing header, token nor error translation).
+
+    Security (``serve --tokens``, ``--tls_cert``): ``token`` (default: the environment
+    variable ``SPLINEGRID_TOKEN``) is sent with every call as ``authorization: Bearer TOKEN``.
+    ``tls_ca`` (a PEM file: the CA the server's certificate must chain to), or ``tls=True``
+    for the system's roots, makes the channel TLS; ``tls_cert`` and ``tls_key`` (PEM files)
+    are this client's certificate for a server that requires one (mTLS); ``tls_server_name``
+    is the name the server's certificate must carry when it is not the target's host.
     """
 
     def __init__(self, target: str = "localhost:50051", timeout: float = 120.0,
-                 retry: Optional[RetryPolicy] = None) -> None:
+                 retry: Optional[RetryPolicy] = None, *, token: Optional[str] = None,
+                 tls: bool = False, tls_ca: Optional[str] = None,
+                 tls_cert: Optional[str] = None, tls_key: Optional[str] = None,
+                 tls_server_name: Optional[str] = None) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout = {timeout}; must be positive")
+        if token is None:
+            token = os.environ.get("SPLINEGRID_TOKEN", "")
+        if token and not (token.isascii() and token.isprintable() and " " not in token):
+            # Never repeat the token itself.
+            raise ValueError("token: must be printable ASCII without blanks")
+        if (tls_cert is None) != (tls_key is None):
+            raise ValueError("tls_cert and tls_key: give both (a client certificate) or neither")
+        self._auth = (("authorization", f"Bearer {token}"),) if token else ()
         self.target = target
         self.timeout = timeout
         self.retry = RetryPolicy() if retry is None else retry
@@ -374,7 +392,16 @@ class Client:
                          max(1, int(self.retry.initial_backoff * 1000))),
                         ("grpc.max_reconnect_backoff_ms",
                          max(1, int(self.retry.max_backoff * 1000)))]
-        self._channel = grpc.insecure_channel(target, options=options)
+        if tls or tls_ca is not None or tls_cert is not None or tls_server_name is not None:
+            credentials = grpc.ssl_channel_credentials(
+                root_certificates=_read_pem(tls_ca, "tls_ca"),
+                private_key=_read_pem(tls_key, "tls_key"),
+                certificate_chain=_read_pem(tls_cert, "tls_cert"))
+            if tls_server_name:
+                options.append(("grpc.ssl_target_name_override", tls_server_name))
+            self._channel = grpc.secure_channel(target, credentials, options=options)
+        else:
+            self._channel = grpc.insecure_channel(target, options=options)
         self.stub = service_grpc.SplineGridStub(self._channel)
         # The bulk methods exchange hand-encoded bytes (see _wire) instead of generated classes.
         self._import_grid = self._channel.stream_unary(
@@ -415,7 +442,7 @@ class Client:
         deadline ``self.timeout`` from now. grpc.RpcError -> SplinegridError (chained; the
         message says the attempt when there were retries)."""
         deadline = time.monotonic() + self.timeout
-        metadata = _routing_metadata(grid)
+        metadata = self._metadata(grid)
         waits = self.retry.waits()
         attempts = 0
         while True:
@@ -437,6 +464,10 @@ class Client:
                             "earlier ones failed with UNAVAILABLE]")
                     raise translated from error
             self._pause_before_retry(wait)
+
+    def _metadata(self, grid: str) -> Optional[tuple]:
+        """The metadata of a call about ``grid``: its routing header and the token."""
+        return ((_routing_metadata(grid) or ()) + self._auth) or None
 
     def _pause_before_retry(self, wait: float, stop: Optional[threading.Event] = None) -> bool:
         """Waits ``wait`` seconds before the next attempt of a call, with a health check that
@@ -877,7 +908,7 @@ class Client:
         if after < -1:
             raise ValueError(f"after_revision = {after_revision}; must be >= -1")
         request = service_pb2.WatchGridRequest(name=grid_name(name), after_revision=after)
-        metadata = _routing_metadata(_routing_grid(request))
+        metadata = self._metadata(_routing_grid(request))
         return RevisionWatch(lambda: self.stub.WatchGrid(request, metadata=metadata),
                              request.name, self.retry, self._pause_before_retry)
 
@@ -1124,6 +1155,17 @@ def _routing_grid(request: Union[bytes, Message]) -> str:
         if "grid_id" in fields:
             return request.grid_id
     return ""
+
+
+def _read_pem(path: Optional[str], name: str) -> Optional[bytes]:
+    """The bytes of the PEM file ``path`` (argument ``name``), or None."""
+    if path is None:
+        return None
+    try:
+        with open(path, "rb") as file:
+            return file.read()
+    except OSError as error:
+        raise ValueError(f"{name}: cannot read {path!r}: {error.strerror}") from error
 
 
 def _routing_metadata(grid: str) -> Optional[tuple]:

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "absl/status/status.h"
+
 namespace splinegrid::server {
 
 // Ordered: each role may do everything the roles before it may.
@@ -22,7 +24,17 @@ struct Caller {
   // The token's principal, or the peer ("ipv4:127.0.0.1:40312") when the server has no tokens.
   std::string principal;
   Role role = Role::kAdmin;
+  // Whether a token named the caller (else the principal is only the peer address).
+  bool from_token = false;
+
+  // What a grid this caller creates records as its owner: the principal with tokens, else "".
+  std::string owner() const { return from_token ? principal : std::string(); }
 };
+
+// Whether `caller` may delete the grid `name` created by `owner` (StoredGrid::owner): an admin
+// any grid, a writer only its own (a grid created without tokens has no owner: admin only).
+// PERMISSION_DENIED naming the owner otherwise.
+absl::Status MayDeleteGrid(const Caller& caller, const std::string& owner, const std::string& name);
 
 }  // namespace splinegrid::server
 

@@ -1,6 +1,7 @@
 #include "server/store/grid_archive.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/service.h"
@@ -12,6 +13,7 @@ v1::ArchiveHeader EncodeGridHeader(const StoredGrid& grid, int64_t num_revisions
   header.set_format_version(kArchiveFormatVersion);
   header.set_id(grid.id);
   header.set_display_name(grid.display_name);
+  header.set_owner(grid.owner);
   EncodeStoredTime(grid.create_time, header.mutable_create_time());
   const SourcePoints& source = *grid.source;
   header.set_source_format(source.format);
@@ -73,11 +75,15 @@ absl::Status GridAssembler::AddHeader(const v1::ArchiveHeader& header) {
   SG_RETURN_IF_ERROR(CheckArchiveVersion(header));
   const std::string id = id_.empty() ? header.id() : id_;
   if (!IsValidGridId(id)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "header.id = '", id.substr(0, 80), "' is not a grid id (1-63 of [a-z0-9-], a letter first)"));
+    return absl::InvalidArgumentError(absl::StrCat("header.id = ", QuoteClientString(id),
+                                                   " is not a grid id (1-63 of [a-z0-9-], a "
+                                                   "letter first)"));
   }
   if (header.display_name().size() > 1024) {
     return absl::InvalidArgumentError("header.display_name is longer than 1024 bytes");
+  }
+  if (header.owner().size() > 1024) {
+    return absl::InvalidArgumentError("header.owner is longer than 1024 bytes");
   }
   if (header.num_source_chunks() < 0 || header.num_revisions() < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -91,6 +97,7 @@ absl::Status GridAssembler::AddHeader(const v1::ArchiveHeader& header) {
   grid_ = std::make_shared<StoredGrid>();
   grid_->id = id;
   grid_->display_name = header.display_name();
+  grid_->owner = header.owner();
   grid_->create_time = create_time;
   header_ = header;
   return absl::OkStatus();

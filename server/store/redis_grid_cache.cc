@@ -19,6 +19,15 @@ std::optional<RedisGridCache::Entry> RedisGridCache::Find(const std::string& id)
   return it->second.entry;
 }
 
+std::optional<RedisGridCache::Entry> RedisGridCache::FindConfirmedSince(const std::string& id,
+                                                                        absl::Time since) {
+  std::lock_guard<std::mutex> lock(mu_);
+  const auto it = slots_.find(id);
+  if (it == slots_.end() || it->second.confirmed < since) return std::nullopt;
+  it->second.used = ++clock_;
+  return it->second.entry;
+}
+
 void RedisGridCache::Put(const std::string& id, Entry entry) {
   Entry replaced;  // released after the lock
   std::lock_guard<std::mutex> lock(mu_);
@@ -29,6 +38,7 @@ void RedisGridCache::Put(const std::string& id, Entry entry) {
   }
   replaced = std::exchange(slot.entry, std::move(entry));
   slot.used = ++clock_;
+  slot.confirmed = absl::Now();
 }
 
 void RedisGridCache::Erase(const std::string& id) {

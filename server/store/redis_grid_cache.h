@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "absl/time/time.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
 
@@ -32,6 +33,8 @@ class RedisGridCache {
 
   // The cached snapshot of `id` (now the most recently used), if any.
   std::optional<Entry> Find(const std::string& id);
+  // The same, if Redis confirmed it (it was Put) at `since` or later.
+  std::optional<Entry> FindConfirmedSince(const std::string& id, absl::Time since);
   // Caches `entry` as the snapshot of `id`, unless one of the same generation with a higher
   // latest revision is cached already (a slower reader must not go back in time).
   void Put(const std::string& id, Entry entry);
@@ -43,7 +46,8 @@ class RedisGridCache {
  private:
   struct Slot {
     Entry entry;
-    uint64_t used = 0;  // clock_ at the last use
+    uint64_t used = 0;     // clock_ at the last use
+    absl::Time confirmed;  // when it was Put
   };
 
   MemoryBudget* const budget_;

@@ -79,6 +79,7 @@ absl::StatusOr<RedisSnapshots::Fetched> RedisSnapshots::Assemble(
   auto snapshot = std::make_shared<StoredGrid>();
   snapshot->id = id;
   snapshot->display_name = shell->display_name;
+  snapshot->owner = shell->owner;
   snapshot->create_time = shell->create_time;
   snapshot->source = shell->source;
   bool made_room = false;

@@ -41,6 +41,10 @@ class RedisSnapshots {
 
   // The cached snapshot of `id`, if any.
   std::optional<RedisGridCache::Entry> Cached(const std::string& id) { return cache_.Find(id); }
+  // The cached snapshot of `id` if Redis confirmed it within `window`.
+  std::optional<RedisGridCache::Entry> Recent(const std::string& id, absl::Duration window) {
+    return cache_.FindConfirmedSince(id, absl::Now() - window);
+  }
   // Appends the scripts' "what the caller has" arguments for `cached`: its generation ("" if
   // none), then its revision numbers.
   static void AppendKnown(const std::optional<RedisGridCache::Entry>& cached,

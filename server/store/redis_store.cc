@@ -128,6 +128,8 @@ class RedisStore final : public GridStore {
     SG_ASSIGN_OR_RETURN(RedisSnapshots::Fetched fetched, snapshots_.Fetch(id));
     return std::move(fetched.snapshot);
   }
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> GetHolding(
+      const std::string& id, std::initializer_list<int64_t> numbers) override;
   absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
                                                                 GridRevision revision,
                                                                 int64_t expected_latest) override;
@@ -168,6 +170,23 @@ class RedisStore final : public GridStore {
   absl::Status available_;  // OpenRedisStore reached Redis
   std::thread health_;
 };
+
+absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::GetHolding(
+    const std::string& id, std::initializer_list<int64_t> numbers) {
+  const bool all_given =
+      std::all_of(numbers.begin(), numbers.end(), [](int64_t n) { return n > 0; });
+  if (all_given && options_.cached_read_window > absl::ZeroDuration()) {
+    if (std::optional<RedisGridCache::Entry> cached =
+            snapshots_.Recent(id, options_.cached_read_window)) {
+      const StoredGrid& grid = *cached->snapshot;
+      if (std::all_of(numbers.begin(), numbers.end(),
+                      [&](int64_t n) { return grid.FindRevision(n).ok(); })) {
+        return std::move(cached->snapshot);
+      }
+    }
+  }
+  return Get(id);
+}
 
 // ---- Writing ----
 

@@ -117,6 +117,10 @@ struct RedisStoreOptions {
   absl::Duration pending_ttl = absl::Minutes(10);
   // How long a deleted grid's event stream stays for the watchers of other replicas.
   absl::Duration deleted_events_ttl = absl::Minutes(5);
+  // GetHolding answers from this process's snapshot of a grid when Redis confirmed it within
+  // this window: a grid deleted (or a revision dropped) through another replica can still be
+  // read here for at most this long. Zero: every call asks Redis.
+  absl::Duration cached_read_window = absl::Seconds(1);
 };
 
 // Opens the store at `spec` (`redis://HOST:PORT[/DB]`): INVALID_ARGUMENT for a bad spec or a

@@ -90,7 +90,8 @@ class EndToEndTest : public ::testing::Test {
     if (server_ == 0) {
       freopen(log_.c_str(), "a", stderr);
       std::vector<std::string> args = {kBinary, "serve",
-                                       absl::StrCat("--address=127.0.0.1:", port_), "--threads=2"};
+                                       absl::StrCat("--address=127.0.0.1:", port_), "--threads=2",
+                                       "--drain_notice=0s"};
       args.insert(args.end(), flags.begin(), flags.end());
       std::vector<char*> argv;
       for (std::string& arg : args) argv.push_back(arg.data());

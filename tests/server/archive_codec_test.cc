@@ -90,7 +90,9 @@ void ExpectSameOptions(const GridFitOptions& a, const GridFitOptions& b) {
   EXPECT_EQ(a.order, b.order);
   EXPECT_EQ(a.parametrization, b.parametrization);
   ASSERT_EQ(a.tolerance.has_value(), b.tolerance.has_value());
-  if (a.tolerance) EXPECT_SAME_BITS(*a.tolerance, *b.tolerance);
+  if (a.tolerance) {
+    EXPECT_SAME_BITS(*a.tolerance, *b.tolerance);
+  }
   ASSERT_EQ(a.boundary_tolerances.has_value(), b.boundary_tolerances.has_value());
   if (a.boundary_tolerances) {
     const BoundaryTolerances &ta = *a.boundary_tolerances, &tb = *b.boundary_tolerances;

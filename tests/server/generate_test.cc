@@ -124,7 +124,10 @@ TEST_P(GenerateAirfoilTest, StoresAFittedValidOGrid) {
   EXPECT_EQ(r.grid().name(), "grids/" + id);
   EXPECT_EQ(r.grid().latest_revision(), 1);
   EXPECT_EQ(r.fit().revision(), 1);
-  EXPECT_TRUE(r.fit().report().tolerance_met()) << r.fit().report().unmet_reason();
+  // An interpolation has no tolerance to meet, and the report does not claim one (issue 12.7);
+  // its exactness is measured below.
+  EXPECT_FALSE(r.fit().report().tolerance_met());
+  EXPECT_THAT(r.fit().report().unmet_reason(), HasSubstr("no tolerance was given"));
   // Without a spec the grid is interpolated: exact at its points (the default tolerances by
   // kind would fold the wall cells: 1.5e-4 against a 1e-4 first layer). Known limit: the spline
   // is clamped, not periodic, at the seam, and refinement levels 1-2 fold sub-cells in the

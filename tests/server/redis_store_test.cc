@@ -444,6 +444,51 @@ TEST_F(RedisStoreTest, ConcurrentWritersFromTheSameBaseExactlyOneWins) {
   EXPECT_EQ(b_->Get("g").value()->revisions.back()->number, latest + 2);
 }
 
+// GetHolding answers given revisions from the replica's own snapshot while Redis confirmed it
+// within cached_read_window (no round trip), and asks Redis after that, for the latest (0), and
+// for revisions the snapshot does not hold.
+TEST_F(RedisStoreTest, GetHoldingReadsRecentSnapshotsWithoutARoundTrip) {
+  server::RedisStoreOptions options;
+  options.cached_read_window = absl::Milliseconds(300);
+  std::unique_ptr<GridStore> reader = Open(options);
+  CreateFitted("g");
+  ASSERT_EQ(reader->Get("g").value()->revisions.size(), 1u);  // cached, confirmed now
+  const int64_t added = Deform(*b_, "g");
+  ASSERT_EQ(added, 2);
+  // Revision 1 from the snapshot (it does not know revision 2 yet); revision 2 and the latest
+  // from Redis.
+  EXPECT_EQ(reader->GetHolding("g", {1}).value()->revisions.back()->number, 1);
+  EXPECT_EQ(reader->GetHolding("g", {1, 2}).value()->revisions.back()->number, 2);
+  EXPECT_EQ(reader->GetHolding("g", {0}).value()->revisions.back()->number, 2);
+
+  // Deleted through another replica: readable here for at most the window, then NOT_FOUND.
+  ASSERT_TRUE(b_->Delete("g").ok());
+  EXPECT_THAT(reader->GetHolding("g", {0}).status(), StatusIs(absl::StatusCode::kNotFound, "g"));
+  ASSERT_TRUE(reader->Create(MakeGrid("h")).ok());
+  const absl::Time before_confirmed = absl::Now();
+  ASSERT_TRUE(reader->AddRevision("h", MakeRevision(RevisionOrigin::kFit)).ok());
+  const absl::Time after_confirmed = absl::Now();
+  ASSERT_TRUE(b_->Delete("h").ok());
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> stale = reader->GetHolding("h", {1});
+  EXPECT_TRUE(stale.ok() || absl::Now() - after_confirmed > absl::Milliseconds(300))
+      << "read from the snapshot within the window: " << stale.status();
+  while (stale.ok()) {
+    ASSERT_LT(absl::Now() - after_confirmed, absl::Seconds(5)) << "the snapshot never expired";
+    absl::SleepFor(absl::Milliseconds(20));
+    stale = reader->GetHolding("h", {1});
+  }
+  EXPECT_THAT(stale.status(), StatusIs(absl::StatusCode::kNotFound, "h"));
+  EXPECT_GE(absl::Now() - before_confirmed, absl::Milliseconds(300));
+
+  // A window of zero: every call asks Redis.
+  options.cached_read_window = absl::ZeroDuration();
+  std::unique_ptr<GridStore> strict = Open(options);
+  ASSERT_TRUE(strict->Create(MakeGrid("k")).ok());
+  ASSERT_TRUE(strict->AddRevision("k", MakeRevision(RevisionOrigin::kFit)).ok());
+  ASSERT_TRUE(b_->Delete("k").ok());
+  EXPECT_THAT(strict->GetHolding("k", {1}).status(), StatusIs(absl::StatusCode::kNotFound, "k"));
+}
+
 TEST_F(RedisStoreTest, RetentionDropsOldDeformedRevisionsAndNumbersAreNeverReused) {
   CreateFitted("g");                                           // 1
   for (int r = 0; r < 3; ++r) Deform(r % 2 ? *a_ : *b_, "g");  // 2, 3, 4

@@ -86,7 +86,10 @@ TEST_F(ServiceErrorsTest, BadFitSpecsAreInvalid) {
   spec.mutable_control_counts()->set_i(2);
   spec.mutable_control_counts()->set_j(12);
   spec.set_order(4);
-  // Two controls are below nothing here (order drops to 2), but one is below any order.
+  // Two controls are below the order (it is not lowered to 2), and one is below any order.
+  EXPECT_THAT(client_->Fit("naca", spec).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "spec.control_counts[0] = 2 is below order = 4"));
   spec.mutable_control_counts()->set_i(1);
   EXPECT_THAT(client_->Fit("naca", spec).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, "control_counts[0] = 1"));
@@ -100,7 +103,7 @@ TEST_F(ServiceErrorsTest, BadFitSpecsAreInvalid) {
               StatusIs(absl::StatusCode::kInvalidArgument, "control_counts[0] = 500"));
   per_block->set_block(7);
   EXPECT_THAT(client_->Fit("naca", spec).status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, "block 7"));
+              StatusIs(absl::StatusCode::kInvalidArgument, "block_control_counts[0].block = 7"));
   v1::FitSpec tol;
   tol.set_tolerance(std::nan(""));
   EXPECT_THAT(client_->Fit("naca", tol).status(),

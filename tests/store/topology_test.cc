@@ -225,7 +225,8 @@ class TopologyTest : public ::testing::Test {
   std::unique_ptr<ChildProcess> Serve(const std::string& name, int port, const std::string& store) {
     return std::make_unique<ChildProcess>(
         std::vector<std::string>{kBinary, "serve", absl::StrCat("--address=", Address(port)), store,
-                                 "--threads=1", "--keep_revisions=1000", "--shutdown_grace=2s"},
+                                 "--threads=1", "--keep_revisions=1000", "--shutdown_grace=2s",
+                                 "--drain_notice=0s"},
         (dir_ / (name + ".log")).string());
   }
 

@@ -1,0 +1,409 @@
+// Transport security and tokens with the real binary on loopback ports: TLS and mutual TLS
+// round trips (CLI, C++ and Python clients) with certificates made by `openssl` at test time,
+// plaintext refused by a TLS server and on non-loopback addresses without --insecure, the
+// tokens file reloaded on SIGHUP, and no token ever in the server's output.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "client/client.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace splinegrid::testing {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+const std::string kBinary = SPLINEGRID_BINARY_DIR "/splinegrid";
+const std::string kSource = SPLINEGRID_SOURCE_DIR;
+
+constexpr char kReadToken[] = "carol-read-7f3a91";
+constexpr char kAdminToken[] = "root-admin-52c0e8";
+constexpr char kWrongToken[] = "mallory-guess-0bad";
+
+// A port on 127.0.0.1 that was free a moment ago.
+int FreePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+  socklen_t len = sizeof(addr);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return ntohs(addr.sin_port);
+}
+
+bool PortOpen(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const bool open = connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
+  close(fd);
+  return open;
+}
+
+struct Result {
+  int exit_code;
+  std::string out;  // stdout and stderr
+};
+
+// Runs `[VAR=VALUE...] PROGRAM ARGS` (bounded by `timeout` 60 s) and collects its output and exit code.
+Result Shell(const std::string& command) {
+  FILE* pipe = popen(absl::StrCat("timeout 60 env ", command, " 2>&1").c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// `splinegrid serve` as a child process with its output in a log file; killed if still running
+// when destroyed.
+class Server {
+ public:
+  Server(const std::vector<std::string>& flags, std::string log) : log_(std::move(log)) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      setpgid(0, 0);
+      const int fd = open(log_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<std::string> args = {kBinary, "serve", "--threads=2"};
+      args.insert(args.end(), flags.begin(), flags.end());
+      std::vector<char*> argv;
+      for (std::string& arg : args) argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(kBinary.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  ~Server() {
+    if (Running()) Stop(SIGKILL);
+  }
+
+  bool Running() {
+    if (exit_code_ >= 0) return false;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == 0) return true;
+    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return false;
+  }
+  // Waits up to `timeout` for the exit: its code, or -1.
+  int Wait(absl::Duration timeout) {
+    const absl::Time end = absl::Now() + timeout;
+    while (Running() && absl::Now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return exit_code_;
+  }
+  int Stop(int signal = SIGTERM) {
+    if (Running()) kill(pid_, signal);
+    return Wait(absl::Seconds(20));
+  }
+  void Signal(int signal) { kill(pid_, signal); }
+  // Waits until the port accepts connections (false if the server exits or 20 s pass).
+  bool WaitForPort(int port) {
+    const absl::Time end = absl::Now() + absl::Seconds(20);
+    while (absl::Now() < end && Running()) {
+      if (PortOpen(port)) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+  // Waits up to 10 s until the log has `count` lines containing `text`.
+  bool WaitForLog(const std::string& text, int count = 1) {
+    const absl::Time end = absl::Now() + absl::Seconds(10);
+    while (absl::Now() < end) {
+      const std::string log = Log();
+      int found = 0;
+      for (size_t at = log.find(text); at != std::string::npos; at = log.find(text, at + 1)) {
+        ++found;
+      }
+      if (found >= count) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+  std::string Log() const { return ReadFile(log_); }
+
+ private:
+  pid_t pid_ = -1;
+  int exit_code_ = -1;
+  std::string log_;
+};
+
+class TlsAuthTest : public ::testing::Test {
+ protected:
+  // One CA, a server certificate for 127.0.0.1 and localhost, a client certificate.
+  static void SetUpTestSuite() {
+    certs_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                       absl::StrCat("splinegrid-certs-", getpid()));
+    std::filesystem::create_directories(*certs_);
+    const std::string key = "-newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes";
+    const Result made = Shell(absl::StrCat(
+        "sh -c 'set -e; cd ", certs_->string(), "; ", "openssl req -x509 ", key,
+        " -keyout ca.key -out ca.pem -days 2 -subj /CN=sg-test-ca; ", "openssl req ", key,
+        " -keyout server.key -out server.csr -subj /CN=localhost; ",
+        "printf \"subjectAltName=IP:127.0.0.1,DNS:localhost\\nextendedKeyUsage=serverAuth\\n\" "
+        "> server.ext; ",
+        "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial ",
+        "-out server.pem -days 2 -extfile server.ext; ", "openssl req ", key,
+        " -keyout client.key -out client.csr -subj /CN=sg-test-client; ",
+        "printf \"extendedKeyUsage=clientAuth\\n\" > client.ext; ",
+        "openssl x509 -req -in client.csr -CA ca.pem -CAkey ca.key -CAcreateserial ",
+        "-out client.pem -days 2 -extfile client.ext'"));
+    ASSERT_EQ(made.exit_code, 0) << made.out;
+  }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*certs_);
+    delete certs_;
+  }
+
+  void SetUp() override {
+    port_ = FreePort();
+    dir_ = std::filesystem::temp_directory_path() /
+           absl::StrCat("splinegrid-tls-", getpid(), "-", port_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  static std::string Cert(const std::string& name) { return (*certs_ / name).string(); }
+  std::string Address() const { return absl::StrCat("127.0.0.1:", port_); }
+  std::string Log() const { return (dir_ / "server.log").string(); }
+
+  // The CLI against this test's server with `flags`.
+  Result Cli(const std::string& command, const std::string& flags = "") const {
+    return Shell(
+        absl::StrCat(kBinary, " ", command, " --server=", Address(), " --timeout=5s ", flags));
+  }
+
+  // Runs Python `code` with `client` bound to splinegrid.client and the server's address as
+  // `target`; its output.
+  Result Python(const std::string& code, const std::string& env = "") const {
+    const std::filesystem::path script = dir_ / "client.py";
+    std::ofstream(script) << "import sys\nfrom splinegrid import client\ntarget = '" << Address()
+                          << "'\ncerts = '" << certs_->string() << "'\n"
+                          << code;
+    return Shell(absl::StrCat(env, " PYTHONPATH=", SPLINEGRID_BINARY_DIR,
+                              "/python /usr/bin/python3 ", script.string()));
+  }
+
+  static std::filesystem::path* certs_;
+  int port_ = 0;
+  std::filesystem::path dir_;
+};
+
+std::filesystem::path* TlsAuthTest::certs_ = nullptr;
+
+TEST_F(TlsAuthTest, TlsRoundTripsAndAPlaintextClientFails) {
+  Server server({"--address=" + Address(), "--tls_cert=" + Cert("server.pem"),
+                 "--tls_key=" + Cert("server.key")},
+                Log());
+  ASSERT_TRUE(server.WaitForPort(port_)) << server.Log();
+  const std::string tls = "--tls_ca=" + Cert("ca.pem");
+  // CLI: health, a fit (import + fit) and a get, over TLS.
+  EXPECT_THAT(Cli("health", tls).out, HasSubstr("SERVING"));
+  const Result fit = Cli(absl::StrCat("fit ", kSource, "/../shared/data/grids/n0012_113-33.p2dfmt"),
+                         tls + " --name=naca --ctl=12,8");
+  EXPECT_EQ(fit.exit_code, 0) << fit.out;
+  EXPECT_EQ(Cli("get naca", tls).exit_code, 0);
+  // The certificate names localhost too.
+  const Result by_name =
+      Shell(absl::StrCat(kBinary, " list --timeout=5s --server=localhost:", port_, " ", tls));
+  EXPECT_EQ(by_name.exit_code, 0) << by_name.out;
+  // A plaintext client does not get through.
+  const Result plain = Cli("list", "--timeout=2s");
+  EXPECT_NE(plain.exit_code, 0);
+  EXPECT_THAT(plain.out, HasSubstr("UNAVAILABLE"));
+
+  // C++ client.
+  client::ClientOptions options;
+  options.timeout = absl::Seconds(5);
+  options.retry.max_attempts = 1;
+  ASSERT_TRUE(client::LoadTlsFiles(Cert("ca.pem"), "", "", &options).ok());
+  EXPECT_TRUE(options.use_tls);
+  EXPECT_EQ(client::Client::Connect(Address(), options)->List().value().size(), 1u);
+  client::ClientOptions plaintext = options;
+  plaintext.use_tls = false;
+  EXPECT_EQ(client::Client::Connect(Address(), plaintext)->List().status().code(),
+            absl::StatusCode::kUnavailable);
+  EXPECT_THAT(client::LoadTlsFiles("/nonexistent/ca.pem", "", "", &options),
+              ::testing::Property(&absl::Status::message, HasSubstr("--tls_ca")));
+
+  // Python client.
+  const Result python = Python(
+      "with client.Client(target, timeout=5, tls_ca=certs + '/ca.pem') as c:\n"
+      "    print('grids', len(c.list()))\n"
+      "try:\n"
+      "    client.Client(target, timeout=2, retry=client.RetryPolicy(max_attempts=1)).list()\n"
+      "except client.SplinegridError as e:\n"
+      "    print('plaintext', e.code)\n");
+  EXPECT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("grids 1"));
+  EXPECT_THAT(python.out, HasSubstr("plaintext UNAVAILABLE"));
+
+  EXPECT_EQ(server.Stop(), 0) << server.Log();
+  EXPECT_THAT(server.Log(), HasSubstr("splinegrid: TLS, no tokens"));
+}
+
+TEST_F(TlsAuthTest, MutualTlsRefusesAClientWithoutACertificate) {
+  Server server({"--address=" + Address(), "--tls_cert=" + Cert("server.pem"),
+                 "--tls_key=" + Cert("server.key"), "--tls_client_ca=" + Cert("ca.pem")},
+                Log());
+  ASSERT_TRUE(server.WaitForPort(port_)) << server.Log();
+  const std::string ca = "--tls_ca=" + Cert("ca.pem");
+  const std::string mtls =
+      absl::StrCat(ca, " --tls_cert=", Cert("client.pem"), " --tls_key=", Cert("client.key"));
+  const Result with_cert = Cli("list", mtls);
+  EXPECT_EQ(with_cert.exit_code, 0) << with_cert.out;
+  const Result without = Cli("list", ca + " --timeout=2s");
+  EXPECT_NE(without.exit_code, 0);
+  EXPECT_THAT(without.out, HasSubstr("UNAVAILABLE"));
+  // A certificate without its key is a usage error of the client.
+  EXPECT_EQ(Cli("list", ca + " --tls_cert=" + Cert("client.pem")).exit_code, 2);
+
+  client::ClientOptions options;
+  options.timeout = absl::Seconds(5);
+  options.retry.max_attempts = 1;
+  ASSERT_TRUE(
+      client::LoadTlsFiles(Cert("ca.pem"), Cert("client.pem"), Cert("client.key"), &options).ok());
+  EXPECT_TRUE(client::Client::Connect(Address(), options)->List().ok());
+  options.tls_cert_chain.clear();
+  options.tls_private_key.clear();
+  EXPECT_FALSE(client::Client::Connect(Address(), options)->List().ok());
+
+  const Result python = Python(
+      "with client.Client(target, timeout=5, tls_ca=certs + '/ca.pem',\n"
+      "                   tls_cert=certs + '/client.pem', tls_key=certs + '/client.key') as c:\n"
+      "    print('grids', len(c.list()))\n"
+      "try:\n"
+      "    client.Client(target, timeout=2, tls_ca=certs + '/ca.pem',\n"
+      "                  retry=client.RetryPolicy(max_attempts=1)).list()\n"
+      "except client.SplinegridError as e:\n"
+      "    print('no cert', e.code)\n");
+  EXPECT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("grids 0"));
+  EXPECT_THAT(python.out, HasSubstr("no cert UNAVAILABLE"));
+  EXPECT_EQ(server.Stop(), 0) << server.Log();
+}
+
+TEST_F(TlsAuthTest, PlaintextOnANonLoopbackAddressNeedsInsecure) {
+  const std::string any = absl::StrCat("--address=0.0.0.0:", port_);
+  {
+    Server refused({any}, Log());
+    EXPECT_EQ(refused.Wait(absl::Seconds(20)), 2);
+    EXPECT_THAT(refused.Log(), HasSubstr("refusing to serve plaintext on the non-loopback "
+                                         "address 0.0.0.0:"));
+    EXPECT_THAT(refused.Log(), HasSubstr("--insecure"));
+  }
+  EXPECT_FALSE(PortOpen(port_));
+  Server insecure({any, "--insecure"}, Log());
+  ASSERT_TRUE(insecure.WaitForPort(port_)) << insecure.Log();
+  EXPECT_EQ(Cli("list").exit_code, 0);
+  EXPECT_EQ(insecure.Stop(), 0) << insecure.Log();
+  // Loopback stays plaintext by default.
+  Server loopback({"--address=" + Address()}, Log());
+  ASSERT_TRUE(loopback.WaitForPort(port_)) << loopback.Log();
+  EXPECT_EQ(loopback.Stop(), 0);
+}
+
+TEST_F(TlsAuthTest, TokensAreCheckedReloadedOnSighupAndNeverLogged) {
+  const std::filesystem::path tokens = dir_ / "tokens";
+  std::ofstream(tokens) << "# test\n"
+                        << kReadToken << " carol read\n"
+                        << kAdminToken << " root admin\n";
+  Server server({"--address=" + Address(), "--tokens=" + tokens.string()}, Log());
+  ASSERT_TRUE(server.WaitForPort(port_)) << server.Log();
+  EXPECT_TRUE(server.WaitForLog("2 tokens from")) << server.Log();
+  // Health stays open for probes.
+  EXPECT_THAT(Cli("health").out, HasSubstr("SERVING"));
+  // No token, an unknown token, the wrong role.
+  EXPECT_THAT(Cli("list").out, HasSubstr("UNAUTHENTICATED"));
+  const Result wrong = Cli("list", absl::StrCat("--token=", kWrongToken));
+  EXPECT_THAT(wrong.out, HasSubstr("UNAUTHENTICATED"));
+  EXPECT_THAT(wrong.out, Not(HasSubstr(kWrongToken)));
+  EXPECT_EQ(Cli("list", absl::StrCat("--token=", kReadToken)).exit_code, 0);
+  const std::string env = absl::StrCat("SPLINEGRID_TOKEN=", kReadToken, " ");
+  EXPECT_EQ(Shell(env + kBinary + " list --timeout=5s --server=" + Address()).exit_code, 0);
+  EXPECT_THAT(Shell(env + kBinary + " rm nothing --timeout=5s --server=" + Address()).out,
+              HasSubstr("PERMISSION_DENIED"));
+
+  // carol becomes a writer: her delete now reaches the store (NOT_FOUND).
+  std::ofstream(tokens) << kReadToken << " carol write\n" << kAdminToken << " root admin\n";
+  server.Signal(SIGHUP);
+  ASSERT_TRUE(server.WaitForLog("tokens reloaded: 2 tokens")) << server.Log();
+  EXPECT_THAT(Shell(env + kBinary + " rm nothing --timeout=5s --server=" + Address()).out,
+              HasSubstr("NOT_FOUND"));
+  // A bad file keeps the previous table.
+  std::ofstream(tokens) << kReadToken << " carol superuser\n";
+  server.Signal(SIGHUP);
+  ASSERT_TRUE(server.WaitForLog("tokens not reloaded")) << server.Log();
+  EXPECT_THAT(server.Log(), HasSubstr(tokens.string() + ":1: the role 'superuser'"));
+  EXPECT_THAT(Shell(env + kBinary + " rm nothing --timeout=5s --server=" + Address()).out,
+              HasSubstr("NOT_FOUND"));
+  EXPECT_TRUE(server.Running());
+
+  // Python: the argument, the environment, neither.
+  const Result python =
+      Python(absl::StrCat("print('arg', len(client.Client(target, token='", kAdminToken,
+                          "').list()))\n"
+                          "print('env', len(client.Client(target).list()))\n"
+                          "try:\n"
+                          "    client.Client(target, token='').list()\n"
+                          "except client.SplinegridError as e:\n"
+                          "    print('none', e.code)\n"),
+             env);
+  EXPECT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("arg 0"));
+  EXPECT_THAT(python.out, HasSubstr("env 0"));
+  EXPECT_THAT(python.out, HasSubstr("none UNAUTHENTICATED"));
+
+  EXPECT_EQ(server.Stop(), 0) << server.Log();
+  const std::string log = server.Log();
+  for (const char* token : {kReadToken, kAdminToken, kWrongToken}) {
+    EXPECT_THAT(log, Not(HasSubstr(token)));
+  }
+  EXPECT_THAT(log, HasSubstr("carol"));  // the principal is what the call log names
+}
+
+TEST_F(TlsAuthTest, ABadTokensFileAtStartIsAnErrorNamingTheLine) {
+  const std::filesystem::path tokens = dir_ / "tokens";
+  std::ofstream(tokens) << "# ok\n" << kReadToken << " carol read\n" << kAdminToken << " root\n";
+  Server server({"--address=" + Address(), "--tokens=" + tokens.string()}, Log());
+  EXPECT_EQ(server.Wait(absl::Seconds(20)), 2);
+  const std::string log = server.Log();
+  EXPECT_THAT(log, HasSubstr(tokens.string() + ":3: expected 'TOKEN PRINCIPAL ROLE'"));
+  EXPECT_THAT(log, Not(HasSubstr(kAdminToken)));
+  EXPECT_THAT(log, Not(HasSubstr(kReadToken)));
+}
+
+}  // namespace
+}  // namespace splinegrid::testing
