@@ -184,7 +184,10 @@ std::unique_ptr<grpc::ClientContext> Client::NewContext(absl::Time deadline,
                                                         const std::string& token) {
   auto context = std::make_unique<grpc::ClientContext>();
   if (deadline != absl::InfiniteFuture()) context->set_deadline(absl::ToChronoTime(deadline));
-  if (!grid.empty() &&
+  // Only what can be a grid id (1-63 characters; 128 leaves room for "grids/"): a long or
+  // binary name goes without the routing header, so that the server, not the metadata limit,
+  // answers it (INVALID_ARGUMENT naming the field).
+  if (!grid.empty() && grid.size() <= 128 &&
       std::all_of(grid.begin(), grid.end(), [](char c) { return c >= 0x20 && c < 0x7F; })) {
     context->AddMetadata(kGridRoutingHeader, grid);
   }

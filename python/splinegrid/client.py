@@ -1172,7 +1172,9 @@ def _routing_metadata(grid: str) -> Optional[tuple]:
     """The routing header naming ``grid`` (none for no grid, or an id that is not printable
     ASCII, which the server refuses anyway)."""
     grid = _grid_id(grid)
-    if not grid or not (grid.isascii() and grid.isprintable()):
+    # Only what can be a grid id: a long or binary name goes without the header, so that the
+    # server (not the metadata size limit) answers it with INVALID_ARGUMENT naming the field.
+    if not grid or len(grid) > 128 or not (grid.isascii() and grid.isprintable()):
         return None
     return ((GRID_ROUTING_HEADER, grid),)
 
