@@ -119,6 +119,9 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> RedisSnapshots::DecodeRevisi
   if (!stored.ParseFromArray(value.data(), static_cast<int>(value.size()))) {
     return absl::DataLossError(absl::StrCat(what, " in Redis is not a StoredRevision"));
   }
+  // AddRevisionScript stores the value as the client sent it, without a number (the script
+  // chooses it; appending it in Lua copied the value twice more): the field is its number.
+  if (stored.number() == 0) stored.set_number(number);
   absl::StatusOr<std::shared_ptr<const GridRevision>> revision = LoadRevision(stored, budget_);
   if (revision.status().code() == absl::StatusCode::kResourceExhausted && !*made_room) {
     *made_room = true;  // once per snapshot
