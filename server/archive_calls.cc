@@ -123,7 +123,10 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportAr
  public:
   ImportArchiveReactor(ServiceState* state, grpc::CallbackServerContext* context,
                        v1::Grid* response)
-      : state_(state), response_(response), log_("ImportArchive", "", state->options) {
+      : state_(state),
+        context_(context),
+        response_(response),
+        log_("ImportArchive", "", state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
     if (!caller.ok()) {
       End(caller.status());
@@ -146,6 +149,12 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportAr
     if (!ok) {  // the client closed its side: everything has arrived
       idle_.Stop();  // from here on the call is the pool's
       if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
+      // Reads also end when the client cancels or the shutdown's grace runs out: then nothing
+      // is stored and the status says why.
+      if (context_->IsCancelled()) {
+        End(WhyCallEnded(*state_, context_));
+        return;
+      }
       if (absl::Status status =
               state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
           !status.ok()) {
@@ -225,6 +234,7 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportAr
   }
 
   ServiceState* state_;
+  grpc::CallbackServerContext* context_;
   v1::Grid* response_;
   CallLog log_;
   Caller caller_;

@@ -18,18 +18,25 @@ namespace {
 // Highest refinement level of the fold check (16 sub-cells per cell in 2D, 64 in 3D at 2).
 constexpr int kMaxCheckLevel = 4;
 
-// The cache key of the deformer: the grid (id and creation), the reference revision and
-// everything the deformer is built from.
-std::string DeformerKey(const StoredGrid& grid, int64_t reference,
-                        const v1::DeformGridRequest& request) {
+// The start of a deformer's cache key: the grid's id, the reference revision and everything the
+// deformer is built from (length-prefixed, so that no key is the prefix of another's).
+std::string DeformerShapeKey(const std::string& id, int64_t reference,
+                             const v1::DeformGridRequest& request) {
   v1::DeformGridRequest shape;
   *shape.mutable_boundary() = request.boundary();
   shape.set_propagation(request.propagation());
   shape.set_rigid_radius(request.rigid_radius());
   shape.set_decay_radius(request.decay_radius());
   shape.set_smoothing_iterations(request.smoothing_iterations());
-  return absl::StrCat(DeformerKeyPrefix(grid.id), absl::ToUnixNanos(grid.create_time), "#",
-                      reference, "#", shape.SerializeAsString());
+  const std::string bytes = shape.SerializeAsString();
+  return absl::StrCat(DeformerKeyPrefix(id), reference, "#", bytes.size(), ":", bytes, "#");
+}
+
+// The whole key: the shape key and the grid's creation (an id may be used again).
+std::string DeformerKey(const StoredGrid& grid, int64_t reference,
+                        const v1::DeformGridRequest& request) {
+  return absl::StrCat(DeformerShapeKey(grid.id, reference, request),
+                      absl::ToUnixNanos(grid.create_time));
 }
 
 }  // namespace
@@ -40,13 +47,17 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
   CallLog log("DeformGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   // A deform with a kept deformer costs about a millisecond: cheap work. Building the deformer
-  // (the grid's first deform, or after its 16 most recent were evicted) factorises the boundary
-  // fits, up to seconds: long work. Whether this grid has one kept is the hint (a new boundary
-  // or reference on a grid that has one is built on the cheap lane, once).
+  // (the first deform with this reference and boundary, or after it was evicted) factorises the
+  // boundary fits, up to seconds: long work, scheduled fairly. The request names the deformer
+  // up to the grid's creation, so a kept one for the same shape decides (a grid deleted and made
+  // again under the same id builds once on the cheap lane); reference 0 (the latest) is long.
   const absl::StatusOr<std::string> grid_id = ParseGridName(request->name(), "name");
-  const WorkKind kind = grid_id.ok() && state_->deformers.HasAny(DeformerKeyPrefix(*grid_id))
-                            ? WorkKind::kCheap
-                            : WorkKind::kLong;
+  const WorkKind kind =
+      grid_id.ok() && request->reference_revision() > 0 &&
+              state_->deformers.HasAny(
+                  DeformerShapeKey(*grid_id, request->reference_revision(), *request))
+          ? WorkKind::kCheap
+          : WorkKind::kLong;
   return RunOnPool(
       context, log, Role::kWrite, kind,
       [this, request, response, cancel](const Caller&) -> absl::Status {

@@ -28,8 +28,8 @@ class DeformerCache {
   // Drops every entry whose key starts with `prefix` (a deleted grid's).
   void Forget(const std::string& prefix);
 
-  // Whether an entry whose key starts with `prefix` is kept (a hint for the scheduler: the
-  // next call may still miss, e.g. with another boundary).
+  // Whether an entry whose key starts with `prefix` is kept (for the scheduler: a deform whose
+  // deformer is kept is cheap work).
   bool HasAny(const std::string& prefix);
 
  private:

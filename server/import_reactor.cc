@@ -24,7 +24,10 @@ namespace {
 class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridRequest>> {
  public:
   ImportReactor(ServiceState* state, grpc::CallbackServerContext* context, v1::Grid* response)
-      : state_(state), response_(response), log_("ImportGrid", "", state->options) {
+      : state_(state),
+        context_(context),
+        response_(response),
+        log_("ImportGrid", "", state->options) {
     absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
     if (!caller.ok()) {
       Fail(caller.status());
@@ -47,6 +50,12 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     if (!ok) {  // the client closed its side: everything has arrived
       idle_.Stop();  // from here on the call is the pool's
       if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
+      // Reads also end when the client cancels or the shutdown's grace runs out: then nothing
+      // is stored and the status says why.
+      if (context_->IsCancelled()) {
+        Fail(WhyCallEnded(*state_, context_));
+        return;
+      }
       if (absl::Status status =
               state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
           !status.ok()) {
@@ -99,10 +108,14 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     constexpr int64_t kSize = sizeof(typename Container::value_type);
     const size_t capacity = std::min(limit, std::max(needed, 2 * into.capacity()));
     const int64_t old_bytes = static_cast<int64_t>(into.capacity()) * kSize;
-    SG_RETURN_IF_ERROR(
-        state_->budget.Extend(&upload_, static_cast<int64_t>(capacity) * kSize, what));
+    // libstdc++'s std::string::reserve allocates at least twice the old capacity: charge the
+    // larger of the two, then what was allocated.
+    const int64_t bound = static_cast<int64_t>(std::max(capacity, 2 * into.capacity())) * kSize;
+    SG_RETURN_IF_ERROR(state_->budget.Extend(&upload_, bound, what));
     into.reserve(capacity);
-    return state_->budget.Resize(&upload_, upload_.bytes() - old_bytes, what);  // a release
+    const int64_t allocated = static_cast<int64_t>(into.capacity()) * kSize;
+    return state_->budget.Resize(&upload_, upload_.bytes() - bound + allocated - old_bytes,
+                                 what);  // a release
   }
 
   absl::Status Accept(const v1::ImportGridRequest& message) {
@@ -293,6 +306,7 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
   }
 
   ServiceState* state_;
+  grpc::CallbackServerContext* context_;
   v1::Grid* response_;
   CallLog log_;
   Caller caller_;

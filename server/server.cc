@@ -191,6 +191,11 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
                                : absl::StrCat(num_tokens, " tokens from ", options.tokens_file,
                                               " (SIGHUP reloads)")
                                      .c_str());
+  if (num_tokens > 0 && options.insecure && options.tls_cert_file.empty()) {
+    std::fprintf(stderr,
+                 "splinegrid: warning: bearer tokens travel in plaintext (--insecure without "
+                 "TLS): anyone on the network path can read and reuse them\n");
+  }
   int received = 0;
   while (sigwait(&signals, &received) == 0 && received == SIGHUP) {
     const absl::StatusOr<int> tokens = (*server)->ReloadTokens();

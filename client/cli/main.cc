@@ -27,8 +27,12 @@ namespace {
 constexpr char kUsage[] =
     "splinegrid: structured grids as B-spline mappings.\n"
     "  splinegrid serve [--address localhost:50051] [--store memory|dir:PATH|redis://H:P[/DB]]\n"
-    "                   [--threads N] [--memory_budget_mb M]\n"
+    "                   [--threads N] [--memory_budget_mb M (0: half the memory limit)]\n"
     "                   [--keep_revisions N]   (deformed revisions kept per grid, default 64)\n"
+    "                   [--log_format text|json] [--drain_notice 5s] [--shutdown_grace 10s]\n"
+    "                   [--import_idle_timeout 60s] [--max_running_long_tasks N]\n"
+    "                   [--max_queued_long_calls_per_principal 8]\n"
+    "                   [--max_streams_per_principal 64]\n"
     "  splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] |\n"
     "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
     "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]\n"

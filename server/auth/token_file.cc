@@ -27,8 +27,9 @@ absl::StatusOr<Role> ParseRole(absl::string_view name) {
   if (name == "read") return Role::kRead;
   if (name == "write") return Role::kWrite;
   if (name == "admin") return Role::kAdmin;
+  // Not quoted: in a line written in the wrong order this field is the token.
   return absl::InvalidArgumentError(
-      absl::StrCat("the role '", name.substr(0, 32), "' is not read, write or admin"));
+      "the third field (the role) is not read, write or admin (fields: TOKEN PRINCIPAL ROLE)");
 }
 
 // One non-comment line's three fields as an entry; errors never quote the token.

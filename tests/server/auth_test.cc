@@ -243,7 +243,8 @@ TEST_F(AuthTest, AServerWithABadTokensFileDoesNotStart) {
   server::ServerOptions options = options_;
   options.tokens_file = (dir_ / "bad").string();
   const absl::Status status = server::Server::Start(options).status();
-  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument, "bad:2: the role"));
+  EXPECT_THAT(status,
+              StatusIs(absl::StatusCode::kInvalidArgument, "bad:2: the third field (the role)"));
   EXPECT_THAT(std::string(status.message()), Not(HasSubstr("some-token-123")));
 }
 

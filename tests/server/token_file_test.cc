@@ -77,6 +77,8 @@ TEST(TokenFileTest, ErrorsNameTheLineAndNeverTheToken) {
       {absl::StrCat(kAliceToken, " alice"), "3 fields), found 2"},
       {absl::StrCat(kAliceToken, " alice write extra"), "found 4"},
       {"short alice read", "must be 8-512"},
+      // In the wrong order the third field is the token: never quoted.
+      {absl::StrCat("ops-admin write ", kAliceToken), "is not read, write or admin"},
   };
   for (const auto& c : cases) {
     const std::string text = absl::StrCat("# header\n", kBobToken, " bob read\n", c.line, "\n");
@@ -161,7 +163,7 @@ TEST(AuthenticatorTest, ReloadSwapsTheTableAndABadFileKeepsTheOldOne) {
 
   file.Write(absl::StrCat(kAliceToken, " alice root\n"));
   EXPECT_THAT(authenticator.Reload().status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, ":1: the role 'root'"));
+              StatusIs(absl::StatusCode::kInvalidArgument, ":1: the third field (the role)"));
   EXPECT_EQ(authenticator.num_tokens(), 2);
   EXPECT_EQ(authenticator.Authenticate(alice, "p")->role, Role::kAdmin);
 
