@@ -67,14 +67,6 @@ absl::Status ExplainCancellation(const ServiceState& state, grpc::CallbackServer
   return WhyCallEnded(state, context);
 }
 
-bool IsValidGridId(const std::string& id) {
-  if (id.empty() || id.size() > 63 || !(id[0] >= 'a' && id[0] <= 'z')) return false;
-  for (char c : id) {
-    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
-  }
-  return true;
-}
-
 absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
                         const std::shared_ptr<StoredGrid>& grid) {
   std::mt19937_64 random(std::random_device{}());

@@ -16,6 +16,7 @@
 #include "server/call_log.h"
 #include "server/decoded_request.h"
 #include "server/deformer_cache.h"
+#include "server/grid_id.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
 #include "server/scheduler.h"
@@ -68,9 +69,6 @@ absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::st
 // requested id.
 absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
                         const std::shared_ptr<StoredGrid>& grid);
-
-// Whether `id` is a valid grid id: 1-63 characters of [a-z0-9-], starting with a letter.
-bool IsValidGridId(const std::string& id);
 
 // The prefix of every DeformerCache key of grid `id`.
 inline std::string DeformerKeyPrefix(const std::string& id) { return id + "#"; }

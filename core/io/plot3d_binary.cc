@@ -273,6 +273,10 @@ bool FirstRecordValid(std::string_view bytes, bool big_endian, std::string* erro
 
 absl::StatusOr<MultiBlockGrid> ParsePlot3dBinary(std::string_view bytes, std::string_view source,
                                                  Plot3dFormat* detected) {
+  // ParsePlot3d never passes empty bytes; the check keeps bytes[0] below in bounds for any caller.
+  if (bytes.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(ErrorPrefix(source), "the file is empty"));
+  }
   std::string little_error, big_error;
   const bool little = FirstRecordValid(bytes, false, &little_error);
   const bool big = FirstRecordValid(bytes, true, &big_error);

@@ -4,7 +4,7 @@
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
-#include "server/service.h"
+#include "server/grid_id.h"
 #include "server/store/revision_codec.h"
 
 namespace splinegrid::server {
