@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <deque>
+#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <mutex>
@@ -200,9 +201,14 @@ class GridStore {
   virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
       const std::string& id, GridRevision revision, int64_t expected_latest = 0) = 0;
 
+  // Decides from a grid's owner whether it may be deleted (OK, or the error to return).
+  using DeleteCheck = std::function<absl::Status(const std::string& owner)>;
+
   // Removes the grid and ends its watches (kGridDeleted); NOT_FOUND if absent. Readers holding
-  // snapshots keep them.
-  virtual absl::Status Delete(const std::string& id) = 0;
+  // snapshots keep them. With `check`, the grid is removed only if `check` of its owner is OK,
+  // decided atomically with the removal (a grid deleted and created again by someone else in
+  // between is not removed); otherwise `check`'s error.
+  virtual absl::Status Delete(const std::string& id, const DeleteCheck& check = nullptr) = 0;
 
   // A watch of grid `id`: its current snapshot, and a subscription that receives every revision
   // published after that snapshot (at most `max_queued` waiting) and the grid's deletion.

@@ -200,11 +200,13 @@ grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerCont
   CallLog log("DeleteGrid", request->name(), state_->options);
   auto work = [this, request](const Caller& caller) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
+    GridStore::DeleteCheck check;
     if (caller.role < Role::kAdmin) {  // a writer deletes only its own grids
-      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-      SG_RETURN_IF_ERROR(MayDeleteGrid(caller, grid->owner, request->name()));
+      check = [&](const std::string& owner) {
+        return MayDeleteGrid(caller, owner, request->name());
+      };
     }
-    SG_RETURN_IF_ERROR(state_->store->Delete(id));
+    SG_RETURN_IF_ERROR(state_->store->Delete(id, check));
     state_->deformers.Forget(DeformerKeyPrefix(id));
     return absl::OkStatus();
   };

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid::server {
 
@@ -94,16 +95,21 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::AddRevision(
   return result;
 }
 
-absl::Status MemoryStore::Delete(const std::string& id) {
+absl::Status MemoryStore::Delete(const std::string& id, const DeleteCheck& check) {
   const std::shared_ptr<std::mutex> writer = WriterOf(id);
   std::lock_guard<std::mutex> write(*writer);
+  std::string owner;
   {
     std::lock_guard<std::mutex> lock(mu_);
-    if (!grids_.contains(id)) {
+    const auto it = grids_.find(id);
+    if (it == grids_.end()) {
       writers_.erase(id);
       return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
     }
+    owner = it->second->owner;
   }
+  // Under the grid's writer lock: no one deletes or creates it meanwhile.
+  if (check) SG_RETURN_IF_ERROR(check(owner));
   if (log_) {
     if (absl::Status deleted = log_->DeleteGrid(id); !deleted.ok()) return deleted;
   }

@@ -18,7 +18,7 @@ if redis.call('EXISTS', KEYS[3]) == 0 or
   return -1
 end
 for i = 3, 7 do redis.call('PERSIST', KEYS[i]) end
-redis.call('HSET', KEYS[1], 'gen', ARGV[2], 'latest', ARGV[3])
+redis.call('HSET', KEYS[1], 'gen', ARGV[2], 'latest', ARGV[3], 'owner', ARGV[6])
 redis.call('ZADD', KEYS[2], 0, ARGV[1])
 return 1
 )lua");
@@ -97,6 +97,9 @@ const RedisScript& DeleteScript() {
   static const RedisScript* script = new RedisScript(R"lua(
 local gen = redis.call('HGET', KEYS[1], 'gen')
 if not gen then return 0 end
+if ARGV[4] == '1' and (redis.call('HGET', KEYS[1], 'owner') or '') ~= ARGV[5] then
+  return -1
+end
 local g = ARGV[1] .. gen
 redis.call('UNLINK', KEYS[1], g .. ':header', g .. ':source', g .. ':revs', g .. ':nums',
            g .. ':deforms')

@@ -41,7 +41,8 @@ class RedisKeys {
 
 // Commits a creation whose keys were written (with a TTL) under a new generation.
 // KEYS: grid, index, then the generation's header, source, revs, nums, deforms.
-// ARGV: id, gen, latest, the number of source chunks, the number of revisions.
+// ARGV: id, gen, latest, the number of source chunks, the number of revisions, the owner
+// (kept in the grid's record, for DeleteScript's check).
 // Returns 1 (created), 0 (the id is taken: the generation's keys are removed) or -1 (the
 // written keys are incomplete, e.g. they expired: removed too).
 const RedisScript& CreateScript();
@@ -64,8 +65,9 @@ const RedisScript& GetScript();
 
 // Deletes a grid: its record, index entry and generation keys; appends the deletion event and
 // lets the event stream expire after a while (watchers on other replicas read it meanwhile).
-// KEYS: grid, index. ARGV: the grid's Stem, id, seconds the event stream is kept.
-// Returns 1 (deleted) or 0 (no such grid).
+// KEYS: grid, index. ARGV: the grid's Stem, id, seconds the event stream is kept, "1" to delete
+// only if the owner is ARGV[5] (compare and delete), the owner.
+// Returns 1 (deleted), 0 (no such grid) or -1 (the owner is another one: nothing deleted).
 const RedisScript& DeleteScript();
 
 }  // namespace splinegrid::server

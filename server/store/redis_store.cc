@@ -133,7 +133,7 @@ class RedisStore final : public GridStore {
   absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
                                                                 GridRevision revision,
                                                                 int64_t expected_latest) override;
-  absl::Status Delete(const std::string& id) override;
+  absl::Status Delete(const std::string& id, const DeleteCheck& check = nullptr) override;
   absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
                                   size_t max_queued) override;
   void Unsubscribe(const std::string& id, const GridSubscription* subscription) override {
@@ -245,8 +245,9 @@ absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
   const std::string count = absl::StrCat(revisions.size());
   // An error here leaves the outcome unknown: the keys are not removed (if not committed they
   // expire).
-  SG_ASSIGN_OR_RETURN(RedisReply committed,
-                      pool_.Run(CreateScript(), keys, {id, gen, latest, chunks, count}));
+  SG_ASSIGN_OR_RETURN(
+      RedisReply committed,
+      pool_.Run(CreateScript(), keys, {id, gen, latest, chunks, count, grid->owner}));
   switch (committed.value().AsInt().value_or(-2)) {
     case 1:
       snapshots_.Put(id, {gen, std::move(grid)});
@@ -353,16 +354,37 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(const 
   return std::move(fetched.snapshot);
 }
 
-absl::Status RedisStore::Delete(const std::string& id) {
+absl::Status RedisStore::Delete(const std::string& id, const DeleteCheck& check) {
   const std::string grid_key = keys_.Grid(id);
   const std::string index = keys_.Index();
   const std::string stem = keys_.Stem(id);
   const std::string ttl = WholeSeconds(options_.deleted_events_ttl);
-  SG_ASSIGN_OR_RETURN(RedisReply reply,
-                      pool_.Run(DeleteScript(), {grid_key, index}, {stem, id, ttl}));
-  snapshots_.Erase(id);
-  if (reply.value().AsInt().value_or(0) != 1) return NotFound(id, "not found");
-  return absl::OkStatus();
+  // With a check: read the owner, check it here, and let the script delete only if the owner is
+  // still that one (compare and delete); if it changed meanwhile (deleted and created again),
+  // check the new one. A few rounds at most: each needs another creation in between.
+  for (int round = 0;; ++round) {
+    std::string owner;
+    if (check) {
+      SG_ASSIGN_OR_RETURN(RedisReply read, pool_.Command({"HGET", grid_key, "owner"}));
+      if (read.value().is_nil() && round == 0) {
+        SG_ASSIGN_OR_RETURN(RedisReply exists, pool_.Command({"EXISTS", grid_key}));
+        if (exists.value().AsInt().value_or(0) == 0) return NotFound(id, "not found");
+      }
+      owner = std::string(read.value().str());
+      SG_RETURN_IF_ERROR(check(owner));
+    }
+    SG_ASSIGN_OR_RETURN(RedisReply reply, pool_.Run(DeleteScript(), {grid_key, index},
+                                                    {stem, id, ttl, check ? "1" : "0", owner}));
+    const int64_t outcome = reply.value().AsInt().value_or(0);
+    if (outcome == -1 && round < 4) continue;
+    if (outcome == -1) {
+      return absl::AbortedError(
+          absl::StrCat("grids/", id, " changed owner while it was being deleted; try again"));
+    }
+    snapshots_.Erase(id);
+    if (outcome != 1) return NotFound(id, "not found");
+    return absl::OkStatus();
+  }
 }
 
 // ---- Watching and listing ----

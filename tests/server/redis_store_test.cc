@@ -329,6 +329,45 @@ TEST_F(RedisStoreTest, CreateGetListDeleteAcrossReplicas) {
   EXPECT_TRUE(b_->Get("g1").value()->revisions.empty());
 }
 
+// A delete with an owner check removes the grid only if the check passes for the owner the grid
+// has at the moment of removal: a grid deleted and created again by another principal between
+// the check and the removal is not removed.
+TEST_F(RedisStoreTest, DeleteWithAnOwnerCheckIsCompareAndDelete) {
+  auto owned_by = [](const std::string& id, const std::string& owner) {
+    std::shared_ptr<StoredGrid> grid = MakeGrid(id);
+    grid->owner = owner;
+    return grid;
+  };
+  auto only = [](const std::string& allowed) {
+    return [allowed](const std::string& owner) {
+      return owner == allowed ? absl::OkStatus()
+                              : absl::PermissionDeniedError(absl::StrCat("owned by ", owner));
+    };
+  };
+  ASSERT_TRUE(a_->Create(owned_by("g", "alice")).ok());
+  EXPECT_THAT(b_->Delete("g", only("bob")),
+              StatusIs(absl::StatusCode::kPermissionDenied, "owned by alice"));
+  EXPECT_TRUE(a_->Get("g").ok());
+  EXPECT_THAT(b_->Delete("absent", only("bob")), StatusIs(absl::StatusCode::kNotFound, "absent"));
+
+  // Alice's delete passes its check, but before the removal the grid is deleted and created
+  // again by bob (from inside the check: between reading the owner and the script).
+  bool raced = false;
+  const absl::Status status = a_->Delete("g", [&](const std::string& owner) -> absl::Status {
+    if (!raced) {
+      raced = true;
+      EXPECT_TRUE(b_->Delete("g").ok());
+      EXPECT_TRUE(b_->Create(owned_by("g", "bob")).ok());
+    }
+    return only("alice")(owner);
+  });
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kPermissionDenied, "owned by bob"));
+  ASSERT_TRUE(a_->Get("g").ok()) << "bob's grid was removed";
+  EXPECT_EQ(a_->Get("g").value()->owner, "bob");
+  EXPECT_TRUE(b_->Delete("g", only("bob")).ok());
+  EXPECT_THAT(a_->Get("g").status(), StatusIs(absl::StatusCode::kNotFound, "g"));
+}
+
 // Everything a grid has lives under its keys; a deletion leaves only the event stream (which
 // expires) behind.
 TEST_F(RedisStoreTest, DeleteRemovesEveryKeyOfTheGrid) {
