@@ -51,15 +51,99 @@ class ControlSets {
   std::vector<int64_t> parent_;
 };
 
-// Makes the controls of every matched boundary bitwise identical: each set takes the value of
-// its first member. Returns the largest change (rounding only when the model is consistent).
+// The control index box of pole p in a spline with `n` controls per direction: every control
+// along p.d, and in each other direction the first or last control where the pole is on that
+// end of the block (the control a clamped end interpolates), else all of them.
+std::pair<Extents, Extents> PoleControlBox(const Pole& p, const StructuredBlock& block,
+                                           const Extents& n) {
+  Extents lo = {0, 0, 0}, hi = {n[0] - 1, n[1] - 1, n[2] - 1};
+  for (int e = 0; e < 3; ++e) {
+    if (e == p.d || p.lo[e] != p.hi[e] || block.extent(e) == 1) continue;
+    lo[e] = hi[e] = p.lo[e] == 0 ? 0 : n[e] - 1;
+  }
+  return {lo, hi};
+}
+
+// Calls f(line_start, d) for every line of controls along p.d in the pole's control box.
+template <typename F>
+void ForEachPoleLine(const Pole& p, const StructuredBlock& block, const Extents& n, F f) {
+  const auto [lo, hi] = PoleControlBox(p, block, n);
+  const int e1 = p.d == 0 ? 1 : 0, e2 = p.d == 2 ? 1 : 2;
+  for (int y = lo[e2]; y <= hi[e2]; ++y) {
+    for (int x = lo[e1]; x <= hi[e1]; ++x) {
+      Extents at = {0, 0, 0};
+      at[e1] = x;
+      at[e2] = y;
+      f(at);
+    }
+  }
+}
+
+// Keeps every pole collapsed: each line of controls along a pole's collapsed direction takes
+// the mean of its controls.
+//
+// Why the mean is the constrained least-squares fit, not an approximation of it. Take a surface
+// block whose edge v = 0 is collapsed to the point c (the data X_{r,0} = c for all r), fitted
+// with clamped knots and interpolated ends: the controls of the edge, P_{a,0}, are then the fit
+// of the edge data alone along u, P_{.,0} = A^+ X_{.,0} (A the collocation matrix along u,
+// A^+ its least-squares solution operator, with the pins of the segment model), because along v
+// the first control is pinned to the first datum of every line. The data are c 1, and B-splines
+// reproduce constants (A 1 = 1, partition of unity): the net c 1 satisfies every pin (end and
+// split pins take data values, all c) with zero residual, and A has full column rank, so it is
+// the unique minimiser, P_{.,0} = c 1, in exact arithmetic. Fairing rows (differences of
+// neighbouring controls) vanish on it too. So the unconstrained fit already satisfies
+// the constraint P_{a,0} = P_{0,0}, so it is also the constrained fit (the minimiser over a set
+// that contains the unconstrained minimiser). The same holds for a volume's face collapsed along
+// u to a line (X_{r,s,0} = Y_s): P_{.,.,0} = (A_u^+ (x) A_v^+) (1 Y^T) = 1 (A_v^+ Y)^T, every line
+// along u constant and the axis fitted as a curve along v. In floating point the controls of a
+// line differ by rounding (about 1e-16 of the coordinates), which would leave a pole not quite a
+// point and blocks meeting at it a hair apart; the mean removes that (it is the orthogonal
+// projection onto {P_a = P_0}, so it also picks the closest collapsed net when the data are only
+// collapsed to within kPoleRelativeTolerance), and CopySharedControls then makes the poles of
+// all blocks bitwise one point.
+void CollapsePoles(const std::vector<Pole>& poles, const MultiBlockGrid& grid,
+                   std::vector<FittedBlock>& blocks) {
+  if (blocks.empty()) return;  // no unfaired fit
+  for (const Pole& p : poles) {
+    TensorSpline& spline = blocks[p.block].spline;
+    const Extents n = spline.control_extents();
+    const int s = spline.spatial_dim();
+    std::span<double> control = spline.mutable_control();
+    const int64_t stride = p.d == 0 ? 1 : (p.d == 1 ? n[0] : int64_t{n[0]} * n[1]);
+    ForEachPoleLine(p, grid.blocks[p.block], n, [&](const Extents& at) {
+      const int64_t first = at[0] + int64_t{n[0]} * (at[1] + int64_t{n[1]} * at[2]);
+      double mean[3] = {0.0, 0.0, 0.0};
+      for (int a = 0; a < n[p.d]; ++a) {
+        for (int c = 0; c < s; ++c) mean[c] += control[s * (first + a * stride) + c];
+      }
+      for (int a = 0; a < n[p.d]; ++a) {
+        for (int c = 0; c < s; ++c) control[s * (first + a * stride) + c] = mean[c] / n[p.d];
+      }
+    });
+  }
+}
+
+// Makes the controls of every matched boundary bitwise identical, and those of every line of a
+// pole: each set takes the value of its first member. Returns the largest change (rounding only
+// when the model is consistent).
 double CopySharedControls(const SegmentModel& model, const Connectivity& connectivity,
+                          const std::vector<Pole>& poles, const MultiBlockGrid& grid,
                           std::vector<FittedBlock>& blocks) {
   std::vector<Extents> extents;
   for (const FittedBlock& b : blocks) extents.push_back(b.spline.control_extents());
   ControlSets sets(blocks);
   for (const auto& [x, y] : model.MatchedControls(connectivity, extents)) {
     sets.Union(sets.Id(x.first, x.second), sets.Id(y.first, y.second));
+  }
+  for (const Pole& p : poles) {
+    const Extents& n = extents[p.block];
+    const int64_t stride = p.d == 0 ? 1 : (p.d == 1 ? n[0] : int64_t{n[0]} * n[1]);
+    ForEachPoleLine(p, grid.blocks[p.block], n, [&](const Extents& at) {
+      const int64_t first = at[0] + int64_t{n[0]} * (at[1] + int64_t{n[1]} * at[2]);
+      for (int a = 1; a < n[p.d]; ++a) {
+        sets.Union(sets.Id(p.block, first), sets.Id(p.block, first + a * stride));
+      }
+    });
   }
   double largest = 0.0;
   for (int64_t id = 0; id < sets.size(); ++id) {
@@ -248,6 +332,23 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
       features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
     }
   }
+  // No edge ratio (refinement.h) at the points of a pole: the edges along a collapsed line have
+  // no length to be relative to (within kPoleRelativeTolerance of 0, not always exactly 0, so a
+  // ratio of rounding noise would refine every class it touches down to interpolation), and
+  // the fit keeps them collapsed exactly (CollapsePoles). An edge ratio of 0 at one end switches
+  // the edge off, so the edges from the pole to the first ring go too; the ring's own points and
+  // edges still bind it.
+  for (const Pole& pole : result.poles) {
+    const StructuredBlock& block = grid.blocks[pole.block];
+    if (edge_tolerances[pole.block].size() != static_cast<size_t>(block.num_points())) continue;
+    for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
+      for (int j = pole.lo[1]; j <= pole.hi[1]; ++j) {
+        for (int i = pole.lo[0]; i <= pole.hi[0]; ++i) {
+          edge_tolerances[pole.block][block.Index(i, j, k)] = 0.0;
+        }
+      }
+    }
+  }
   const Connectivity none;
   const Connectivity& shared = options.watertight ? result.connectivity : none;
   SG_ASSIGN_OR_RETURN(SegmentModel model,
@@ -269,9 +370,15 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
                       RunAdaptiveFit(grid, model, tolerances, edge_tolerances, engine));
   result.blocks = std::move(run.blocks);
   result.unfaired = std::move(run.unfaired);
-  if (options.watertight) {
-    CopySharedControls(model, shared, result.blocks);
-    if (!result.unfaired.empty()) CopySharedControls(model, shared, result.unfaired);
+  // Poles first (each line to its mean), then the shared controls and the pole lines made one
+  // value across blocks.
+  CollapsePoles(result.poles, grid, result.blocks);
+  CollapsePoles(result.poles, grid, result.unfaired);
+  if (options.watertight || !result.poles.empty()) {
+    CopySharedControls(model, shared, result.poles, grid, result.blocks);
+    if (!result.unfaired.empty()) {
+      CopySharedControls(model, shared, result.poles, grid, result.unfaired);
+    }
   }
   result.iterations = run.iterations;
   result.knots_inserted = run.knots_inserted;
@@ -350,6 +457,7 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
   if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
   MultiBlockFit result;
   SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid, options.connectivity));
+  result.poles = FindPoles(grid, PoleTolerance(grid));
   SG_ASSIGN_OR_RETURN(result.kinds,
                       ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
   bool any_wall = false;
@@ -361,6 +469,7 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
   if (options.wall_parameters == WallParametrization::kAuto && any_wall) {
     MultiBlockFit averaged;
     averaged.connectivity = result.connectivity;
+    averaged.poles = result.poles;
     averaged.kinds = result.kinds;
     SG_RETURN_IF_ERROR(FitWithParameters(
         grid, options,

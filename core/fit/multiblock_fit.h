@@ -12,6 +12,10 @@
 //     (adaptive_engine.h).
 //  5. Watertightness: the boundary control points of every matched face range are made
 //     bitwise identical in all blocks that share them (they are the same fit up to rounding).
+//     Poles (edges collapsed to a point, faces collapsed to a line or point: poles.h) are no
+//     match and no segment boundary; every line of controls along a pole's collapsed direction
+//     is given one value (the constrained least-squares fit: multiblock_fit.cc), shared by all
+//     blocks that meet there, so the pole stays exactly collapsed at every resolution.
 #ifndef SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
 #define SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
 
@@ -26,6 +30,7 @@
 #include "core/fit/wall_curvature.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
+#include "core/grid/poles.h"
 
 namespace splinegrid {
 
@@ -90,6 +95,9 @@ struct MultiBlockFit {
   std::vector<FittedBlock> blocks;
   std::vector<BlockFitReport> reports;
   Connectivity connectivity;
+  // Block boundaries collapsed to a point or a line (poles.h); every line of controls along a
+  // pole's collapsed direction holds one control point, bitwise, in every block.
+  std::vector<Pole> poles;
   BoundaryKinds kinds;
   bool met = false;          // every point of every block within its tolerance
   bool quality_met = true;   // no folded or resized cell (when checked)

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "absl/strings/str_cat.h"
+#include "core/grid/poles.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -355,6 +356,22 @@ class MatchGrower {
   const BoundaryIndex& index_;
 };
 
+// Whether `range` lies on a pole: for some tangential direction d of its face, every line along
+// d through its points is collapsed, over the range (the range is part of a collapsed edge) or
+// over the whole face (a range one point wide along d on a face collapsed along d: a line of a
+// polar axis "matched" to itself through another angle).
+bool OnPole(const StructuredBlock& block, const FaceRange& range, double tolerance) {
+  for (int d = 0; d < 3; ++d) {
+    if (d == range.face.normal || block.extent(d) == 1) continue;
+    Extents lo = range.begin, hi = range.end;
+    if (lo[d] < hi[d] && BoxCollapsedAlong(block, lo, hi, d, tolerance)) return true;
+    lo[d] = 0;
+    hi[d] = block.extent(d) - 1;
+    if (BoxCollapsedAlong(block, lo, hi, d, tolerance)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Extents BoundaryMatch::MapToB(const Extents& x) const {
@@ -447,6 +464,9 @@ absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
       options.absolute_tolerance > 0.0 ? options.absolute_tolerance : 1e-7 * std::sqrt(diag2);
   if (!(abs_tol > 0.0)) abs_tol = 1e-12;  // all points in one place
 
+  // Collapsed boundary lines (poles.h) are found at this distance.
+  const double pole_tol = kPoleRelativeTolerance * std::sqrt(diag2);
+
   const BoundaryIndex index(grid, options, abs_tol);
   const MatchGrower grower(grid, index);
   // Pairs of entries already explained by a recorded match (both orders).
@@ -482,9 +502,16 @@ absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
           }
         }
       }
-      // A self-match of a face onto itself must not map points onto themselves.
+      // A self-match of a face onto itself must not map points onto themselves. A range
+      // collapsed along one of its directions (a pole: the centre of a polar disk, a polar axis)
+      // coincides with itself and with every other collapsed range there in any order and
+      // shift, so its "matches" say nothing about which points belong together: drop them. The
+      // blocks around a pole still share it through the faces that meet there (the radial
+      // edges of a polar disk's blocks), and the fit keeps it collapsed (multiblock_fit.cc).
       if (count >= options.min_points &&
-          !(m.a.face == m.b.face && m.a.begin == m.b.begin && m.a.end == m.b.end)) {
+          !(m.a.face == m.b.face && m.a.begin == m.b.begin && m.a.end == m.b.end) &&
+          !OnPole(grid.blocks[m.a.face.block], m.a, pole_tol) &&
+          !OnPole(grid.blocks[m.b.face.block], m.b, pole_tol)) {
         connectivity.matches.push_back(m);
       }
     }

@@ -8,6 +8,8 @@
 // runs along some tangential direction of the second, forwards or backwards. Matches may cover
 // part of a face (a T-junction, the wake part of a C-grid's wall face) and, on edges, may have
 // hanging nodes: every point of the coarse edge coincides with every second point of the fine one.
+// A range collapsed to a point or a line (a pole, poles.h) is never a match: its points coincide
+// with each other in any order, so they say nothing about which points belong together.
 #ifndef SPLINEGRID_CORE_GRID_CONNECTIVITY_H_
 #define SPLINEGRID_CORE_GRID_CONNECTIVITY_H_
 
