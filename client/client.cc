@@ -298,8 +298,9 @@ absl::StatusOr<v1::FitGridResponse> Client::Fit(const std::string& name, const v
 }
 
 absl::StatusOr<v1::FitGridResponse> Client::Fair(const std::string& name, int64_t revision,
-                                                 const v1::Fairing* fairing) {
+                                                 const v1::Fairing* fairing, bool allow_folds) {
   v1::FairGridRequest request;
+  request.set_allow_folds(allow_folds);
   request.set_name(GridName(name));
   request.set_revision(revision);
   if (fairing != nullptr) *request.mutable_fairing() = *fairing;

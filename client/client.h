@@ -189,8 +189,10 @@ class Client {
                                         const ProgressFn& progress = {});
   absl::StatusOr<v1::FitGridResponse> Fit(const std::string& name, const v1::FitSpec& spec);
   // A faired refit of `revision` (0: latest); fairing null: the server's default (to tolerance).
+  // allow_folds: store the revision even if its cells fold (FairGridRequest.allow_folds).
   absl::StatusOr<v1::FitGridResponse> Fair(const std::string& name, int64_t revision,
-                                           const v1::Fairing* fairing = nullptr);
+                                           const v1::Fairing* fairing = nullptr,
+                                           bool allow_folds = false);
   // Deforms a grid (request.name may be an id); see DeformGridRequest. A deformation that
   // folds cells is FAILED_PRECONDITION with the server's message (nothing was stored).
   absl::StatusOr<v1::DeformGridResponse> Deform(v1::DeformGridRequest request);

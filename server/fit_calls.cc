@@ -31,7 +31,13 @@ absl::StatusOr<GridRevision> SplineGridService::FitRevision(const SourcePoints& 
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,
                       state_->budget.Reserve(2 * source.memory.bytes(), "the fit"));
-  SG_ASSIGN_OR_RETURN(GridFit fit, splinegrid::FitGrid(source.grid, options, cancel));
+  absl::StatusOr<GridFit> fitted = splinegrid::FitGrid(source.grid, options, cancel);
+  if (fitted.status().code() == absl::StatusCode::kFailedPrecondition) {
+    // A grid that cannot be fitted, or one whose fit folds without options.allow_folds.
+    return absl::FailedPreconditionError(
+        absl::StrCat(fitted.status().message(), "; nothing was stored"));
+  }
+  SG_ASSIGN_OR_RETURN(GridFit fit, std::move(fitted));
   GridRevision revision;
   revision.create_time = absl::Now();
   revision.origin = origin;
@@ -102,6 +108,8 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
           return absl::InvalidArgumentError(
               "fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
         }
+        // Folds are accepted only when this request says so, not because the parent did.
+        options.allow_folds = request->allow_folds();
         return FitAndStore(*grid, options, RevisionOrigin::kFair, parent->number, cancel, response);
       });
 }

@@ -38,6 +38,7 @@ absl::StatusOr<GridFitOptions> GeneratedFitOptions(const v1::GenerateGridRequest
   if (request.has_spec()) {
     SG_ASSIGN_OR_RETURN(options, ParseFitSpec(request.spec()));
   }
+  options.allow_folds = options.allow_folds || request.allow_folds();
   if (options.face_kinds.empty()) {
     options.face_kinds = {{Face{0, 1, false}, BoundaryKind::kWall},
                           {Face{0, 1, true}, BoundaryKind::kOuter}};

@@ -229,13 +229,65 @@ absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag() {
   return fairing;
 }
 
+// --face: BLOCK:FACE=KIND[,...] (flags.cc), as FitSpec.face_kinds. Errors name the token.
+// There is no symmetry kind: the kernel knows wall, interface and outer
+// (core/grid/boundary_kinds.h), and a symmetry plane is fitted as an outer boundary.
+absl::StatusOr<std::vector<v1::FaceKind>> ParseFaceFlag(const std::string& text) {
+  static const std::map<std::string, v1::BlockFace> kFaces = {
+      {"imin", v1::BLOCK_FACE_I_MIN}, {"imax", v1::BLOCK_FACE_I_MAX},
+      {"jmin", v1::BLOCK_FACE_J_MIN}, {"jmax", v1::BLOCK_FACE_J_MAX},
+      {"kmin", v1::BLOCK_FACE_K_MIN}, {"kmax", v1::BLOCK_FACE_K_MAX}};
+  static const std::map<std::string, v1::BoundaryKind> kKinds = {
+      {"wall", v1::BOUNDARY_KIND_WALL},
+      {"interface", v1::BOUNDARY_KIND_INTERFACE},
+      {"outer", v1::BOUNDARY_KIND_OUTER}};
+  std::vector<v1::FaceKind> out;
+  std::map<std::pair<int32_t, int>, v1::BoundaryKind> seen;
+  for (absl::string_view raw : absl::StrSplit(text, ',')) {
+    const std::string token(absl::StripAsciiWhitespace(raw));
+    auto bad = [&](const std::string& why) {
+      return Usage(absl::StrCat("--face: '", token, "': ", why,
+                                " (give BLOCK:FACE=KIND, FACE imin, imax, jmin, jmax, kmin or "
+                                "kmax, KIND wall, interface or outer)"));
+    };
+    const std::vector<std::string> block_rest = absl::StrSplit(token, absl::MaxSplits(':', 1));
+    if (block_rest.size() != 2) return bad("no ':' after the block number");
+    int32_t block = 0;
+    if (!absl::SimpleAtoi(block_rest[0], &block) || block < 0) {
+      return bad(absl::StrCat("block '", block_rest[0], "' is not a block number >= 0"));
+    }
+    const std::vector<std::string> face_kind =
+        absl::StrSplit(block_rest[1], absl::MaxSplits('=', 1));
+    if (face_kind.size() != 2) return bad("no '=' before the kind");
+    const std::string face = absl::AsciiStrToLower(face_kind[0]);
+    const std::string kind = absl::AsciiStrToLower(face_kind[1]);
+    const auto f = kFaces.find(face);
+    if (f == kFaces.end()) return bad(absl::StrCat("unknown face '", face_kind[0], "'"));
+    const auto k = kKinds.find(kind);
+    if (k == kKinds.end()) {
+      return bad(kind == "symmetry"
+                     ? std::string("there is no symmetry kind (fit a symmetry plane as outer)")
+                     : absl::StrCat("unknown kind '", face_kind[1], "'"));
+    }
+    const auto [it, inserted] = seen.insert({{block, f->second}, k->second});
+    if (!inserted && it->second != k->second) return bad("the face is given another kind before");
+    if (!inserted) continue;
+    v1::FaceKind& entry = out.emplace_back();
+    entry.set_block(block);
+    entry.set_face(f->second);
+    entry.set_kind(k->second);
+  }
+  return out;
+}
+
 // The FitSpec of the fit flags.
 absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   const double tol = absl::GetFlag(FLAGS_tol);
   const std::string ctl = absl::GetFlag(FLAGS_ctl);
   const bool kinds = absl::GetFlag(FLAGS_kinds) || absl::GetFlag(FLAGS_wall) != 0.0 ||
                      absl::GetFlag(FLAGS_interface) != 0.0 || absl::GetFlag(FLAGS_outer) != 0.0 ||
-                     absl::GetFlag(FLAGS_interior) != 0.0 || absl::GetFlag(FLAGS_edge) >= 0.0;
+                     absl::GetFlag(FLAGS_interior) != 0.0 || absl::GetFlag(FLAGS_edge) >= 0.0 ||
+                     absl::GetFlag(FLAGS_ref_length) != 0.0 || !absl::GetFlag(FLAGS_face).empty();
   if ((tol != 0.0) + !ctl.empty() + kinds > 1) {
     return Usage("give one of --tol, --ctl and the tolerances by kind (--kinds, --wall, ...)");
   }
@@ -251,6 +303,7 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
     t->set_outer(absl::GetFlag(FLAGS_outer));
     t->set_interior(absl::GetFlag(FLAGS_interior));
     if (absl::GetFlag(FLAGS_edge) >= 0.0) t->set_edge(absl::GetFlag(FLAGS_edge));
+    spec.set_reference_length(absl::GetFlag(FLAGS_ref_length));
     spec.set_max_controls_per_direction(absl::GetFlag(FLAGS_max_ctl));
   } else if (!ctl.empty()) {
     SG_ASSIGN_OR_RETURN(const Extents counts, ParseTriple(ctl, "--ctl"));
@@ -260,7 +313,23 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   }
   SG_ASSIGN_OR_RETURN(const std::optional<v1::Fairing> fairing, ParseFairFlag());
   if (fairing) *spec.mutable_fairing() = *fairing;
+  if (const std::string face = absl::GetFlag(FLAGS_face); !face.empty()) {
+    SG_ASSIGN_OR_RETURN(const std::vector<v1::FaceKind> kinds, ParseFaceFlag(face));
+    for (const v1::FaceKind& kind : kinds) *spec.add_face_kinds() = kind;
+  }
+  spec.set_allow_folds(absl::GetFlag(FLAGS_allow_folds));
   return spec;
+}
+
+// After a stored fit: FAILED_PRECONDITION with exit status kExitQualityNotMet (3) when
+// --allow_folds let the server store a revision whose cells fold (its report says quality_met =
+// false), so that a script cannot mistake it for a good grid, nor for a call that failed (1).
+absl::Status FoldsStored(const std::string& name, const v1::FitGridResponse& fit) {
+  if (fit.report().folded_cells() == 0) return absl::OkStatus();
+  absl::Status status = absl::FailedPreconditionError(absl::StrCat(
+      name, " revision ", fit.revision(), " was stored with ", fit.report().folded_cells(),
+      " folded sub-cells (--allow_folds); do not use it as a valid grid"));
+  return WithExitCode(std::move(status), kExitQualityNotMet);
 }
 
 }  // namespace
@@ -296,7 +365,7 @@ absl::Status Fit(const Args& args) {
     return fit.status();
   }
   Print(FormatFit(grid.name(), *fit), *fit);
-  return absl::OkStatus();
+  return FoldsStored(grid.name(), *fit);
 }
 
 absl::Status Get(const Args& args) {
@@ -408,9 +477,10 @@ absl::Status Fair(const Args& args) {
   SG_ASSIGN_OR_RETURN(const std::optional<v1::Fairing> fairing, ParseFairFlag());
   SG_ASSIGN_OR_RETURN(
       const v1::FitGridResponse fit,
-      Connect()->Fair(args[0], absl::GetFlag(FLAGS_revision), fairing ? &*fairing : nullptr));
+      Connect()->Fair(args[0], absl::GetFlag(FLAGS_revision), fairing ? &*fairing : nullptr,
+                      absl::GetFlag(FLAGS_allow_folds)));
   Print(FormatFit(client::GridName(args[0]), fit), fit);
-  return absl::OkStatus();
+  return FoldsStored(client::GridName(args[0]), fit);
 }
 
 absl::Status Curvature(const Args& args) {
@@ -457,9 +527,16 @@ absl::Status Airfoil(const Args& args) {
   }
   SG_ASSIGN_OR_RETURN(const AirfoilFit fit, FitAirfoil(coordinates.points, options));
   const std::string out = absl::GetFlag(FLAGS_o);
-  if (!out.empty()) SG_RETURN_IF_ERROR(WriteFileAtomically(out, AirfoilCurvatureCsv(fit)));
+  // The curvature of a fit that missed its tolerance (or has a cusp) is not the profile's: a
+  // failure writes no file, and says so.
+  if (!out.empty() && fit.met) {
+    SG_RETURN_IF_ERROR(WriteFileAtomically(out, AirfoilCurvatureCsv(fit)));
+  }
   std::string text = FormatAirfoilFit(coordinates.name, options.tolerance, fit);
-  if (!out.empty()) absl::StrAppend(&text, "  curvature written to ", out, "\n");
+  if (!out.empty()) {
+    absl::StrAppend(&text, fit.met ? "  curvature written to " : "  curvature not written to ", out,
+                    fit.met ? "\n" : " (the fit failed)\n");
+  }
   std::fwrite(text.data(), 1, text.size(), stdout);
   return fit.met ? absl::OkStatus()
                  : absl::FailedPreconditionError(absl::StrCat("not met: ", fit.unmet_reason));
@@ -657,6 +734,7 @@ absl::Status Offset(const Args& args) {
     }
     *request.mutable_spec() = spec;
   }
+  request.set_allow_folds(absl::GetFlag(FLAGS_allow_folds));
   auto client = Connect();
   SG_ASSIGN_OR_RETURN(const v1::GenerateGridResponse response, client->Generate(request));
   std::string human = FormatGenerate(response);
@@ -674,7 +752,7 @@ absl::Status Offset(const Args& args) {
                     ")\n");
   }
   Print(human, response);
-  return absl::OkStatus();
+  return FoldsStored(response.grid().name(), response.fit());
 }
 
 absl::Status Watch(const Args& args) {

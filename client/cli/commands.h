@@ -8,10 +8,33 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/strings/cord.h"
 
 namespace splinegrid::cli {
 
 using Args = std::vector<std::string>;
+
+// Exit statuses: 0 success, 1 a failed call (nothing stored), 2 usage (INVALID_ARGUMENT), and
+// kExitQualityNotMet when a revision was stored whose quality is not met (folded cells, accepted
+// with --allow_folds): fit, fair and offset print its report and exit 3.
+inline constexpr int kExitQualityNotMet = 3;
+// The payload of a status that names its exit status (ExitCodeOf).
+inline constexpr char kExitCodePayload[] = "type.splinegrid.dev/cli.exit_code";
+
+// `status` (not OK) with exit status `code`.
+inline absl::Status WithExitCode(absl::Status status, int code) {
+  status.SetPayload(kExitCodePayload, absl::Cord(std::to_string(code)));
+  return status;
+}
+
+// The exit status of a command's status: its payload's, else 0 (OK), 2 (INVALID_ARGUMENT), 1.
+inline int ExitCodeOf(const absl::Status& status) {
+  if (status.ok()) return 0;
+  if (const auto code = status.GetPayload(kExitCodePayload)) {
+    if (*code == "3") return kExitQualityNotMet;
+  }
+  return status.code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
+}
 
 // Reads the client commands' --token (or $SPLINEGRID_TOKEN) and --tls_* flags, with the PEM
 // files they name; every later client command connects with them. Errors name the flag.

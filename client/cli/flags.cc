@@ -37,7 +37,11 @@ ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
 ABSL_FLAG(bool, planar, true, "fit: store the 2D view of grids held as two planes (CFL3D style)");
 ABSL_FLAG(int, max_ctl, 0, "fit --tol/--kinds: most control points per direction (0: no cap)");
 ABSL_FLAG(bool, kinds, false,
-          "fit: tolerances by boundary kind (defaults 0.15e-3 wall, 2e-3 interface, 8e-3 outer)");
+          "fit: tolerances by boundary kind (defaults 0.15e-3 wall, 2e-3 interface, 8e-3 outer "
+          "times the reference length; --wall, --interface, --outer, --interior are lengths)");
+ABSL_FLAG(double, ref_length, 0.0,
+          "fit: reference length of the default tolerances by kind, in the grid's unit (implies "
+          "--kinds; 0: detected, the largest extent of a wall, e.g. the chord)");
 ABSL_FLAG(double, wall, 0.0, "fit: wall tolerance (implies --kinds; 0: default)");
 ABSL_FLAG(double, interface, 0.0, "fit: block interface tolerance (implies --kinds; 0: default)");
 ABSL_FLAG(double, outer, 0.0, "fit: outer boundary tolerance (implies --kinds; 0: default)");
@@ -46,6 +50,13 @@ ABSL_FLAG(double, edge, -1.0,
           "fit: relative accuracy of grid edges inside blocks (implies --kinds; <0: default 0.5)");
 ABSL_FLAG(std::string, fair, "",
           "fit/fair: fairing: 'tol' (largest weight within the tolerances) or a weight lambda");
+ABSL_FLAG(std::string, face, "",
+          "fit: explicit boundary kinds of faces, BLOCK:FACE=KIND[,...] with FACE imin, imax, "
+          "jmin, jmax, kmin or kmax and KIND wall, interface or outer (implies --kinds); e.g. "
+          "--face 0:imin=wall,2:jmax=outer");
+ABSL_FLAG(bool, allow_folds, false,
+          "fit/fair/offset: store the revision even if cells fold at levels 0..2 (exit 1 after "
+          "storing it; without the flag such a fit is refused and nothing is stored)");
 
 ABSL_FLAG(int64_t, revision, 0, "get/eval/fair/curvature: revision (0: latest)");
 ABSL_FLAG(bool, full, false, "get: include knots, control points and distributions");

@@ -37,6 +37,9 @@ ABSL_DECLARE_FLAG(double, outer);
 ABSL_DECLARE_FLAG(double, interior);
 ABSL_DECLARE_FLAG(double, edge);
 ABSL_DECLARE_FLAG(std::string, fair);
+ABSL_DECLARE_FLAG(double, ref_length);
+ABSL_DECLARE_FLAG(std::string, face);
+ABSL_DECLARE_FLAG(bool, allow_folds);
 // get
 ABSL_DECLARE_FLAG(int64_t, revision);
 ABSL_DECLARE_FLAG(bool, full);

@@ -33,9 +33,17 @@ constexpr char kUsage[] =
     "                   [--import_idle_timeout 60s] [--max_running_long_tasks N]\n"
     "                   [--max_queued_long_calls_per_principal 8]\n"
     "                   [--max_streams_per_principal 64]\n"
-    "  splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] |\n"
-    "                 --ctl a,b,c] [--fair tol|LAMBDA]\n"
-    "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]\n"
+    "  splinegrid fit FILE [--name N] [--tol T | --kinds [--ref_length L] [--wall W --interface I\n"
+    "                 --outer O] | --ctl a,b,c] [--fair tol|LAMBDA] [--allow_folds]\n"
+    "      --kinds: defaults 0.15e-3, 2e-3, 8e-3 times the reference length (the largest\n"
+    "      extent of a wall, e.g. the chord; --ref_length overrides); --tol, --wall ... are\n"
+    "      lengths in the grid's unit\n"
+    "      --face BLOCK:FACE=KIND[,...]: kinds of faces (FACE imin..kmax, KIND wall, interface,\n"
+    "      outer; implies --kinds), e.g. --face 0:imin=wall,2:jmax=outer\n"
+    "  splinegrid fair NAME [--revision R] [--fair tol|LAMBDA] [--allow_folds]\n"
+    "      fit/fair/offset: a grid whose cells fold at levels 0..2 (after repair) is\n"
+    "      FAILED_PRECONDITION (exit 1), nothing stored; with --allow_folds it is stored\n"
+    "      and the command exits 3 after printing its report (exit 1: a failed call)\n"
     "  splinegrid curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]\n"
     "  splinegrid airfoil FILE.dat [--tol 1e-4] [--fair tol|LAMBDA|off] [-o OUT.csv]   (local)\n"
     "  splinegrid get NAME [--revision R | --step N] [--full] | list | rm NAME | health\n"
@@ -90,8 +98,11 @@ int main(int argc, char** argv) {
       command->first == "serve" ? absl::OkStatus() : splinegrid::cli::PrepareConnection();
   if (status.ok()) status = command->second(args);
   if (!status.ok()) {
-    std::fprintf(stderr, "splinegrid %s: %s\n", positional[1], status.ToString().c_str());
-    return status.code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
+    // Code and message, without payloads (the exit status is one).
+    std::fprintf(stderr, "splinegrid %s: %s: %s\n", positional[1],
+                 absl::StatusCodeToString(status.code()).c_str(),
+                 std::string(status.message()).c_str());
+    return splinegrid::cli::ExitCodeOf(status);
   }
   return 0;
 }

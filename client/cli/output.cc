@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "absl/strings/str_cat.h"
@@ -95,6 +96,49 @@ std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c)
       c.max_abs_curvature());
 }
 
+// "wall 0.000137 <= 0.00015 met, interface ..., interior 0.205 (no tolerance)": the largest
+// deviation of each kind over `blocks`, against the tolerance the fit was held to where one was
+// asked (FitReport.tolerances); "met" only there.
+std::string FormatKindDeviations(const v1::FitReport& r,
+                                 const google::protobuf::RepeatedPtrField<v1::BlockFitSummary>& blocks) {
+  struct Kind {
+    const char* name;
+    bool has = false;
+    double deviation = 0.0;
+    double tolerance = 0.0;  // 0: none
+  };
+  const v1::BoundaryTolerances& t = r.tolerances();
+  const bool held = r.tolerances_given() && r.has_tolerances();
+  Kind kinds[4] = {{"wall", false, 0.0, held ? t.wall() : 0.0},
+                   {"interface", false, 0.0, held ? t.interface() : 0.0},
+                   {"outer", false, 0.0, held ? t.outer() : 0.0},
+                   {"interior", false, 0.0, held ? t.interior() : 0.0}};
+  for (const v1::BlockFitSummary& b : blocks) {
+    const v1::DeviationByKind& d = b.deviation_by_kind();
+    const bool has[4] = {d.has_wall(), d.has_interface(), d.has_outer(), d.has_interior()};
+    const double value[4] = {d.wall(), d.interface(), d.outer(), d.interior()};
+    for (int k = 0; k < 4; ++k) {
+      if (!has[k]) continue;
+      kinds[k].deviation = kinds[k].has ? std::max(kinds[k].deviation, value[k]) : value[k];
+      kinds[k].has = true;
+    }
+  }
+  std::string out;
+  for (const Kind& k : kinds) {
+    if (!k.has) continue;
+    if (!out.empty()) absl::StrAppend(&out, ", ");
+    if (k.tolerance > 0.0) {
+      const bool met = k.deviation <= k.tolerance;
+      absl::StrAppend(&out, absl::StrFormat("%s %.3g %s %.3g %s", k.name, k.deviation,
+                                            met ? "<=" : ">", k.tolerance, met ? "met" : "NOT MET"));
+    } else {
+      absl::StrAppend(&out, absl::StrFormat("%s %.3g%s", k.name, k.deviation,
+                                            held ? " (no tolerance)" : ""));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string FormatReport(const v1::FitReport& r) {
@@ -108,6 +152,14 @@ std::string FormatReport(const v1::FitReport& r) {
   }
   for (const std::string& adjustment : r.adjustments()) {
     absl::StrAppend(&out, "  not as asked: ", adjustment, "\n");
+  }
+  if (r.reference_length() > 0.0) {
+    absl::StrAppend(&out, absl::StrFormat("  reference length %.6g (%s)%s\n", r.reference_length(),
+                                          r.reference_length_description(),
+                                          r.tolerances_given() && r.has_tolerances()
+                                              ? ""
+                                              : ": the default tolerances by kind are fractions "
+                                                "of it"));
   }
   absl::StrAppend(&out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original "
                                         "cells folded or resized beyond 2x; worst Jacobian ratio "
@@ -136,9 +188,14 @@ std::string FormatReport(const v1::FitReport& r) {
 
 std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   std::string out = absl::StrFormat(
-      "%s revision %d: %d points -> %d control points (%.1fx), max deviation %.3g, %.1f ms\n", name,
-      fit.revision(), fit.num_points(), fit.num_control_points(), fit.compression_ratio(),
-      fit.max_deviation(), 1e3 * fit.seconds());
+      "%s revision %d: %d points -> %d control points (%.1fx), %.1f ms\n", name, fit.revision(),
+      fit.num_points(), fit.num_control_points(), fit.compression_ratio(), 1e3 * fit.seconds());
+  // The deviation of each kind against its tolerance, not one maximum beside "met" (the interior
+  // of a fit by kind has no tolerance).
+  const std::string kinds = FormatKindDeviations(fit.report(), fit.blocks());
+  absl::StrAppend(&out, "  deviation: ",
+                  kinds.empty() ? absl::StrFormat("max %.3g", fit.max_deviation()) : kinds,
+                  fit.report().tolerances_given() ? "" : " (no tolerance given)", "\n");
   absl::StrAppend(&out, FormatReport(fit.report()));
   absl::StrAppend(
       &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %8s %8s %6s\n", "block",

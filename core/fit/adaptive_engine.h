@@ -11,6 +11,10 @@
 //     state so far is restored and the rounds stop. More knots cure cells a coarse fit spoils,
 //     but not the wiggles of a fit that already nearly interpolates a kink in the data, so the
 //     guard is what keeps this step from making things worse.
+//  2b. Repair (with a quality check): where cells still fold, bound the runs of knot spans
+//     holding a single datum (a fit that nearly interpolates is nearly singular on them and
+//     swings between its data; refinement.h SingleDatumRun), removing knots there and refining
+//     again under that bound; kept only if every tolerance holds and the folds decrease.
 //  3. Remove knots one at a time where the tolerances still hold and the quality is no worse.
 //  4. Fair (optional): a fixed weight for every fit, or, to tolerance, the largest weight that
 //     keeps every tolerance and the quality no worse (a search over decades, then bisection on
@@ -60,6 +64,8 @@ struct EngineResult {
   int knots_inserted = 0;
   int knots_removed = 0;
   int quality_rounds = 0;
+  // Fold repairs kept (step 2b; the knots they removed are counted in knots_removed).
+  int repair_rounds = 0;
   double fairing_weight = 0.0;  // lambda of the final fits
   // Fairing to tolerance: the same knots without fairing (else empty).
   std::vector<FittedBlock> unfaired;

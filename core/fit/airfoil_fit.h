@@ -25,6 +25,10 @@
 //     controls meet a tolerance (RAE 2822 at 1e-4: 16 controls instead of 21).
 //  3. Knots: from no interior knots, the knot span with the worst distance is split at the
 //     middle of its data, one span per round, until every distance is within the target.
+//     When insertion runs out of spans or controls, it is redone with parameter correction
+//     restricted to regular feet, |kappa| d <= 1/2 (profile_fitter.h, "Focal points"): on dense
+//     outlines the feet on an early, too tightly bent fit crowd into one span and leave its
+//     neighbour without data, where the curve loops.
 //  4. Knot removal: interior knots are tried in order of their scaled third-derivative jump
 //     (fairing.h; a small jump means the neighbouring pieces are nearly one polynomial, T. Lyche
 //     and K. Morken, "A data reduction strategy for splines", IMA J. Numer. Anal. 8, 1988) and a

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/fit/segment_model.h"
 #include "core/util/status_macros.h"
 
@@ -63,11 +64,13 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options
 
 // Tolerance mode: the watertight multi-block fit.
 absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& options,
-                             const CancelCheck& cancel, GridFit& result) {
+                             double reference_length, const CancelCheck& cancel,
+                             GridFit& result) {
   MultiBlockFitOptions mb;
   mb.order = options.order;
   mb.parametrization = options.parametrization;
-  mb.tolerances = options.Tolerances();
+  mb.tolerances = options.Tolerances(reference_length);
+  result.report.tolerances = mb.tolerances;
   mb.face_kinds = options.face_kinds;
   mb.max_controls_per_direction = options.max_controls_per_direction;
   mb.check_quality = options.check_quality;
@@ -100,8 +103,10 @@ absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& o
 
 }  // namespace
 
-BoundaryTolerances GridFitOptions::Tolerances() const {
-  if (boundary_tolerances) return *boundary_tolerances;
+BoundaryTolerances GridFitOptions::Tolerances(double reference_length) const {
+  if (boundary_tolerances) {
+    return ScaleTolerances(*boundary_tolerances, relative_kinds, reference_length);
+  }
   BoundaryTolerances t;
   if (tolerance) t.wall = t.interface = t.outer = t.interior = *tolerance;
   return t;
@@ -132,6 +137,15 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
           absl::StrCat("tolerance = ", *tolerance, "; must be positive and finite"));
     }
     if (boundary_tolerances) SG_RETURN_IF_ERROR(boundary_tolerances->Validate());
+    if (reference_length && !boundary_tolerances) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "reference_length = ", *reference_length,
+          " applies to the tolerances by kind; tolerance is a length in the grid's unit"));
+    }
+    if (reference_length && (!(*reference_length > 0.0) || !std::isfinite(*reference_length))) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("reference_length = ", *reference_length, "; must be positive and finite"));
+    }
     SG_RETURN_IF_ERROR(ValidateControlCap(max_controls_per_direction, order));
     if (!block_control_counts.empty()) {
       return absl::InvalidArgumentError("block_control_counts cannot be combined with a tolerance");
@@ -141,6 +155,11 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
   if (fairing.mode == FairingMode::kToTolerance) {
     return absl::InvalidArgumentError(
         "fairing to tolerance needs a tolerance; with control counts give a fairing weight");
+  }
+  if (reference_length) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("reference_length = ", *reference_length,
+                     " applies to the tolerances by kind; a fit to control counts has none"));
   }
   for (size_t q = 0; q < block_control_counts.size(); ++q) {
     const int block = block_control_counts[q].first;
@@ -176,8 +195,24 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
     }
   }
   GridFit result;
+  // The reference length: given, or, when tolerances by kind are relative to it, detected before
+  // the fit from the kinds FitMultiBlock will find (the same connectivity and overrides); else
+  // detected after the fit, for the report.
+  std::optional<ReferenceLength> reference;
+  if (options.reference_length) {
+    reference = ReferenceLength{*options.reference_length, ReferenceLengthSource::kGiven,
+                                absl::StrCat("given: reference_length = ",
+                                             *options.reference_length)};
+  } else if (options.boundary_tolerances && options.relative_kinds != 0) {
+    SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
+                        FindConnectivity(grid, MultiBlockFitOptions().connectivity));
+    SG_ASSIGN_OR_RETURN(const BoundaryKinds kinds,
+                        ClassifyBoundaries(grid, connectivity, options.face_kinds));
+    reference = DetectReferenceLength(grid, kinds);
+  }
   if (options.tolerance_mode()) {
-    SG_RETURN_IF_ERROR(FitToTolerances(grid, options, cancel, result));
+    SG_RETURN_IF_ERROR(
+        FitToTolerances(grid, options, reference ? reference->length : 1.0, cancel, result));
   } else {
     SG_RETURN_IF_ERROR(FitBlocks(grid, options, cancel, result));
     // Nothing was measured against a tolerance: the report must not say one was met.
@@ -217,6 +252,7 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
     result.report.wall_curvature = WallCurvatureMetrics(fitted, result.kinds, kCurvatureLevel);
   }
   result.report.num_matches = static_cast<int>(result.connectivity.matches.size());
+  result.report.reference = reference ? *reference : DetectReferenceLength(grid, result.kinds);
   for (size_t b = 0; b < result.blocks.size(); ++b) {
     const Extents points = grid.blocks[b].extents();
     for (int d = 0; d < 3; ++d) {
@@ -230,6 +266,26 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
   }
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Never a folded grid unless asked for: the tolerance mode has already tried to repair the
+  // folds (adaptive_engine.h, steps 2 and 2b); a fit to control counts cannot be repaired
+  // without changing the counts it was given, which would be a silent change.
+  if (!options.allow_folds) {
+    std::vector<std::string> folds;
+    for (size_t b = 0; b < result.blocks.size(); ++b) {
+      std::string d = DescribeFolds(static_cast<int>(b), result.blocks[b].quality);
+      if (!d.empty()) folds.push_back(std::move(d));
+    }
+    if (!folds.empty()) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "the fitted grid folds at refinement levels 0..", quality_options.max_level, ": ",
+          absl::StrJoin(folds, "; "),
+          options.tolerance_mode()
+              ? ". Local refinement and knot removal did not repair it; try a looser tolerance"
+              : ". A fit to control counts is not repaired (that would change the counts); try "
+                "other counts or a tolerance",
+          ", or set allow_folds to accept the folded grid"));
+    }
+  }
   return result;
 }
 

@@ -23,6 +23,7 @@
 #include "core/fit/wall_curvature.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
+#include "core/grid/reference_length.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -33,10 +34,22 @@ struct GridFitOptions {
   // Spline order (degree + 1).
   int order = 4;
   Parametrization parametrization = Parametrization::kChordLength;
-  // Tolerance mode: one tolerance for every point (in the grid's length unit), or tolerances
-  // by boundary kind. At most one of the two; with neither, control counts.
+  // Tolerance mode: one tolerance for every point (in the grid's length unit, absolute), or
+  // tolerances by boundary kind. At most one of the two; with neither, control counts.
   std::optional<double> tolerance;
+  // By kind, each field is a fraction of the reference length for the kinds in relative_kinds,
+  // else a length in the grid's unit. The defaults (BoundaryTolerances() with every kind
+  // relative) are the QUADFLOW paper's tolerances in chords: 0.15e-3, 2e-3 and 8e-3 of the
+  // reference length on walls, interfaces and outer boundaries, none inside; so a grid in
+  // chords, millimetres or inches is fitted alike.
   std::optional<BoundaryTolerances> boundary_tolerances;
+  // Bits (reference_length.h: kRelativeWall, ..., kRelativeInterior): the fields of
+  // boundary_tolerances that are fractions of the reference length. ParseFitSpec marks the kinds
+  // a request leaves unset (defaults) and clears the kinds it states (absolute).
+  uint8_t relative_kinds = kAllKindsRelative;
+  // The reference length of relative tolerances, in the grid's unit (positive, finite); unset:
+  // detected from the walls (DetectReferenceLength). Only with boundary_tolerances.
+  std::optional<double> reference_length;
   // Control points per direction for every block; 0 = as many as points.
   Extents control_counts = {0, 0, 0};
   // Per-block overrides of control_counts: (block index, counts), at most one per block. Counts
@@ -52,10 +65,14 @@ struct GridFitOptions {
   // Tolerance mode: refine locally where cells fold or change size (the quality is reported in
   // either mode).
   bool check_quality = true;
+  // Accept folds: a fit whose cells still fold at levels 0..2 after the repair (tolerance mode)
+  // is returned with quality_met = false instead of failing with FAILED_PRECONDITION.
+  bool allow_folds = false;
 
   bool tolerance_mode() const { return tolerance.has_value() || boundary_tolerances.has_value(); }
-  // The per-kind tolerances of the tolerance mode (one tolerance: every kind, inside too).
-  BoundaryTolerances Tolerances() const;
+  // The per-kind tolerances of the tolerance mode in the grid's unit (one tolerance: every kind,
+  // inside too), the relative kinds scaled by `reference_length`.
+  BoundaryTolerances Tolerances(double reference_length) const;
 
   // OK if the options suit `grid`; INVALID_ARGUMENT naming the field and value otherwise.
   absl::Status Validate(const MultiBlockGrid& grid) const;
@@ -94,6 +111,11 @@ struct GridFitReport {
   int knots_removed = 0;
   int quality_rounds = 0;
   double seconds = 0.0;
+  // The reference length (reference_length.h): given, or detected from the walls, in every
+  // mode (the default tolerances by kind are fractions of it).
+  ReferenceLength reference;
+  // Tolerance mode: the tolerance of each kind the fit was held to, in the grid's unit.
+  std::optional<BoundaryTolerances> tolerances;
   // Where the fit differs from the options, one sentence each: a direction with more than one
   // but fewer points than the order is fitted through its points at a lower order (the only
   // fit there is). Empty: as asked.

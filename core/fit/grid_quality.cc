@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 
@@ -162,7 +163,8 @@ void ForEachCell(const double* lo, const double* hi, const RowLayout& layout, F&
   }
 }
 
-enum CellState : uint8_t { kChecked = 0, kSkipped = 1, kBad = 2 };
+// kFolded: some sub-cell folded (it is bad too); kBad: only out of size.
+enum CellState : uint8_t { kChecked = 0, kSkipped = 1, kBad = 2, kFolded = 3 };
 
 // Per original cell: weights w with ratio = <measure_fitted, w> / share, and its state.
 struct Reference {
@@ -222,6 +224,7 @@ absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlo
   const int fast = active[0];
   CellQuality q;
   int64_t worst_parent = 0;
+  q.folded_by_level.assign(options.max_level + 1, 0);
   for (int level = 0; level <= options.max_level; ++level) {
     Resolution resolution;
     resolution.level = level;
@@ -287,10 +290,11 @@ absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlo
           q.max_ratio = std::max(q.max_ratio, std::abs(ratio));
           if (ratio <= 0.0) {
             ++q.folded;
-            state = kBad;
+            ++q.folded_by_level[level];
+            state = kFolded;
           } else if (ratio < low || ratio > high) {
             ++q.out_of_size;
-            state = kBad;
+            if (state != kFolded) state = kBad;
           }
         });
         std::swap(lo, hi);
@@ -310,7 +314,13 @@ absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlo
   };
   if (q.cells_checked > 0) q.worst_cell = to_cell(worst_parent);
   for (int64_t parent = 0; parent < static_cast<int64_t>(ref.state.size()); ++parent) {
-    if (ref.state[parent] != kBad) continue;
+    if (ref.state[parent] != kBad && ref.state[parent] != kFolded) continue;
+    if (ref.state[parent] == kFolded) {
+      ++q.num_folded_cells;
+      if (static_cast<int64_t>(q.folded_cells.size()) < options.max_reported_cells) {
+        q.folded_cells.push_back(to_cell(parent));
+      }
+    }
     ++q.num_bad_cells;
     if (static_cast<int64_t>(q.bad_cells.size()) < options.max_reported_cells) {
       q.bad_cells.push_back(to_cell(parent));
@@ -322,6 +332,30 @@ absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlo
 std::string ExtentsString(const Extents& e) { return absl::StrCat(e[0], " x ", e[1], " x ", e[2]); }
 
 }  // namespace
+
+std::string DescribeFolds(int block, const CellQuality& quality, int max_listed) {
+  if (quality.folded == 0) return "";
+  std::vector<std::string> levels;
+  for (size_t l = 0; l < quality.folded_by_level.size(); ++l) {
+    if (quality.folded_by_level[l] > 0) {
+      levels.push_back(absl::StrCat(quality.folded_by_level[l], " at level ", l));
+    }
+  }
+  auto cell = [](const Extents& c) { return absl::StrCat("(", c[0], ", ", c[1], ", ", c[2], ")"); };
+  std::string out = absl::StrCat("block ", block, ": ", quality.folded, " folded sub-cells (",
+                                 absl::StrJoin(levels, ", "), ") in ", quality.num_folded_cells,
+                                 " cells; the worst at cell ", cell(quality.worst_cell), ", level ",
+                                 quality.worst_level, ", Jacobian ratio ", quality.min_ratio);
+  const size_t listed = std::min<size_t>(quality.folded_cells.size(), std::max(max_listed, 0));
+  if (listed > 0) {
+    absl::StrAppend(&out, "; cells");
+    for (size_t q = 0; q < listed; ++q) {
+      absl::StrAppend(&out, q ? ", " : " ", cell(quality.folded_cells[q]));
+    }
+    if (static_cast<int64_t>(listed) < quality.num_folded_cells) absl::StrAppend(&out, ", ...");
+  }
+  return out;
+}
 
 absl::Status CellQualityOptions::Validate() const {
   if (max_level < 0 || max_level > kMaxRefinementLevel) {

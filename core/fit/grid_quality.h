@@ -106,6 +106,12 @@ struct CellQuality {
   // in index order (i fastest).
   int64_t num_bad_cells = 0;
   std::vector<Extents> bad_cells;
+  // Checked cells with ratio <= 0 at each level 0..max_level (they sum to `folded`).
+  std::vector<int64_t> folded_by_level;
+  // Distinct original cells with a folded sub-cell at some level (a subset of the bad cells),
+  // and the first max_reported_cells of them in index order.
+  int64_t num_folded_cells = 0;
+  std::vector<Extents> folded_cells;
 
   // No folded and no out-of-size cell.
   bool ok() const { return folded == 0 && out_of_size == 0; }
@@ -123,6 +129,13 @@ struct CellQuality {
 absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
                                              const StructuredBlock& original,
                                              const CellQualityOptions& options = {});
+
+// One sentence on the folds of block `block`'s `quality` (empty when nothing folded): the
+// folded sub-cells per level, the original cells they lie in, the worst cell with its level and
+// Jacobian ratio and the first `max_listed` folded cells, e.g. "block 0: 268 folded sub-cells at
+// level 1 and 1010 at level 2 in 657 cells; the worst at cell (3, 40, 0), level 2, Jacobian ratio
+// -0.8; first cells (2, 39, 0), ...".
+std::string DescribeFolds(int block, const CellQuality& quality, int max_listed = 8);
 
 // The cell measures of the file comment, for single cells (corners in binary order; z ignored
 // for the planar area). Planar signed area, positive when x0 x1 x3 x2 runs counter-clockwise.

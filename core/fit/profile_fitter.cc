@@ -122,6 +122,9 @@ absl::StatusOr<Curve> ProfileFitter::Fit(const std::vector<double>& interior,
     if (round >= std::min(max_rounds, max_corrections_)) break;
     std::vector<double> next = params, distance;
     Project(curve, next, &distance);
+    if (max_focal_ratio_ < std::numeric_limits<double>::infinity()) {
+      KeepRegularFeet(curve, params, distance, next);
+    }
     if (!KeepOrder(params, next) || !WellPosed(knots, next)) break;
     params = std::move(next);
     double sum = 0.0;
@@ -168,6 +171,18 @@ void ProfileFitter::Project(const Curve& curve, std::vector<double>& u,
     }
     u[i] = best_t;
     if (distance != nullptr) (*distance)[i] = best;
+  }
+}
+
+void ProfileFitter::KeepRegularFeet(const Curve& curve, const std::vector<double>& old,
+                                    const std::vector<double>& distance,
+                                    std::vector<double>& next) const {
+  std::vector<double> jet;
+  EvaluateJet(curve, next, 2, jet);
+  for (int i = 0; i < m_; ++i) {
+    if (std::abs(JetCurvature(jet.data() + 6 * i)) * distance[i] > max_focal_ratio_) {
+      next[i] = old[i];
+    }
   }
 }
 

@@ -20,6 +20,16 @@
 //    Correction also ends, keeping the previous parameters, when the feet cannot be made
 //    strictly increasing (restoring the old parameter of every point out of order) or no longer
 //    determine every control (Schoenberg-Whitney).
+// Focal points. The foot map of a point Q at signed distance h along the normal of C(u) has
+// derivative du/ds = 1 / (|C'| (1 - kappa h)) with respect to arc length s along the data: on the
+// convex side of a bend (kappa h < 0) the feet crowd together by 1 / (1 + |kappa h|), and beyond
+// the centre of curvature (kappa h >= 1) they fold. An early fit with few controls bends much
+// more tightly than the data at the nose, so Hoschek's correction then crowds hundreds of points
+// of a dense outline into one knot span and leaves its neighbour without data; the least-squares
+// piece there is undetermined by its own data and loops (a cusp the distances cannot see), and no
+// split can help because the span has no data to split (the failure of 12,000-point outlines that
+// a quarter of their points fitted). set_max_focal_ratio restricts the correction to regular feet,
+// |kappa| d <= ratio; FitAirfoil uses it when the unrestricted placement fails (airfoil_fit.h).
 // A solve costs O(m k^2) (banded QR); a projection O(k^2 + log n) per point and Newton step,
 // 2-4 steps from the previous foot.
 #ifndef SPLINEGRID_CORE_FIT_PROFILE_FITTER_H_
@@ -90,6 +100,14 @@ class ProfileFitter {
   bool WellPosed(const KnotVector& knots, std::span<const double> params) const;
   bool WellPosed(const std::vector<double>& interior, std::span<const double> params) const;
 
+  // Restricts parameter correction to regular feet: a point Q at distance d from its foot C(u),
+  // where the curve's curvature is kappa, moves to u only when |kappa| d <= ratio; else it keeps
+  // its parameter. Infinity (the default): every foot is taken. Why (file comment, "Focal
+  // points"): near a bend of the curve tighter than the data's, the foot map Q -> u contracts
+  // parameter spacing by 1 / (1 + |kappa| d) on the convex side and folds beyond the centre of
+  // curvature (|kappa| d >= 1) on the concave side.
+  void set_max_focal_ratio(double ratio) { max_focal_ratio_ = ratio; }
+
   // Least squares with `penalty` and parameter correction (file comment): fit, move every
   // parameter to its foot on the curve, refit, ... for at most max_rounds rounds (and
   // max_corrections), until a round gains less than 1% (kSettledGain). On return `params` are
@@ -109,6 +127,9 @@ class ProfileFitter {
   // Makes the corrected parameters `next` strictly increasing by restoring the old value of
   // every point that is out of order; false if that is not enough.
   bool KeepOrder(const std::vector<double>& old, std::vector<double>& next) const;
+  // Restores the old parameter of every point whose foot is not regular (set_max_focal_ratio).
+  void KeepRegularFeet(const Curve& curve, const std::vector<double>& old,
+                       const std::vector<double>& distance, std::vector<double>& next) const;
 
   std::vector<double> fit_data_, data_;
   int m_;
@@ -117,6 +138,7 @@ class ProfileFitter {
   const CancelCheck& cancel_;
   std::vector<int> anchors_;  // 0, features, m - 1
   std::vector<int> segment_;  // per point: index a of the anchors' interval [a, a + 1] it is in
+  double max_focal_ratio_ = std::numeric_limits<double>::infinity();
   int fits_ = 0;
 };
 

@@ -186,8 +186,50 @@ std::vector<int> DetectFeatures(const StructuredBlock& block, int d,
   return features;
 }
 
+namespace {
+
+// The number of data in every span of the interior knots (last span closed).
+std::vector<int> DataPerSpan(const std::vector<double>& params, const std::vector<double>& knots) {
+  std::vector<int> count(knots.size() + 1, 0);
+  for (double u : params) {
+    ++count[std::upper_bound(knots.begin(), knots.end(), u) - knots.begin()];
+  }
+  return count;
+}
+
+}  // namespace
+
+int SingleDatumRun(const std::vector<double>& params, const std::vector<double>& knots) {
+  int longest = 0, run = 0;
+  for (int c : DataPerSpan(params, knots)) {
+    run = c < 2 ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  return longest;
+}
+
+std::vector<double> BreakSingleDatumRuns(const std::vector<double>& params,
+                                         const std::vector<double>& knots, int max_run) {
+  const std::vector<int> count = DataPerSpan(params, knots);
+  std::vector<double> kept;
+  int run = count[0] < 2 ? 1 : 0;
+  int previous = count[0];  // data of the span ending at the next knot
+  for (size_t s = 1; s < count.size(); ++s) {
+    if (count[s] < 2 && run + 1 > max_run) {
+      previous += count[s];  // drop knots[s - 1]: span s joins the one before
+      if (previous >= 2) run = 0;
+      continue;
+    }
+    kept.push_back(knots[s - 1]);
+    previous = count[s];
+    run = count[s] < 2 ? run + 1 : 0;
+  }
+  return kept;
+}
+
 int SplitSpans(const std::vector<double>& params, const std::vector<double>& ratio, double limit,
-               int max_new, std::vector<double>& knots, const std::function<bool()>& well_posed) {
+               int max_new, std::vector<double>& knots, const std::function<bool()>& well_posed,
+               int max_single_run) {
   std::vector<double> breaks = {0.0};
   breaks.insert(breaks.end(), knots.begin(), knots.end());
   breaks.push_back(1.0);
@@ -214,7 +256,8 @@ int SplitSpans(const std::vector<double>& params, const std::vector<double>& rat
   for (const auto& [worst, knot] : candidates) {
     if (added == max_new) break;
     const auto at = knots.insert(std::upper_bound(knots.begin(), knots.end(), knot), knot);
-    if (well_posed()) {
+    if ((max_single_run <= 0 || SingleDatumRun(params, knots) <= max_single_run) &&
+        well_posed()) {
       ++added;
     } else {
       knots.erase(std::find(knots.begin(), knots.end(), knot));

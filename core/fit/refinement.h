@@ -68,8 +68,38 @@ std::vector<int> DetectFeatures(const StructuredBlock& block, int d, const Featu
 // at the middle of its data, worst span first. Only spans with at least two data points strictly
 // inside are split, so each half keeps one. A split is kept only if `well_posed()` holds
 // afterwards; at most `max_new` are kept. Returns the number of knots added.
+// With `max_single_run` > 0, a split is also refused when it leaves more than that many knot
+// spans in a row holding fewer than two data (SingleDatumRun).
 int SplitSpans(const std::vector<double>& params, const std::vector<double>& ratio, double limit,
-               int max_new, std::vector<double>& knots, const std::function<bool()>& well_posed);
+               int max_new, std::vector<double>& knots, const std::function<bool()>& well_posed,
+               int max_single_run = 0);
+
+// Runs of "single-datum" knot spans: spans of the interior knots `knots` on [0, 1] that hold
+// fewer than two of the ascending data `params` (span [t_s, t_s+1), the last one closed).
+//
+// Why they matter: on a run of L such spans a spline of order k has L + k - 1 controls against
+// L data, so k - 1 of its degrees of freedom are not fixed by the data there; only the spans
+// holding two or more data at the ends of the run pin them. The splines that vanish at the
+// run's data form a (k - 1)-dimensional family whose members are carried from span to span by a
+// transfer matrix with eigenvalues of modulus near 1 (for cubics: an alternating mode of
+// constant size besides a growing and a decaying one, cf. the cardinal spline eigenvalues
+// -(2 +- sqrt 3) of de Boor, "A Practical Guide to Splines", ch. XIII). The least-squares problem
+// stays solvable (Schoenberg-Whitney holds) but its smallest singular value falls with the run's
+// length, and the fit picks up a large multiple of that mode: a spline that meets every datum to
+// the tolerance and swings between them. At refinement levels 1 and 2 this is a checkerboard of
+// folded sub-cells (measured: control points 1e9 away between data 500 apart on the NACA 0012
+// C-grid at tolerance 5e-5, where 168 of 196 i-spans held one datum). Bounding the runs bounds
+// the amplification; interpolation (one datum per span, no surplus at all) is the exception
+// that is well posed on its own and has no surplus to pin with.
+//
+// The longest run.
+int SingleDatumRun(const std::vector<double>& params, const std::vector<double>& knots);
+// `knots` with knots removed so that no run is longer than `max_run` (>= 1): walking the spans,
+// a single-datum span that would extend a run beyond max_run is merged with the span before it
+// (its left knot removed), which gives a span of two data that pins the mode. Removes about one
+// knot in max_run + 1 along a run, none elsewhere.
+std::vector<double> BreakSingleDatumRuns(const std::vector<double>& params,
+                                         const std::vector<double>& knots, int max_run);
 
 }  // namespace splinegrid
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 
@@ -61,6 +64,147 @@ BoundaryKind GeometricKind(const StructuredBlock& block, const Face& face,
   }
   return Median(first) < options.wall_spacing_ratio * Median(all) ? BoundaryKind::kWall
                                                                   : BoundaryKind::kOuter;
+}
+
+// A wall segment of a planar block: two neighbouring points of a wall face that both carry the
+// wall kind.
+struct WallSegment {
+  const double* a;
+  const double* b;
+};
+
+// Position of a point of `block`.
+const double* At(const StructuredBlock& block, const Extents& x) {
+  return block.Point(x[0], x[1], x[2]);
+}
+
+// Whether a solid lies behind the face at `contact` (a point at an end of an unmatched run of a
+// face of a planar block): some wall segment that starts at (a point coincident with) `contact`
+// leaves it on the side of the face away from the block's interior, i.e. its unit direction w
+// has w . n_in < -kBehind, with n_in the unit direction from the face into the block there.
+// (A channel inlet between two walls fails this: its walls run along the block's side.)
+bool SolidBehind(const double* contact, const double* inward, int dim,
+                 std::span<const WallSegment> walls, double coincide) {
+  constexpr double kBehind = 0.1;  // cos 84 degrees: the wall turns away by > 6 degrees
+  double n2 = 0.0;
+  for (int c = 0; c < dim; ++c) n2 += (inward[c] - contact[c]) * (inward[c] - contact[c]);
+  if (!(n2 > 0.0)) return false;
+  for (const WallSegment& w : walls) {
+    for (const auto& [from, to] : {std::pair{w.a, w.b}, std::pair{w.b, w.a}}) {
+      double gap2 = 0.0, dot = 0.0, l2 = 0.0;
+      for (int c = 0; c < dim; ++c) {
+        gap2 += (from[c] - contact[c]) * (from[c] - contact[c]);
+        dot += (to[c] - from[c]) * (inward[c] - contact[c]);
+        l2 += (to[c] - from[c]) * (to[c] - from[c]);
+      }
+      if (gap2 <= coincide * coincide && l2 > 0.0 && dot < -kBehind * std::sqrt(l2 * n2)) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+// Second pass of ClassifyBoundaries for planar blocks (one point in k): a run of unmatched
+// points of a face classified outer by clustering is a wall when a solid lies behind the face at
+// both ends of the run (SolidBehind), as at the blunt base of a nozzle lip or a thick trailing
+// edge: the run then joins two walls of one solid across the side of the face away from the
+// flow. The clustering test misses such bases when the grid is not clustered towards them.
+// Overridden faces are left as given. Cost: O(boundary points x wall segments) for the run ends.
+void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindOverride> overrides,
+                           const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
+  constexpr uint8_t kWallBit = static_cast<uint8_t>(BoundaryKind::kWall);
+  constexpr uint8_t kOuterBit = static_cast<uint8_t>(BoundaryKind::kOuter);
+  std::vector<WallSegment> walls;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  int dim = 0;
+  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
+    const StructuredBlock& block = grid.blocks[b];
+    if (block.extent(2) != 1) continue;
+    dim = std::max(dim, block.spatial_dim());
+    for (int64_t p = 0; p < block.num_points(); ++p) {
+      for (int c = 0; c < block.spatial_dim(); ++c) {
+        lo[c] = std::min(lo[c], block.coords()[block.spatial_dim() * p + c]);
+        hi[c] = std::max(hi[c], block.coords()[block.spatial_dim() * p + c]);
+      }
+    }
+    const std::vector<Face> faces = BlockFaces(block, b);
+    for (size_t f = 0; f < faces.size(); ++f) {
+      if (kinds.face_kinds[b][f] != BoundaryKind::kWall) continue;
+      const int e = 1 - faces[f].normal;  // the face's own direction
+      Extents x = {0, 0, 0};
+      x[faces[f].normal] = faces[f].upper ? block.extent(faces[f].normal) - 1 : 0;
+      for (int r = 0; r + 1 < block.extent(e); ++r) {
+        Extents y = x;
+        x[e] = r, y[e] = r + 1;
+        if ((kinds.point_kinds[b][block.Index(x[0], x[1], 0)] & kWallBit) &&
+            (kinds.point_kinds[b][block.Index(y[0], y[1], 0)] & kWallBit)) {
+          walls.push_back({At(block, x), At(block, y)});
+        }
+      }
+    }
+  }
+  if (walls.empty()) return;
+  double diagonal2 = 0.0;
+  for (int c = 0; c < dim; ++c) diagonal2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  const double coincide = 1e-9 * std::sqrt(diagonal2);
+  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
+    const StructuredBlock& block = grid.blocks[b];
+    if (block.extent(2) != 1 || ActiveDirections(block.extents()) != 2) continue;
+    const std::vector<Face> faces = BlockFaces(block, b);
+    for (size_t f = 0; f < faces.size(); ++f) {
+      const Face& face = faces[f];
+      const bool overridden =
+          std::any_of(overrides.begin(), overrides.end(),
+                      [&](const FaceKindOverride& o) { return o.face == face; });
+      if (overridden || kinds.face_kinds[b][f] != BoundaryKind::kOuter) continue;
+      const int d = face.normal, e = 1 - d, n = block.extent(e);
+      auto point = [&](int r) {
+        Extents x = {0, 0, 0};
+        x[d] = face.upper ? block.extent(d) - 1 : 0;
+        x[e] = r;
+        return x;
+      };
+      auto inward = [&](int r) {
+        Extents x = point(r);
+        x[d] += face.upper ? -1 : 1;
+        return At(block, x);
+      };
+      auto unmatched = [&](int r) {
+        const Extents x = point(r);
+        return !(matched[b][block.Index(x[0], x[1], 0)] & FaceBit(face));
+      };
+      bool all_runs = true, any_run = false;
+      for (int r0 = 0; r0 < n;) {
+        if (!unmatched(r0)) {
+          ++r0;
+          continue;
+        }
+        int r1 = r0;
+        while (r1 + 1 < n && unmatched(r1 + 1)) ++r1;
+        any_run = true;
+        // The contact points: the matched neighbours of the run, or its own ends at corners.
+        const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
+        const bool base =
+            SolidBehind(At(block, point(c0)), inward(c0), block.spatial_dim(), walls, coincide) &&
+            SolidBehind(At(block, point(c1)), inward(c1), block.spatial_dim(), walls, coincide);
+        if (base) {
+          for (int r = c0; r <= c1; ++r) {
+            const Extents x = point(r);
+            uint8_t& k = kinds.point_kinds[b][block.Index(x[0], x[1], 0)];
+            // The run and its contact points become wall: the outer kind they carry is this
+            // face's, except at a block corner, which keeps the other face's kind.
+            if (r > 0 && r + 1 < n) k &= static_cast<uint8_t>(~kOuterBit);
+            k |= kWallBit;
+          }
+        } else {
+          all_runs = false;
+        }
+        r0 = r1 + 1;
+      }
+      if (any_run && all_runs) kinds.face_kinds[b][f] = BoundaryKind::kWall;
+    }
+  }
 }
 
 }  // namespace
@@ -149,6 +293,7 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
       });
     }
   }
+  WallBasesBetweenWalls(grid, overrides, matched, kinds);
   return kinds;
 }
 

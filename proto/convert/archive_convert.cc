@@ -63,6 +63,18 @@ void EncodeFitReport(const GridFitReport& report, v1::StoredFitReport* out) {
   out->set_quality_rounds(report.quality_rounds);
   out->set_seconds(report.seconds);
   for (const std::string& adjustment : report.adjustments) out->add_adjustments(adjustment);
+  out->set_reference_length(report.reference.length);
+  out->set_reference_length_source(EncodeReferenceLengthSource(report.reference.source));
+  out->set_reference_length_description(report.reference.description);
+  if (report.tolerances) {
+    const BoundaryTolerances& t = *report.tolerances;
+    v1::StoredBoundaryTolerances* stored = out->mutable_tolerances();
+    stored->set_wall(t.wall);
+    stored->set_interface(t.interface);
+    stored->set_outer(t.outer);
+    stored->set_interior(t.interior);
+    stored->set_edge(t.edge);
+  }
 }
 
 absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
@@ -88,6 +100,22 @@ absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
   report.knots_removed = stored.knots_removed();
   report.quality_rounds = stored.quality_rounds();
   report.seconds = stored.seconds();
+  // Archives from before reference lengths have none: the report keeps the default (1, given).
+  if (stored.reference_length_source() != v1::REFERENCE_LENGTH_SOURCE_UNSPECIFIED) {
+    const std::optional<ReferenceLengthSource> source =
+        ParseReferenceLengthSource(stored.reference_length_source());
+    if (!source) {
+      return Invalid(field, ".reference_length_source = ",
+                     static_cast<int>(stored.reference_length_source()), " is not a known value");
+    }
+    report.reference = ReferenceLength{stored.reference_length(), *source,
+                                       stored.reference_length_description()};
+  }
+  if (stored.has_tolerances()) {
+    const v1::StoredBoundaryTolerances& t = stored.tolerances();
+    report.tolerances = BoundaryTolerances{t.wall(), t.interface(), t.outer(), t.interior(),
+                                           t.edge()};
+  }
   SG_RETURN_IF_ERROR(CheckNonNegative(report.num_points, field + ".num_points"));
   SG_RETURN_IF_ERROR(CheckNonNegative(report.num_control_points, field + ".num_control_points"));
   SG_RETURN_IF_ERROR(CheckNonNegative(report.num_matches, field + ".num_matches"));
@@ -184,6 +212,9 @@ void EncodeGridFitOptions(const GridFitOptions& options, v1::StoredFitOptions* o
     entry->set_kind(EncodeBoundaryKind(o.kind));
   }
   out->set_check_quality(options.check_quality);
+  out->set_allow_folds(options.allow_folds);
+  out->set_relative_kinds(options.relative_kinds);
+  if (options.reference_length) out->set_reference_length(*options.reference_length);
 }
 
 absl::StatusOr<GridFitOptions> ParseGridFitOptions(const v1::StoredFitOptions& stored,
@@ -262,6 +293,13 @@ absl::StatusOr<GridFitOptions> ParseGridFitOptions(const v1::StoredFitOptions& s
     options.face_kinds.push_back({face, kind});
   }
   options.check_quality = stored.check_quality();
+  options.allow_folds = stored.allow_folds();
+  if (stored.relative_kinds() > kAllKindsRelative) {
+    return Invalid(field, ".relative_kinds = ", stored.relative_kinds(), " is not a mask of ",
+                   static_cast<int>(kAllKindsRelative));
+  }
+  options.relative_kinds = static_cast<uint8_t>(stored.relative_kinds());
+  if (stored.has_reference_length()) options.reference_length = stored.reference_length();
   return options;
 }
 

@@ -79,14 +79,18 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
       break;
     case v1::FitSpec::kBoundaryTolerances: {
       const v1::BoundaryTolerances& given = spec.boundary_tolerances();
+      // A kind given is absolute; a kind left unset keeps its default, a fraction of the
+      // reference length.
       BoundaryTolerances t;
-      auto take = [](double value, double& field) {
-        if (value != 0.0) field = value;
+      uint8_t relative = kAllKindsRelative;
+      auto take = [&relative](double value, double& field, uint8_t bit) {
+        if (value != 0.0) field = value, relative &= ~bit;
       };
-      take(given.wall(), t.wall);
-      take(given.interface(), t.interface);
-      take(given.outer(), t.outer);
-      take(given.interior(), t.interior);
+      take(given.wall(), t.wall, kRelativeWall);
+      take(given.interface(), t.interface, kRelativeInterface);
+      take(given.outer(), t.outer, kRelativeOuter);
+      take(given.interior(), t.interior, kRelativeInterior);
+      options.relative_kinds = relative;
       if (given.has_edge()) t.edge = given.edge();
       if (absl::Status s = t.Validate(); !s.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("spec.boundary_tolerances: ", s.message()));
@@ -125,7 +129,34 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
     options.face_kinds.push_back(FaceKindOverride{face, *kind});
   }
   options.check_quality = !spec.skip_quality_refinement();
+  options.allow_folds = spec.allow_folds();
+  if (spec.reference_length() != 0.0) options.reference_length = spec.reference_length();
   return options;
+}
+
+v1::ReferenceLengthSource EncodeReferenceLengthSource(ReferenceLengthSource source) {
+  switch (source) {
+    case ReferenceLengthSource::kGiven:
+      return v1::REFERENCE_LENGTH_SOURCE_GIVEN;
+    case ReferenceLengthSource::kWall:
+      return v1::REFERENCE_LENGTH_SOURCE_WALL;
+    case ReferenceLengthSource::kBoundingBox:
+      return v1::REFERENCE_LENGTH_SOURCE_BOUNDING_BOX;
+  }
+  return v1::REFERENCE_LENGTH_SOURCE_UNSPECIFIED;
+}
+
+std::optional<ReferenceLengthSource> ParseReferenceLengthSource(v1::ReferenceLengthSource source) {
+  switch (source) {
+    case v1::REFERENCE_LENGTH_SOURCE_GIVEN:
+      return ReferenceLengthSource::kGiven;
+    case v1::REFERENCE_LENGTH_SOURCE_WALL:
+      return ReferenceLengthSource::kWall;
+    case v1::REFERENCE_LENGTH_SOURCE_BOUNDING_BOX:
+      return ReferenceLengthSource::kBoundingBox;
+    default:
+      return std::nullopt;
+  }
 }
 
 v1::BlockFace EncodeBlockFace(int normal, bool upper) {
@@ -258,10 +289,15 @@ void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
   } else if (options.boundary_tolerances) {
     const BoundaryTolerances& t = *options.boundary_tolerances;
     v1::BoundaryTolerances* given = out->mutable_boundary_tolerances();
-    given->set_wall(t.wall);
-    given->set_interface(t.interface);
-    given->set_outer(t.outer);
-    given->set_interior(std::isfinite(t.interior) ? t.interior : 0.0);
+    // A relative kind is written unset: its default fraction of the reference length (the
+    // kernel's other fractions have no FitSpec form).
+    auto put = [&options](double value, uint8_t bit) {
+      return (options.relative_kinds & bit) || !std::isfinite(value) ? 0.0 : value;
+    };
+    given->set_wall(put(t.wall, kRelativeWall));
+    given->set_interface(put(t.interface, kRelativeInterface));
+    given->set_outer(put(t.outer, kRelativeOuter));
+    given->set_interior(put(t.interior, kRelativeInterior));
     given->set_edge(t.edge);
   } else {
     EncodeExtents(options.control_counts, out->mutable_control_counts());
@@ -274,6 +310,8 @@ void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
     entry->set_kind(EncodeBoundaryKind(o.kind));
   }
   out->set_skip_quality_refinement(!options.check_quality);
+  out->set_allow_folds(options.allow_folds);
+  if (options.reference_length) out->set_reference_length(*options.reference_length);
   for (const auto& [block, counts] : options.block_control_counts) {
     v1::BlockControlCounts* entry = out->add_block_control_counts();
     entry->set_block(block);
@@ -345,6 +383,18 @@ void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& b
   out->set_knots_removed(report.knots_removed);
   out->set_quality_rounds(report.quality_rounds);
   for (const std::string& adjustment : report.adjustments) out->add_adjustments(adjustment);
+  out->set_reference_length(report.reference.length);
+  out->set_reference_length_source(EncodeReferenceLengthSource(report.reference.source));
+  out->set_reference_length_description(report.reference.description);
+  if (report.tolerances) {
+    const BoundaryTolerances& t = *report.tolerances;
+    v1::BoundaryTolerances* held = out->mutable_tolerances();
+    held->set_wall(t.wall);
+    held->set_interface(t.interface);
+    held->set_outer(t.outer);
+    held->set_interior(std::isfinite(t.interior) ? t.interior : 0.0);
+    held->set_edge(t.edge);
+  }
   double min_ratio = std::numeric_limits<double>::infinity(), size_ratio = 0.0;
   int64_t folded = 0, bad = 0;
   for (const BlockFit& b : blocks) {

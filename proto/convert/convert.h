@@ -48,6 +48,10 @@ v1::BoundaryKind EncodeBoundaryKind(BoundaryKind kind);
 // WALL, INTERFACE or OUTER; nullopt for anything else (callers name the field in their error).
 std::optional<BoundaryKind> ParseBoundaryKind(int value);
 
+v1::ReferenceLengthSource EncodeReferenceLengthSource(ReferenceLengthSource source);
+// GIVEN, WALL or BOUNDING_BOX; nullopt for anything else (callers name the field).
+std::optional<ReferenceLengthSource> ParseReferenceLengthSource(v1::ReferenceLengthSource source);
+
 v1::BlockFace EncodeBlockFace(int normal, bool upper);
 // Face `face` of block `block`, or INVALID_ARGUMENT naming `field`.
 absl::StatusOr<Face> ParseBlockFace(int block, v1::BlockFace face, const std::string& field);

@@ -582,7 +582,10 @@ class Client:
             tolerance: Optional[float] = None, order: int = 4,
             max_controls: int = 0,
             boundary_tolerances: Optional[dict[str, float]] = None,
-            fairing: Union[None, str, float] = None) -> service_pb2.FitGridResponse:
+            fairing: Union[None, str, float] = None,
+            allow_folds: bool = False,
+            ref_length: Optional[float] = None,
+            face_kinds: Union[None, str, dict, list] = None) -> service_pb2.FitGridResponse:
         """Fits the grid's source points; the result is stored as a new revision.
 
         Give one of ``control_counts`` ``(a, b)`` or ``(a, b, c)`` (control points per
@@ -590,11 +593,31 @@ class Client:
         ``tolerance`` (largest deviation of every point, in the grid's length unit) or
         ``boundary_tolerances``, a dict with any of ``wall``, ``interface``, ``outer``,
         ``interior`` and ``edge`` (missing: the paper's 0.15e-3, 2e-3, 8e-3, no interior
-        tolerance, edge 0.5; ``{}`` takes all defaults). With tolerances, knots are added until
+        tolerance, edge 0.5; ``{}`` takes all defaults). The values given are lengths in the
+        grid's unit; the defaults are fractions of the grid's reference length: ``ref_length``
+        (implies ``boundary_tolerances={}`` when none is given; refused with ``tolerance`` or
+        ``control_counts``, which are absolute), else detected by the server as the largest
+        extent of a wall (an airfoil's chord; the bounding-box diagonal without walls), so a
+        grid in chords, millimetres or inches is fitted alike. The report states it
+        (``reference_length``, ``reference_length_description``) and the tolerances held
+        (``tolerances``). With tolerances, knots are added until
         they are met or ``max_controls`` per direction (0 = no cap) is reached, and the fit is
         watertight across blocks. Neither: interpolate.
 
         ``fairing``: ``"tol"`` (the largest fairing weight within the tolerances) or a weight.
+
+        ``face_kinds``: explicit boundary kinds of block faces, overriding the server's
+        classification: a dict ``{(block, face): kind}``, a list of ``"BLOCK:FACE=KIND"``
+        strings, or one such string with commas (as the CLI's ``--face``); FACE is ``imin``,
+        ``imax``, ``jmin``, ``jmax``, ``kmin`` or ``kmax``, KIND ``wall``, ``interface`` or
+        ``outer`` (there is no symmetry kind). Implies ``boundary_tolerances={}`` when none
+        is given; refused with ``tolerance`` or ``control_counts``. A bad entry raises
+        ValueError naming it.
+
+        A fit whose cells fold at refinement levels 0-2 (after the server's repair, tolerance
+        fits only) raises a FAILED_PRECONDITION error naming the cells and stores nothing,
+        unless ``allow_folds`` is true: then the revision is stored and its ``report`` says
+        ``quality_met = False`` with ``folded_cells``.
 
         Returns the FitGridResponse proto: ``revision``, ``num_points``,
         ``num_control_points``, ``compression_ratio``, ``max_deviation``, ``seconds``,
@@ -603,20 +626,42 @@ class Client:
         validity at refinement levels 0-2, connectivity and gaps, fairing weight, wall
         curvature before and after fairing).
         """
+        if ref_length is not None:
+            if tolerance is not None or control_counts is not None:
+                raise ValueError("ref_length applies to the tolerances by kind; tolerance and "
+                                 "control_counts are absolute")
+            if not float(ref_length) > 0.0:
+                raise ValueError(f"ref_length = {ref_length}; give a positive length")
+            if boundary_tolerances is None:
+                boundary_tolerances = {}
+        if face_kinds is not None:
+            if tolerance is not None or control_counts is not None:
+                raise ValueError("face_kinds apply to the tolerances by kind; tolerance and "
+                                 "control_counts do not use kinds")
+            if boundary_tolerances is None:
+                boundary_tolerances = {}
         spec = _fit_spec(control_counts, tolerance, order, max_controls, boundary_tolerances,
                          fairing)
+        if face_kinds is not None:
+            spec.face_kinds.extend(_face_kinds(face_kinds))
+        spec.allow_folds = bool(allow_folds)
+        if ref_length is not None:
+            spec.reference_length = float(ref_length)
         request = service_pb2.FitGridRequest(name=grid_name(name), spec=spec)
         return self._unary(self.stub.FitGrid, request)
 
     def fair(self, name: str, revision: int = 0,
-             fairing: Union[None, str, float] = None) -> service_pb2.FitGridResponse:
+             fairing: Union[None, str, float] = None,
+             allow_folds: bool = False) -> service_pb2.FitGridResponse:
         """Refits revision ``revision`` (0: latest) with fairing and stores a new revision.
+        A faired fit that folds cells is refused (FAILED_PRECONDITION) unless ``allow_folds``.
 
         ``fairing``: ``"tol"``, a weight, or None (the server's default: to tolerance for a
         revision fitted to tolerances). Returns the FitGridResponse of the new revision; its
         report compares the wall curvature with and without fairing.
         """
-        request = service_pb2.FairGridRequest(name=grid_name(name), revision=revision)
+        request = service_pb2.FairGridRequest(name=grid_name(name), revision=revision,
+                                              allow_folds=bool(allow_folds))
         if fairing is not None:
             request.fairing.CopyFrom(_fairing(fairing))
         return self._unary(self.stub.FairGrid, request)
@@ -633,7 +678,7 @@ class Client:
                  control_counts: Optional[Triple] = None, tolerance: Optional[float] = None,
                  order: int = 4, max_controls: int = 0,
                  boundary_tolerances: Optional[dict[str, float]] = None,
-                 fairing: Union[None, str, float] = None
+                 fairing: Union[None, str, float] = None, allow_folds: bool = False
                  ) -> service_pb2.GenerateGridResponse:
         """Generates an O-grid around a profile, stores it as the new grid ``name`` ("" lets the
         server pick an id; ALREADY_EXISTS if taken) and fits it as revision 1. Nothing is
@@ -656,7 +701,8 @@ class Client:
 
         The fit of revision 1 takes :meth:`fit`'s arguments; with none of ``control_counts``,
         ``tolerance``, ``boundary_tolerances`` and ``fairing`` the server interpolates the grid
-        (exact; wall j = 0, outer j = max, the seam an interface).
+        (exact; wall j = 0, outer j = max, the seam an interface). A fit that folds cells is
+        refused (nothing stored) unless ``allow_folds``.
 
         Returns the GenerateGridResponse proto: ``grid`` (BASIC view, revision 1), ``report``
         (GenerationReport: ``parameters`` used, ``extents``, ``profile`` fit, ``growth_ratio``,
@@ -668,7 +714,8 @@ class Client:
         if sum(given) != 1:
             raise ValueError("give exactly one of airfoil, points and stored_wall")
         request = service_pb2.GenerateGridRequest(grid_id=_grid_id(name),
-                                                  display_name=display_name)
+                                                  display_name=display_name,
+                                                  allow_folds=bool(allow_folds))
         if airfoil is not None:
             request.airfoil_file = _airfoil_text(airfoil)
         elif points is not None:
@@ -1308,6 +1355,56 @@ def _fit_spec(control_counts: Optional[Triple], tolerance: Optional[float], orde
     if fairing is not None:
         spec.fairing.CopyFrom(_fairing(fairing))
     return spec
+
+
+_FACES = {"imin": grid_pb2.BLOCK_FACE_I_MIN, "imax": grid_pb2.BLOCK_FACE_I_MAX,
+          "jmin": grid_pb2.BLOCK_FACE_J_MIN, "jmax": grid_pb2.BLOCK_FACE_J_MAX,
+          "kmin": grid_pb2.BLOCK_FACE_K_MIN, "kmax": grid_pb2.BLOCK_FACE_K_MAX}
+_KINDS = {"wall": grid_pb2.BOUNDARY_KIND_WALL, "interface": grid_pb2.BOUNDARY_KIND_INTERFACE,
+          "outer": grid_pb2.BOUNDARY_KIND_OUTER}
+_FACE_HELP = ("give BLOCK:FACE=KIND or {(block, face): kind}, FACE imin, imax, jmin, jmax, kmin "
+              "or kmax, KIND wall, interface or outer")
+
+
+def _face_kinds(face_kinds: Union[str, dict, list]) -> list:
+    """FaceKind messages of :meth:`Client.fit`'s ``face_kinds``; ValueError names a bad entry."""
+    if isinstance(face_kinds, str):
+        face_kinds = [t for t in face_kinds.split(",") if t.strip()]
+    if isinstance(face_kinds, dict):
+        entries = [(key, key, kind) for key, kind in face_kinds.items()]
+    else:
+        entries = []
+        for token in face_kinds:
+            text = str(token).strip()
+            block_face, sep, kind = text.partition("=")
+            block, sep2, face = block_face.partition(":")
+            if not sep or not sep2:
+                raise ValueError(f"face_kinds: {text!r}: {_FACE_HELP}")
+            entries.append((text, (block, face), kind))
+    out, seen = [], {}
+    for what, key, kind in entries:
+        try:
+            block, face = key
+            block = int(block)
+        except (TypeError, ValueError):
+            raise ValueError(f"face_kinds: {what!r}: the block is not a number; "
+                             f"{_FACE_HELP}") from None
+        face_name, kind_name = str(face).strip().lower(), str(kind).strip().lower()
+        if block < 0:
+            raise ValueError(f"face_kinds: {what!r}: block {block} < 0; {_FACE_HELP}")
+        if face_name not in _FACES:
+            raise ValueError(f"face_kinds: {what!r}: unknown face {face!r}; {_FACE_HELP}")
+        if kind_name not in _KINDS:
+            why = ("there is no symmetry kind (fit a symmetry plane as outer)"
+                   if kind_name == "symmetry" else f"unknown kind {kind!r}")
+            raise ValueError(f"face_kinds: {what!r}: {why}; {_FACE_HELP}")
+        if (block, face_name) in seen:
+            if seen[(block, face_name)] != kind_name:
+                raise ValueError(f"face_kinds: {what!r}: the face is given another kind before")
+            continue
+        seen[(block, face_name)] = kind_name
+        out.append(grid_pb2.FaceKind(block=block, face=_FACES[face_name], kind=_KINDS[kind_name]))
+    return out
 
 
 def _airfoil_text(airfoil: Union[str, bytes, "os.PathLike[str]"]) -> str:

@@ -90,7 +90,8 @@ TEST_F(FitReportTest, FairGridOfACountsRevisionNeedsAWeight) {
   v1::Fairing weight;
   weight.set_mode(v1::FAIRING_MODE_WEIGHT);
   weight.set_weight(1e-3);
-  const v1::FitGridResponse faired = client_->Fair("naca", 1, &weight).value();
+  const v1::FitGridResponse faired =
+      client_->Fair("naca", 1, &weight, /*allow_folds=*/true).value();
   EXPECT_DOUBLE_EQ(faired.report().fairing_weight(), 1e-3);
   const v1::Grid grid = client_->Get("naca").value();
   EXPECT_EQ(grid.revision().fit_spec().fairing().mode(), v1::FAIRING_MODE_WEIGHT);
@@ -185,6 +186,7 @@ TEST_F(FitReportTest, AnImpossibleToleranceIsReportedNotLooped) {
   v1::FitSpec spec;
   spec.mutable_boundary_tolerances()->set_wall(1e-12);
   spec.set_max_controls_per_direction(20);
+  spec.set_allow_folds(true);  // 20 controls fold the C-grid; the unmet tolerance is tested
   const v1::FitGridResponse fit = client_->Fit("naca", spec).value();
   EXPECT_FALSE(fit.report().tolerance_met());
   EXPECT_THAT(fit.report().unmet_reason(), ::testing::HasSubstr("wall point ("));

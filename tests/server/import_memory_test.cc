@@ -170,6 +170,7 @@ TEST_F(ImportMemoryTest, ResidentMemoryFollowsTheBudget) {
     ImportShared(name, id);
     v1::FitSpec spec;
     spec.mutable_control_counts();  // as many controls as points
+    spec.set_allow_folds(true);     // interpolating the C-grids folds sub-cells at levels 1-2
     EXPECT_TRUE(client_->Fit(id, spec).ok());
     const int64_t used = SettledBudget(), rss = ResidentBytes();
     std::printf("after %d grids: budget.used %.1f MiB, VmRSS %.1f MiB (idle %.1f, growth %.1f)\n",
