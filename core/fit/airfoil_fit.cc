@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <span>
@@ -157,24 +158,80 @@ absl::Status ValidateOutline(const StructuredBlock& points) {
 // sampled coarsely, like a nose, turns by about as much at the neighbours), never the leading
 // edge, and only where both neighbouring segments keep order - 2 data points strictly inside
 // (what the order - 2 free controls of a segment without interior knots need).
+//
+// The turning is measured at the length scale of the tolerance, not between neighbouring
+// segments: on a dense noisy outline (the file's spacing refined a hundredfold puts points 1e-6
+// chord apart at the nose, as close as 1e-6 chord noise) neighbouring segments turn by tens of
+// degrees at random, and every such point that DetectFeatures reports and that turns twice as
+// much as its neighbours would become a C0 knot (RAE 2822 at 12k points: 1-3 false features,
+// up to 26 controls against 17). For a kink angle theta and the fit's tolerance tol, let
+//   L(theta) = 8 tol / theta,
+// and T_L(r) be the angle between the chords p(a) -> p(r) and p(r) -> p(b), a and b the nearest
+// points at least L before and after r along the polyline (or its ends). Why L:
+//  - Noise: data anywhere within the tolerance band of a smooth curve move each chord end by at
+//    most tol across it, so a chord of length >= L turns by at most 2 tol / L and T_L by at
+//    most 4 tol / L = theta / 2: what the fit absorbs anyway cannot turn by theta over L.
+//  - Fillet: a kink of angle theta is rounded within tol by a circular fillet of radius R with
+//    R (1 / cos(theta / 2) - 1) ~ R theta^2 / 8 = tol, whose arc length R theta is L: over
+//    chords of length L the kink turns by theta, the smooth curve by about its curvature * L.
+// A point is a kink at angle theta when T_L(r) >= theta, T_L(r) >= kKinkRatio * max(T_L(a),
+// T_L(b)) (the neighbours L away, as the neighbouring points were), T_L(r) is the largest
+// turning of the points of [a, b] (one kink, not every point whose chords straddle it), and r
+// is at least L along the outline from the leading edge (whose chords would measure the nose).
+// The angles tried are theta = spike_degrees * 2^j <= 180 degrees: the largest L is that of the
+// smallest kink of interest, and larger kinks are also looked at on their own, shorter scale
+// (two cove corners 0.06 chord apart each see the other within 8 tol / 4 degrees at 5e-4
+// chord). A candidate that is a kink at one of these angles is a feature. Where the points are
+// at least L apart, a = r - 1 and b = r + 1 and the test is the one between neighbouring
+// segments that coarse outlines have always had (with theta <= the point's turning).
 std::vector<int> OutlineFeatures(const StructuredBlock& points, const FeatureOptions& options,
-                                 int leading_edge, int order) {
+                                 int leading_edge, int order, double tolerance) {
   const int m = static_cast<int>(points.num_points());
-  auto turning = [&](int r) {
-    if (r <= 0 || r >= m - 1) return 0.0;
-    const double *a = points.Point(r - 1, 0, 0), *b = points.Point(r, 0, 0),
-                 *c = points.Point(r + 1, 0, 0);
-    const double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - b[0], vy = c[1] - b[1];
-    return std::abs(std::atan2(ux * vy - uy * vx, ux * vx + uy * vy));
+  const double spike = options.spike_degrees * std::numbers::pi / 180.0;
+  std::vector<double> arc(m, 0.0);  // arc length of the polyline at each point
+  for (int i = 1; i < m; ++i) {
+    const double *p = points.Point(i - 1, 0, 0), *q = points.Point(i, 0, 0);
+    arc[i] = arc[i - 1] + std::hypot(q[0] - p[0], q[1] - p[1]);
+  }
+  // One scale: the angle theta, L, and per point a, b and T_L.
+  struct Scale {
+    double theta = 0.0, length = 0.0;
+    std::vector<int> before, after;
+    std::vector<double> turning;
+  };
+  std::vector<Scale> scales;
+  for (double theta = spike; theta > 0.0 && theta <= std::numbers::pi; theta *= 2.0) {
+    Scale& scale = scales.emplace_back();
+    scale.theta = theta, scale.length = 8.0 * tolerance / theta;
+    scale.before.resize(m), scale.after.resize(m), scale.turning.assign(m, 0.0);
+    for (int r = 0; r < m; ++r) {
+      const auto lo = std::upper_bound(arc.begin(), arc.end(), arc[r] - scale.length);
+      const auto hi = std::lower_bound(arc.begin(), arc.end(), arc[r] + scale.length);
+      scale.before[r] = std::max(0, std::min(r - 1, static_cast<int>(lo - arc.begin()) - 1));
+      scale.after[r] = std::min(m - 1, std::max(r + 1, static_cast<int>(hi - arc.begin())));
+      if (r == 0 || r == m - 1) continue;
+      const double *a = points.Point(scale.before[r], 0, 0), *b = points.Point(r, 0, 0),
+                   *c = points.Point(scale.after[r], 0, 0);
+      const double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - b[0], vy = c[1] - b[1];
+      scale.turning[r] = std::abs(std::atan2(ux * vy - uy * vx, ux * vx + uy * vy));
+    }
+  }
+  auto kink = [&](const Scale& scale, int r) {
+    if (std::abs(arc[r] - arc[leading_edge]) < scale.length) return false;
+    const int a = scale.before[r], b = scale.after[r];
+    const double t = scale.turning[r];
+    if (t < scale.theta || t < kKinkRatio * std::max(scale.turning[a], scale.turning[b])) {
+      return false;
+    }
+    return *std::max_element(scale.turning.begin() + a, scale.turning.begin() + b + 1) <= t;
   };
   std::vector<int> kept;
   for (int r : DetectFeatures(points, 0, options)) {
     const int previous = kept.empty() ? 0 : kept.back();
-    if (r == leading_edge || r - previous < order - 1 || m - 1 - r < order - 1 ||
-        turning(r) < kKinkRatio * std::max(turning(r - 1), turning(r + 1))) {
-      continue;
+    if (r == leading_edge || r - previous < order - 1 || m - 1 - r < order - 1) continue;
+    if (std::any_of(scales.begin(), scales.end(), [&](const Scale& s) { return kink(s, r); })) {
+      kept.push_back(r);
     }
-    kept.push_back(r);
   }
   return kept;
 }
@@ -336,7 +393,8 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
     const double d = std::hypot(data[2 * i] - te_x, data[2 * i + 1] - te_y);
     if (d > farthest) farthest = d, result.leading_edge = i;
   }
-  result.features = OutlineFeatures(points, options.features, result.leading_edge, k);
+  result.features =
+      OutlineFeatures(points, options.features, result.leading_edge, k, tolerance);
   const int min_controls = k + static_cast<int>(result.features.size()) * (k - 1);
   const int cap = options.max_control_points == 0 ? m : std::min(options.max_control_points, m);
   if (cap < min_controls) {

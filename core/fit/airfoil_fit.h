@@ -11,7 +11,11 @@
 // feature points are the kinks among DetectFeatures' points (refinement.h) that turn by at least
 // twice as much as both neighbours: a tangent discontinuity stands out, a tight smooth bend
 // sampled coarsely does not (the NACA 0012 file turns by 29.6 degrees at its nose point and 24.8
-// at its neighbours). A feature gets a knot of multiplicity order - 1 and a pinned control.
+// at its neighbours). The turning is measured over chords of length L = 8 tol / theta (theta the
+// spike angle and its doublings up to 180 degrees), where noise within the tolerance cannot turn
+// by more than theta / 2 (OutlineFeatures in airfoil_fit.cc); on outlines sampled coarser than L
+// those are the neighbouring segments. A feature gets a knot of multiplicity order - 1 and a
+// pinned control.
 //
 // Algorithm (each least-squares fit costs O(points); about 300 fits in all, independent of the
 // number of points):

@@ -69,7 +69,10 @@ double Turning(const StructuredBlock& block, int r) {
 // (at least its start point, so the coarse points are all kept); then every coordinate of every
 // point gets Gaussian noise of standard deviation kNoise chords (fixed seed), tapered to 0 over
 // kTaper chords at the trailing edge (where the surfaces are closer than the noise).
-StructuredBlock Densify(const StructuredBlock& coarse, int target, uint64_t seed) {
+// With `own_spacing` every interval gets the same number of samples instead: the file's own
+// spacing, refined (very dense where the file is dense, at the nose).
+StructuredBlock Densify(const StructuredBlock& coarse, int target, uint64_t seed,
+                        bool own_spacing = false) {
   const int m = coarse.extent(0);
   const double chord = Chord(coarse);
   std::vector<double> length(m - 1);
@@ -105,7 +108,8 @@ StructuredBlock Densify(const StructuredBlock& coarse, int target, uint64_t seed
     EXPECT_TRUE(spline.ok()) << spline.status();
     std::vector<double> samples;
     for (int i = 0; i + 1 < n; ++i) {
-      const int per = std::max(1, static_cast<int>(std::lround(target * length[r0 + i] / total)));
+      const double share = own_spacing ? 1.0 / (m - 1) : length[r0 + i] / total;
+      const int per = std::max(1, static_cast<int>(std::lround(target * share)));
       for (int j = 0; j < per; ++j) samples.push_back(u[i] + (u[i + 1] - u[i]) * j / per);
     }
     if (c + 2 == cuts.size()) samples.push_back(1.0);  // the last piece ends the outline
@@ -163,6 +167,7 @@ Measured FitAndCheck(const StructuredBlock& data, double tolerance, double chord
       << what;
   const Measured out{data.extent(0), fit->num_control_points, fit->max_deviation / chord, ms};
   std::cout << what << ": " << out.points << " points, " << out.controls << " controls, "
+            << fit->features.size() << " features, "
             << out.deviation << " chords, " << ms << " ms\n";
   return out;
 }
@@ -174,20 +179,28 @@ struct Case {
 };
 
 // The dense outline and every 4th of its points fit within the tolerance; the dense one with at
-// most 10% more controls than the quarter.
-void CheckDenseAgainstQuarter(const Case& c) {
+// most 10% more controls than the quarter (plus `extra`).
+void CheckDenseAgainstQuarter(const Case& c, bool own_spacing = false, int extra = 0) {
   const StructuredBlock coarse = Shared(c.name);
   const double chord = Chord(coarse);
-  const StructuredBlock dense = Densify(coarse, c.points, 13);
+  const StructuredBlock dense = Densify(coarse, c.points, 13, own_spacing);
   const std::string what = absl::StrCat(c.name, " at ", c.tolerance, " chord");
   const Measured full = FitAndCheck(dense, c.tolerance * chord, chord, what + ", dense");
   const Measured quarter = FitAndCheck(Thin(dense, 4), c.tolerance * chord, chord, what + ", 1/4");
   EXPECT_GE(full.points, 10000) << what;
-  EXPECT_LE(full.controls, std::floor((1.0 + kControlSlack) * quarter.controls)) << what;
+  EXPECT_LE(full.controls, std::floor((1.0 + kControlSlack) * quarter.controls) + extra) << what;
 }
 
 TEST(DenseProfileTest, Rae2822At12000Points) {
   CheckDenseAgainstQuarter({"rae2822", 12000, 1e-4});  // measured 16 and 16 controls
+}
+
+// The file's own spacing refined about 93 times: at the nose the dense spacing is about the
+// noise, so neighbouring segments turn by tens of degrees; the noise must not make kinks.
+// Measured 17 and 18 controls, no feature (with the turning between neighbouring segments:
+// 1 false feature and 20 controls; 1-3 and up to 26 for the seeds 2-6).
+TEST(DenseProfileTest, Rae2822At12000PointsWithTheFilesSpacing) {
+  CheckDenseAgainstQuarter({"rae2822", 12000, 1e-4}, /*own_spacing=*/true, /*extra=*/1);
 }
 
 // A blunt trailing edge and a nose that the file samples coarsely: without the restricted
