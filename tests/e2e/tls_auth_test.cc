@@ -25,6 +25,7 @@
 #include "client/client.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::testing {
 namespace {
@@ -231,7 +232,7 @@ TEST_F(TlsAuthTest, TlsRoundTripsAndAPlaintextClientFails) {
   const std::string tls = "--tls_ca=" + Cert("ca.pem");
   // CLI: health, a fit (import + fit) and a get, over TLS.
   EXPECT_THAT(Cli("health", tls).out, HasSubstr("SERVING"));
-  const Result fit = Cli(absl::StrCat("fit ", kSource, "/../shared/data/grids/n0012_113-33.p2dfmt"),
+  const Result fit = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt")),
                          tls + " --name=naca --ctl=12,8 --allow_folds");
   EXPECT_EQ(fit.exit_code, 3) << fit.out;  // these counts fold: stored, exit 3 (issue 13.3)
   EXPECT_EQ(Cli("get naca", tls).exit_code, 0);
