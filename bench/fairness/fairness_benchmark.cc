@@ -50,6 +50,7 @@
 #include "absl/time/time.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
+#include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
 ABSL_FLAG(std::string, scenario, "all", "fairness, soak or all");
@@ -73,13 +74,6 @@ using Clock = std::chrono::steady_clock;
 constexpr char kNaca[] = "grids/n0012_225-65.p2dfmt";
 constexpr char kSmall[] = "grids/n0012_113-33.p2dfmt";
 constexpr char kAirfoil[] = "airfoils/naca0012.dat";
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -174,7 +168,7 @@ v1::EvaluatePointsRequest PointsRequest(const std::string& id, int points, std::
 
 // Imports the 225 x 65 grid as `id` and fits it (revision 1).
 void ImportAndFit(client::Client& client, const std::string& id) {
-  const std::string bytes = ReadFileToString(SharedData(kNaca)).value();
+  const std::string bytes = ReadFileToString(SharedDataPath(kNaca)).value();
   Check(client.ImportPlot3d(bytes, id, kNaca, /*planar_view=*/false).status(), "import");
   Check(client.Fit(id, KindsSpec()).status(), "fit");
 }
@@ -330,8 +324,8 @@ void SoakClient(const Server& server, int index, absl::Time end, const std::stri
   auto client = server.NewClient();
   std::mt19937 random(100 + index);
   const std::string own = absl::StrCat("soak-", index);
-  const std::string small = ReadFileToString(SharedData(kSmall)).value();
-  const std::string airfoil = ReadFileToString(SharedData(kAirfoil)).value();
+  const std::string small = ReadFileToString(SharedDataPath(kSmall)).value();
+  const std::string airfoil = ReadFileToString(SharedDataPath(kAirfoil)).value();
   // Times `call` and records its status (errors are counted in the stats, not returned).
   auto timed = [&](const std::string& method, const auto& call) {
     const auto t = Clock::now();

@@ -38,6 +38,7 @@
 #include "core/io/file_util.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::bench {
 namespace {
@@ -108,13 +109,6 @@ ServerProcess& SharedServer() {
   return *server;
 }
 
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
-
 void BM_IdleServerMemory(benchmark::State& state) {
   ServerProcess server;  // fresh: nothing imported
   auto client = client::Client::Connect(server.target());
@@ -177,7 +171,7 @@ void BM_EvaluatePointsUnary(benchmark::State& state) {
   auto client = client::Client::Connect(SharedServer().target());
   static bool imported = false;
   if (!imported) {
-    const std::string bytes = ReadFileToString(SharedData("surfaces/m6_small.fmt")).value();
+    const std::string bytes = ReadFileToString(SharedDataPath("surfaces/m6_small.fmt")).value();
     if (absl::Status s = client->ImportPlot3d(bytes, "m6", "", false).status(); !s.ok()) {
       return state.SkipWithError(s.ToString().c_str());
     }
@@ -262,7 +256,7 @@ void BM_FitThroughApi(benchmark::State& state) {
   const std::string& file = kFiles[state.range(0)];
   state.SetLabel(file);
   auto client = client::Client::Connect(SharedServer().target());
-  const std::string bytes = ReadFileToString(SharedData(file)).value();
+  const std::string bytes = ReadFileToString(SharedDataPath(file)).value();
   const bool planar = IsTwoPlaneGrid(ParsePlot3d(bytes, file).value());
   const std::string id = absl::StrCat("fit-", state.range(0));
   (void)client->Delete(id);
@@ -284,7 +278,8 @@ constexpr double kPi = 3.14159265358979323846;
 // Imports the pitching NACA 0012 as `id` (its 2D view) and fits it to the default tolerances by
 // boundary kind; the fit's revision, or 0 (and the error in `error`).
 int64_t ImportPitchGrid(client::Client& client, const std::string& id, std::string* error) {
-  absl::StatusOr<std::string> bytes = ReadFileToString(SharedData("grids/n0012_pitch_257x129.fmt"));
+  absl::StatusOr<std::string> bytes =
+      ReadFileToString(SharedDataPath("grids/n0012_pitch_257x129.fmt"));
   if (!bytes.ok()) {
     *error = bytes.status().ToString();
     return 0;

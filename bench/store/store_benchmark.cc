@@ -43,6 +43,7 @@
 #include "core/io/file_util.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
+#include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
 namespace splinegrid::bench {
@@ -57,13 +58,6 @@ using splinegrid::testing::WaitForPort;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kReplicas = 3;
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 std::string Address(int port) { return absl::StrCat("127.0.0.1:", port); }
 
@@ -286,7 +280,7 @@ std::map<std::string, double>& Results() {
 absl::StatusOr<v1::FitGridResponse> ImportAndFit(client::Client& client, const std::string& file,
                                                  const std::string& id, double* import_us,
                                                  double* fit_us) {
-  absl::StatusOr<std::string> bytes = ReadFileToString(SharedData(file));
+  absl::StatusOr<std::string> bytes = ReadFileToString(SharedDataPath(file));
   if (!bytes.ok()) return bytes.status();
   absl::StatusOr<MultiBlockGrid> parsed = ParsePlot3d(*bytes, file);
   if (!parsed.ok()) return parsed.status();

@@ -30,6 +30,7 @@
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::testing {
 namespace {
@@ -38,12 +39,6 @@ using ::testing::HasSubstr;
 
 const std::string kBinary = SPLINEGRID_BINARY_DIR "/splinegrid";
 const std::string kSource = SPLINEGRID_SOURCE_DIR;
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA"))
-    return std::string(dir) + "/" + relative;
-  return kSource + "/../shared/data/" + relative;
-}
 
 // A port that was free a moment ago (bind to port 0, read it back, close).
 int FreePort() {
@@ -137,7 +132,7 @@ class EndToEndTest : public ::testing::Test {
   // A grid `name` with a fitted, a faired and a deformed revision (step 4) of the coarse
   // NACA 0012 C-grid.
   void MakeGridWithRevisions(const std::string& name) {
-    const Result fit = Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+    const Result fit = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
                                         " --name=", name, " --kinds"));
     ASSERT_EQ(fit.exit_code, 0) << fit.out;
     const Result fair = Cli(absl::StrCat("fair ", name));
@@ -179,14 +174,13 @@ class EndToEndTest : public ::testing::Test {
 };
 
 TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
-  const Result fit = Cli(
-      absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
-                   " --name=naca --ctl=40,16 --allow_folds"));
+  const Result fit = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
+                                      " --name=naca --ctl=40,16 --allow_folds"));
   // These counts fold sub-cells (issue 13.3): stored with --allow_folds, exit 3 says so.
   ASSERT_EQ(fit.exit_code, 3) << fit.out;
   EXPECT_THAT(fit.out, HasSubstr("grids/naca revision 1: 3729 points -> 640 control points"));
 
-  const Result tol = Cli(absl::StrCat("fit ", SharedData("grids/rae2822_257x97.fmt"),
+  const Result tol = Cli(absl::StrCat("fit ", SharedDataPath("grids/rae2822_257x97.fmt"),
                                       " --name=rae --tol=1e-3 --json --allow_folds"));
   // 1e-3 folds sub-cells near the far field (not repaired, issue 13.3): stored, exit 3.
   ASSERT_EQ(tol.exit_code, 3) << tol.out;
@@ -240,14 +234,14 @@ TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
   const Result python = RunCommand(
       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
                    "/python/examples/fit_and_refine.py --server=127.0.0.1:", port_,
-                   " --grid=", SharedData("grids/n0012_225-65.p2dfmt")));  // by kinds: no fold
+                   " --grid=", SharedDataPath("grids/n0012_225-65.p2dfmt")));  // by kinds: no fold
   ASSERT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out, HasSubstr("(1, 257, 897, 2)"));  // level 2 of the 225 x 65 grid
 }
 
 TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
-  const Result fit =
-      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=coarse --kinds"));
+  const Result fit = Cli(
+      absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --name=coarse --kinds"));
   ASSERT_EQ(fit.exit_code, 0) << fit.out;
   EXPECT_THAT(fit.out, HasSubstr("tolerances: met"));
   // The deviation of each kind against the tolerance it was held to, relative to the chord
@@ -275,20 +269,22 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
 
 TEST_F(EndToEndTest, CliFitsAnAirfoilLocally) {
   const std::string csv = (dir_ / "rae.csv").string();
-  const Result fit = Cli(absl::StrCat("airfoil ", SharedData("airfoils/rae2822.dat"), " -o ", csv));
+  const Result fit =
+      Cli(absl::StrCat("airfoil ", SharedDataPath("airfoils/rae2822.dat"), " -o ", csv));
   ASSERT_EQ(fit.exit_code, 0) << fit.out;
   EXPECT_THAT(fit.out, HasSubstr("sharp trailing edge"));
   EXPECT_THAT(fit.out, HasSubstr("(within 0.0001)"));
   EXPECT_THAT(fit.out, HasSubstr("0 spurious"));
   const std::string text = ReadFileToString(csv).value();
   EXPECT_EQ(text.rfind("u,x,y,curvature\n", 0), 0u);
-  EXPECT_NE(Cli(absl::StrCat("airfoil ", SharedData("grids/n0012_113-33.p2dfmt"))).exit_code, 0);
+  EXPECT_NE(Cli(absl::StrCat("airfoil ", SharedDataPath("grids/n0012_113-33.p2dfmt"))).exit_code,
+            0);
 }
 
 // --face sets explicit kinds (issue 13, point 5): the C-grid's far field (j max) as a wall is
 // held to the wall tolerance; a bad token is named with exit status 2.
 TEST_F(EndToEndTest, CliFitSetsFaceKinds) {
-  const Result fit = Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+  const Result fit = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
                                       " --name=faces --face 0:jmax=wall --ref_length 1"
                                       " --allow_folds"));
   // 2 sub-cells fold at level 2 near (13, 21) (issue 13.3): stored with --allow_folds, exit 3.
@@ -299,7 +295,7 @@ TEST_F(EndToEndTest, CliFitSetsFaceKinds) {
   EXPECT_THAT(fit.out,
               ::testing::MatchesRegex("(.|\n)*deviation: wall [0-9.e-]+ <= 0.00015 met(.|\n)*"));
   for (const char* token : {"0:lmin=wall", "0:imin=symmetry", "x:imin=wall", "0:imin"}) {
-    const Result bad = Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+    const Result bad = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
                                         " --name=bad --face 1:jmin=outer,", token));
     EXPECT_EQ(bad.exit_code, 2) << bad.out;
     EXPECT_THAT(bad.out, HasSubstr(absl::StrCat("--face: '", token, "'")));
@@ -310,7 +306,7 @@ TEST_F(EndToEndTest, CliFitSetsFaceKinds) {
 // +-1e-3 chord on its middle points at 1e-6 chord has a cusp (measured: curvature 10393 against
 // the reference's 892).
 TEST_F(EndToEndTest, CliAirfoilFailureWritesNoCurvature) {
-  std::istringstream lines(ReadFileToString(SharedData("airfoils/rae2822.dat")).value());
+  std::istringstream lines(ReadFileToString(SharedDataPath("airfoils/rae2822.dat")).value());
   std::vector<std::string> rows;
   for (std::string line; std::getline(lines, line);) rows.push_back(line);
   const int m = static_cast<int>(rows.size()) - 1;  // after the name line
@@ -334,10 +330,9 @@ TEST_F(EndToEndTest, CliAirfoilFailureWritesNoCurvature) {
 
 TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
   const std::string vts = (dir_ / "grid.vts").string();
-  const Result offset =
-      Cli(absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"),
-                       " --name=naca-og --layers=32 --first=1e-4 --far=20 --points=129 -o ", vts,
-                       " --allow_folds"));
+  const Result offset = Cli(absl::StrCat(
+      "offset ", SharedDataPath("airfoils/naca0012.dat"),
+      " --name=naca-og --layers=32 --first=1e-4 --far=20 --points=129 -o ", vts, " --allow_folds"));
   // The interpolated O-grid folds sub-cells at its clamped seam (generate_test.cc): stored with
   // --allow_folds, and exit 3 says so.
   ASSERT_EQ(offset.exit_code, 3) << offset.out;
@@ -350,7 +345,7 @@ TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
   // Transfinite, as binary Plot3D: every cell of the written grid has a positive area.
   const std::string x = (dir_ / "grid.x").string();
   const Result transfinite = Cli(absl::StrCat(
-      "offset ", SharedData("airfoils/rae2822.dat"),
+      "offset ", SharedDataPath("airfoils/rae2822.dat"),
       " --name=rae-og --method=transfinite --layers=24 --first=1e-3 --far=10 --points=97 --json "
       "--allow_folds -o ",
       x));
@@ -375,12 +370,12 @@ TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
   EXPECT_EQ(non_positive, 0);
 
   // Taken names and bad layers are refused, naming the field (usage errors exit 2).
-  const Result taken = Cli(absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"),
+  const Result taken = Cli(absl::StrCat("offset ", SharedDataPath("airfoils/naca0012.dat"),
                                         " --name=naca-og --layers=8 --points=65"));
   EXPECT_EQ(taken.exit_code, 1);
   EXPECT_THAT(taken.out, HasSubstr("ALREADY_EXISTS"));
-  const Result bad = Cli(
-      absl::StrCat("offset ", SharedData("airfoils/naca0012.dat"), " --name=bad --first=-1e-5"));
+  const Result bad = Cli(absl::StrCat("offset ", SharedDataPath("airfoils/naca0012.dat"),
+                                      " --name=bad --first=-1e-5"));
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.out, HasSubstr("first_height = -1e-05"));
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/bad")));
@@ -415,7 +410,7 @@ with Client(sys.argv[1]) as client:
                   .ok());
   const Result python = RunCommand(
       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", script,
-                   " 127.0.0.1:", port_, " ", SharedData("airfoils/sc20714.dat")));
+                   " 127.0.0.1:", port_, " ", SharedDataPath("airfoils/sc20714.dat")));
   ASSERT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out,
               HasSubstr("generated grids/py-sc2 (33, 129, 2) negative 0 positive True revision 1"));
@@ -429,7 +424,7 @@ TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
   const Result python = RunCommand(
       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
                    "/python/examples/fair_and_plot.py --server=127.0.0.1:", port_,
-                   " --grid=", SharedData("grids/n0012_113-33.p2dfmt"), " --png=", png));
+                   " --grid=", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --png=", png));
   ASSERT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out, HasSubstr("fairing weight"));
   const std::string image = ReadFileToString(png).value();
@@ -439,7 +434,7 @@ TEST_F(EndToEndTest, PythonFairsAndPlotsWallCurvature) {
 
 TEST_F(EndToEndTest, CliDeformsRefusesAFoldAndGetsTheDeformedRevision) {
   ASSERT_EQ(
-      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=naca --kinds"))
+      Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --name=naca --kinds"))
           .exit_code,
       0);
   const Result deform =
@@ -493,10 +488,10 @@ TEST_F(EndToEndTest, CliDeformsRefusesAFoldAndGetsTheDeformedRevision) {
 }
 
 TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) {
-  ASSERT_EQ(
-      Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"), " --name=watched --kinds"))
-          .exit_code,
-      0);
+  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
+                             " --name=watched --kinds"))
+                .exit_code,
+            0);
   // In the background; --after=1: revisions after the fit, the stored ones first, so the
   // deformations below are seen however late the watch starts.
   const std::string out = (dir_ / "watch.out").string();
@@ -525,7 +520,7 @@ TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) 
   EXPECT_THAT(text, HasSubstr("exit=0"));
 
   // ^C ends a watch cleanly (exit 0); --json prints one object per line.
-  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedData("grids/n0012_113-33.p2dfmt"),
+  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
                              " --name=again --ctl=40,16 --allow_folds"))
                 .exit_code,
             3);  // stored with folds (issue 13.3)
@@ -620,7 +615,7 @@ TEST_F(EndToEndTest, CliImportOfADamagedFileFailsAndStoresNothing) {
   EXPECT_NE(crc.exit_code, 0) << crc.out;
   EXPECT_THAT(crc.out, HasSubstr("CRC mismatch"));
   // A Plot3D file is not an archive: the tool says what to do instead.
-  const std::string plot3d = SharedData("grids/n0012_113-33.p2dfmt");
+  const std::string plot3d = SharedDataPath("grids/n0012_113-33.p2dfmt");
   const Result grid = Cli(absl::StrCat("import ", plot3d));
   EXPECT_EQ(grid.exit_code, 2) << grid.out;
   EXPECT_THAT(grid.out, HasSubstr(absl::StrCat(plot3d, " is not a splinegrid archive")));
@@ -676,7 +671,7 @@ TEST_F(EndToEndTest, CppPitchingExampleRunsWithoutFolds) {
   const std::string acked = (dir_ / "cpp.acked").string();
   const Result run = RunCommand(absl::StrCat(
       SPLINEGRID_BINARY_DIR, "/splinegrid_pitching --server=127.0.0.1:", port_,
-      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt"),
+      " --steps=10 --amplitude=20 --grid=", SharedDataPath("grids/n0012_pitch_257x129.fmt"),
       " --acked=", acked, " --keep"));
   ASSERT_EQ(run.exit_code, 0) << run.out;
   ExpectAckedRevisionsStored("pitching-cpp", acked, 10);
@@ -689,11 +684,12 @@ TEST_F(EndToEndTest, CppPitchingExampleRunsWithoutFolds) {
   EXPECT_THAT(run.out, HasSubstr("folds: 0 (folded cells over all steps), 0 steps refused"));
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));
   // Without --keep the grid is deleted at the end.
-  ASSERT_EQ(RunCommand(absl::StrCat(SPLINEGRID_BINARY_DIR,
-                                    "/splinegrid_pitching --quiet --steps=2 --server=127.0.0.1:",
-                                    port_, " --grid=", SharedData("grids/n0012_pitch_257x129.fmt")))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunCommand(absl::StrCat(SPLINEGRID_BINARY_DIR,
+                              "/splinegrid_pitching --quiet --steps=2 --server=127.0.0.1:", port_,
+                              " --grid=", SharedDataPath("grids/n0012_pitch_257x129.fmt")))
+          .exit_code,
+      0);
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("pitching")));
 }
 
@@ -702,7 +698,7 @@ TEST_F(EndToEndTest, PythonPitchingExampleRunsWithoutFolds) {
   const Result python = RunCommand(absl::StrCat(
       "PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
       "/python/examples/pitching.py --server=127.0.0.1:", port_,
-      " --steps=10 --amplitude=20 --grid=", SharedData("grids/n0012_pitch_257x129.fmt"),
+      " --steps=10 --amplitude=20 --grid=", SharedDataPath("grids/n0012_pitch_257x129.fmt"),
       " --acked=", acked, " --keep"));
   ASSERT_EQ(python.exit_code, 0) << python.out;
   ExpectAckedRevisionsStored("pitching-py", acked, 10);
@@ -732,7 +728,7 @@ TEST_F(EndToEndTest, PitchingClientsAcknowledgeStepsWhoseAnswersWereLost) {
   ASSERT_FALSE(proxy_port.empty()) << ReadFileToString((dir_ / "proxy.log").string()).value_or("");
   const std::string through = absl::StrCat(" --server=127.0.0.1:", proxy_port,
                                            " --steps=12 --amplitude=20 --quiet --keep --grid=",
-                                           SharedData("grids/n0012_pitch_257x129.fmt"));
+                                           SharedDataPath("grids/n0012_pitch_257x129.fmt"));
   const std::string cpp_acked = (dir_ / "cpp.acked").string();
   const Result cpp = RunCommand(
       absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching", through, " --acked=", cpp_acked));
@@ -764,7 +760,7 @@ TEST_F(EndToEndTest, PitchingClientsSurviveAServerKilledAndRestartedWithADurable
   constexpr int kSteps = 60;
   const std::string common = absl::StrCat(
       " --server=127.0.0.1:", port_, " --steps=", kSteps,
-      " --amplitude=10 --quiet --keep --grid=", SharedData("grids/n0012_pitch_257x129.fmt"));
+      " --amplitude=10 --quiet --keep --grid=", SharedDataPath("grids/n0012_pitch_257x129.fmt"));
   const std::vector<std::pair<std::string, std::string>> runs = {
       {"pitching-cpp", absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching", common)},
       {"pitching-py",
@@ -793,9 +789,10 @@ TEST_F(EndToEndTest, PitchingClientsSurviveAServerKilledAndRestartedWithADurable
 }
 
 TEST_F(EndToEndTest, SigtermDrainsAndExitsZeroWithOneLogLinePerCall) {
-  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedData("surfaces/m6_small.fmt"), " --name=m6 --ctl=8,8"))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      Cli(absl::StrCat("fit ", SharedDataPath("surfaces/m6_small.fmt"), " --name=m6 --ctl=8,8"))
+          .exit_code,
+      0);
   EXPECT_EQ(Cli("health").exit_code, 0);
   EXPECT_EQ(Stop(), 0);
   const std::string log = ReadLog();

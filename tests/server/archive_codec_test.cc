@@ -208,8 +208,7 @@ GridRevision MakeRevision(GridFit fit, const GridFitOptions& options, int64_t nu
 class ArchiveCodecTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    grid_ = new MultiBlockGrid(
-        ReadPlot3dFile(testing::SharedData("grids/n0012_225-65.p2dfmt")).value());
+    grid_ = new MultiBlockGrid(ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value());
     options_ = new GridFitOptions();
     BoundaryTolerances tolerances;  // interior stays +infinity: a sentinel that must survive
     tolerances.wall = 1e-3;

@@ -37,7 +37,7 @@ class AuthTest : public ServiceTest {
     WriteTokens(Tokens());
     options_.tokens_file = (dir_ / "tokens").string();
     StartServer();
-    grid_bytes_ = ReadFileToString(SharedData(kGrid)).value();
+    grid_bytes_ = ReadFileToString(SharedDataPath(kGrid)).value();
   }
   void TearDown() override {
     server_.reset();
@@ -164,7 +164,7 @@ TEST_F(AuthTest, EachRoleMayDoItsClassOfCalls) {
   generate.set_layers(16);
   generate.set_first_height(1e-3);
   generate.set_distance(10.0);
-  generate.set_airfoil_file(ReadFileToString(SharedData("airfoils/naca0012.dat")).value());
+  generate.set_airfoil_file(ReadFileToString(SharedDataPath("airfoils/naca0012.dat")).value());
   ExpectCode(reader->Generate(generate).status(), absl::StatusCode::kPermissionDenied);
   const absl::StatusOr<v1::GenerateGridResponse> generated = alice->Generate(generate);
   ASSERT_TRUE(generated.ok()) << generated.status();

@@ -46,7 +46,7 @@ TEST_F(ServiceTest, ConcurrentClientsMixingEveryMethod) {
   FitCounts("shared", 10, 10);
   const std::string before =
       client_->Get("shared", 0, v1::GRID_VIEW_FULL).value().SerializeAsString();
-  const MultiBlockGrid sphere = ReadPlot3dFile(SharedData("surfaces/even_sphere.fmt")).value();
+  const MultiBlockGrid sphere = ReadPlot3dFile(SharedDataPath("surfaces/even_sphere.fmt")).value();
 
   std::atomic<int> unexpected{0}, evaluated{0};
   auto worker = [&](int t) {

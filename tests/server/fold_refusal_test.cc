@@ -59,7 +59,7 @@ std::vector<int64_t> IndependentFolds(client::Client& client, const std::string&
 }
 
 StructuredBlock Original(const std::string& relative) {
-  const std::string bytes = ReadFileToString(SharedData(relative)).value();
+  const std::string bytes = ReadFileToString(SharedDataPath(relative)).value();
   return ParsePlot3d(bytes, relative).value().blocks.at(0);
 }
 

@@ -36,7 +36,7 @@ v1::GenerateGridRequest SmallRequest(const std::string& id) {
 }
 
 std::string AirfoilText(const std::string& file) {
-  return ReadFileToString(SharedData("airfoils/" + file)).value();
+  return ReadFileToString(SharedDataPath("airfoils/" + file)).value();
 }
 
 // Twice the signed area of cell (i, j) of a 2D block (positive counter-clockwise in (i, j)).

@@ -18,7 +18,8 @@ class ReferenceLengthServiceTest : public ServiceTest {
  protected:
   // Imports the 225 x 65 C-grid scaled by `factor` as a Plot3D text file under `id`.
   void ImportScaled(double factor, const std::string& id) {
-    absl::StatusOr<MultiBlockGrid> grid = ReadPlot3dFile(SharedData("grids/n0012_225-65.p2dfmt"));
+    absl::StatusOr<MultiBlockGrid> grid =
+        ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt"));
     ASSERT_TRUE(grid.ok()) << grid.status();
     for (StructuredBlock& block : grid->blocks) {
       for (double& x : block.coords()) x *= factor;

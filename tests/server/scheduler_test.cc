@@ -348,7 +348,7 @@ TEST(StreamLimitTcpTest, EachConnectionIsAPrincipalOfItsOwn) {
   };
   auto alice = connect();
   auto bob = connect();
-  const std::string bytes = ReadFileToString(SharedData("grids/n0012_113-33.p2dfmt")).value();
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_113-33.p2dfmt")).value();
   ASSERT_TRUE(alice->ImportPlot3d(bytes, "naca", "naca", false).ok());
   auto open = [](client::Client& client, grpc::ClientContext* context) {
     context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));

@@ -241,7 +241,7 @@ TEST_F(SmallServerTest, OverTheMemoryBudgetIsResourceExhausted) {
   options_.memory_budget_bytes = 400 << 10;  // 400 KiB: the 113x33 grid fits, 225x65 does not
   StartServer();
   ImportShared("grids/n0012_113-33.p2dfmt", "small");
-  const std::string bytes = ReadFileToString(SharedData("grids/n0012_225-65.p2dfmt")).value();
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
   EXPECT_THAT(client_->ImportPlot3d(bytes, "big", "", false).status(),
               StatusIs(absl::StatusCode::kResourceExhausted, "memory budget"));
   EXPECT_EQ(client_->List().value().size(), 1u);

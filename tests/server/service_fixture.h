@@ -12,15 +12,9 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::testing {
-
-inline std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 // A status with `code` whose message contains `fragment`.
 MATCHER_P2(StatusIs, code, fragment, "") {
@@ -52,7 +46,7 @@ class ServiceTest : public ::testing::Test {
 
   // Imports a shared Plot3D file under `id` (planar view for two-plane files).
   v1::Grid ImportShared(const std::string& relative, const std::string& id, bool planar = false) {
-    const std::string bytes = ReadFileToString(SharedData(relative)).value();
+    const std::string bytes = ReadFileToString(SharedDataPath(relative)).value();
     absl::StatusOr<v1::Grid> grid = client_->ImportPlot3d(bytes, id, relative, planar);
     EXPECT_TRUE(grid.ok()) << grid.status();
     return grid.ok() ? *grid : v1::Grid();

@@ -13,7 +13,7 @@ namespace {
 using ::testing::HasSubstr;
 
 MultiBlockGrid ReadShared(const std::string& relative) {
-  return ReadPlot3dFile(SharedData(relative)).value();
+  return ReadPlot3dFile(SharedDataPath(relative)).value();
 }
 
 TEST_F(ServiceTest, ImportPlot3dDescribesTheSource) {

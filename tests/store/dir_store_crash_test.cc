@@ -15,6 +15,7 @@
 #include "core/io/file_util.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
 namespace splinegrid::testing {
@@ -23,11 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kBinary = SPLINEGRID_BINARY_DIR "/splinegrid";
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) return std::string(dir) + "/" + relative;
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 class DirStoreCrashTest : public ::testing::Test {
  protected:
@@ -87,8 +83,9 @@ class DirStoreCrashTest : public ::testing::Test {
 
 TEST_F(DirStoreCrashTest, EveryAcknowledgedRevisionSurvivesSigkill) {
   std::unique_ptr<client::Client> client = Start();
-  const std::string bytes = ReadFileToString(SharedData("grids/n0012_225-65.p2dfmt")).value();
-  const absl::StatusOr<v1::Grid> imported = client->ImportPlot3d(bytes, "pitch", "NACA 0012", false);
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
+  const absl::StatusOr<v1::Grid> imported =
+      client->ImportPlot3d(bytes, "pitch", "NACA 0012", false);
   ASSERT_TRUE(imported.ok()) << imported.status() << "\n" << server_->ReadLog();
   v1::FitSpec spec;
   spec.set_tolerance(1e-3);
@@ -103,7 +100,8 @@ TEST_F(DirStoreCrashTest, EveryAcknowledgedRevisionSurvivesSigkill) {
   const int delay_us = std::uniform_int_distribution<int>(0, 3000)(random);
   std::atomic<int> acknowledged{0};
   std::thread killer([&] {
-    while (acknowledged.load() < kill_after) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    while (acknowledged.load() < kill_after)
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
     std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
     kill(server_->pid(), SIGKILL);
   });
@@ -179,7 +177,7 @@ TEST_F(DirStoreCrashTest, EveryAcknowledgedRevisionSurvivesSigkill) {
 // A damaged revision file is reported and skipped; the rest of the grid loads.
 TEST_F(DirStoreCrashTest, DamagedFilesAreSkippedWithAMessage) {
   std::unique_ptr<client::Client> client = Start();
-  const std::string bytes = ReadFileToString(SharedData("grids/n0012_225-65.p2dfmt")).value();
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
   ASSERT_TRUE(client->ImportPlot3d(bytes, "pitch", "", false).ok());
   v1::FitSpec spec;
   spec.mutable_control_counts()->set_i(40);

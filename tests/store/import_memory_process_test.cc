@@ -17,6 +17,7 @@
 #include "core/io/file_util.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
 namespace splinegrid::testing {
@@ -30,13 +31,6 @@ constexpr int64_t kBudgetMiB = 64;
 // the worker and watchdog threads' stacks touched, the allocator's arenas); streams add gRPC's
 // per-call buffers. 48 MiB leaves room for allocator slack.
 constexpr int64_t kOverheadMiB = 48;
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 // VmRSS of `pid` in bytes (0 when unreadable).
 int64_t ResidentBytes(int pid) {
@@ -135,7 +129,7 @@ TEST(ImportMemoryProcessTest, HeaderAmplificationStaysWithinBudgetPlusOverhead) 
   int64_t peak = with_streams;
   for (const char* name :
        {"grids/n0012_225-65.p2dfmt", "grids/rae2822_257x97.fmt", "grids/n0012_113-33.p2dfmt"}) {
-    const std::string bytes = ReadFileToString(SharedData(name)).value();
+    const std::string bytes = ReadFileToString(SharedDataPath(name)).value();
     absl::StatusOr<v1::Grid> grid = other->ImportPlot3d(bytes, "", name, false);
     ASSERT_TRUE(grid.ok()) << name << ": " << grid.status();
     v1::FitSpec spec;

@@ -39,6 +39,7 @@
 #include "core/io/file_util.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
 namespace splinegrid::testing {
@@ -53,12 +54,6 @@ const std::string kRender = SPLINEGRID_SOURCE_DIR "/deploy/nginx/render.sh";
 constexpr int kReplicas = 3;
 constexpr int kSteps = 200;
 constexpr int kKillAtStep = 100;
-
-std::string SharedData(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA"))
-    return std::string(dir) + "/" + relative;
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 std::string Address(int port) { return absl::StrCat("127.0.0.1:", port); }
 
@@ -378,7 +373,7 @@ TEST_F(TopologyTest, PitchingRunSurvivesKillingTheServingReplica) {
   const auto remaining = [&] { return std::max(run_deadline - absl::Now(), absl::ZeroDuration()); };
   ChildProcess pitching({kPitching, absl::StrCat("--server=", Address(nginx_port_)),
                          absl::StrCat("--steps=", kSteps), absl::StrCat("--name=", id),
-                         absl::StrCat("--grid=", SharedData("grids/n0012_pitch_257x129.fmt")),
+                         absl::StrCat("--grid=", SharedDataPath("grids/n0012_pitch_257x129.fmt")),
                          absl::StrCat("--acked=", acked_file.string()), "--keep", "--quiet"},
                         (dir_ / "pitching.log").string());
 
@@ -549,7 +544,7 @@ TEST_F(TopologyTest, RedisOutageTurnsReplicaNotServingAndBack) {
   ASSERT_TRUE(WaitServing(port, absl::Seconds(20))) << replica->ReadLog();
   replicas_.push_back(std::move(replica));  // for the logs of a failed test
   auto client = DirectClient(port);
-  const std::string bytes = ReadFileToString(SharedData("grids/n0012_113-33.p2dfmt")).value();
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_113-33.p2dfmt")).value();
   ASSERT_TRUE(client->ImportPlot3d(bytes, "outage", "", /*planar_view=*/false).ok());
   v1::FitSpec spec;
   spec.set_tolerance(1e-3);
