@@ -31,6 +31,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/test_data.h"
+#include "tests/store/server_process.h"
 
 namespace splinegrid::testing {
 namespace {
@@ -39,19 +40,6 @@ using ::testing::HasSubstr;
 
 const std::string kBinary = SPLINEGRID_BINARY_DIR "/splinegrid";
 const std::string kSource = SPLINEGRID_SOURCE_DIR;
-
-// A port that was free a moment ago (bind to port 0, read it back, close).
-int FreePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
-  socklen_t len = sizeof(addr);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
 
 struct Result {
   int exit_code;

@@ -9,41 +9,9 @@
 // must give a grid or INVALID_ARGUMENT; a grid must encode in the layout detected and read back.
 #include <cstddef>
 #include <cstdint>
-#include <string>
-#include <string_view>
 
-#include "absl/strings/str_cat.h"
-#include "core/io/plot3d.h"
-#include "core/io/plot3d_memory.h"
-#include "tests/fuzz/fuzz_memory.h"
-#include "tests/fuzz/fuzz_util.h"
-
-namespace {
-
-constexpr int64_t kBudgetBytes = int64_t{64} << 20;
-
-}  // namespace
+#include "tests/fuzz/fuzz_plot3d.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-  const int64_t bound = splinegrid::Plot3dParseBytesBound(bytes);
-  if (bound > kBudgetBytes) return 0;  // refused before parsing
-  splinegrid::Plot3dFormat format;
-  splinegrid::fuzz::PeakAllocation peak;
-  absl::StatusOr<splinegrid::MultiBlockGrid> grid = splinegrid::ParsePlot3d(bytes, "fuzz", &format);
-  const int64_t used = peak.Peak();
-  FUZZ_CHECK(used <= bound + 16384 + 16 * static_cast<int64_t>(size),
-             absl::StrCat("parsing ", size, " bytes took ", used,
-                          " heap bytes at once; the bound is ", bound));
-  if (!grid.ok()) {
-    splinegrid::fuzz::CheckRejection(grid.status());
-    return 0;
-  }
-  // Round trip: what was read must be writable in the layout detected, and read back alike.
-  absl::StatusOr<std::string> encoded = splinegrid::EncodePlot3d(*grid, format);
-  FUZZ_CHECK(encoded.ok(), encoded.status().ToString());
-  absl::StatusOr<splinegrid::MultiBlockGrid> reread = splinegrid::ParsePlot3d(*encoded, "fuzz");
-  FUZZ_CHECK(reread.ok(), reread.status().ToString());
-  FUZZ_CHECK(reread->blocks.size() == grid->blocks.size(), "block count changed");
-  return 0;
+  return splinegrid::fuzz::FuzzPlot3d(data, size);
 }
