@@ -22,6 +22,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "client/cli/flags.h"
+#include "client/cli/grid_output.h"
 #include "client/cli/output.h"
 #include "client/cli/serve_flags.h"
 #include "client/client.h"
@@ -31,7 +32,6 @@
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "core/io/record_file.h"
-#include "core/io/vtk.h"
 #include "core/util/status_macros.h"
 #include "server/server.h"
 
@@ -114,50 +114,6 @@ std::string IdFromPath(const std::string& path) {
   }
   if (id.empty() || !std::isalpha(static_cast<unsigned char>(id[0]))) id = "grid-" + id;
   return id.substr(0, 63);
-}
-
-// OK when `out` ends in .vts, .vtm, .x or .xyz (what WriteEvaluatedGrid writes).
-absl::Status CheckGridOutput(const std::string& out) {
-  const std::string ext = std::filesystem::path(out).extension().string();
-  if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz") {
-    return Usage(absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x or .xyz"));
-  }
-  return absl::OkStatus();
-}
-
-// Writes an evaluation to `out` (VTK .vts for one block or .vtm, binary .x or text .xyz
-// Plot3D); returns the number of points written.
-absl::StatusOr<int64_t> WriteEvaluatedGrid(const std::string& out,
-                                           const client::EvaluatedGrid& result) {
-  const std::string ext = std::filesystem::path(out).extension().string();
-  MultiBlockGrid grid;
-  std::vector<std::vector<VtkPointArray>> arrays;
-  int64_t points = 0;
-  for (const client::EvaluatedBlock& block : result.blocks) {
-    points += block.points.num_points();
-    std::vector<VtkPointArray> fields;
-    if (!block.du.empty()) {
-      const int s = block.points.spatial_dim();
-      fields = {{"dX_du", s, block.du}, {"dX_dv", s, block.dv}, {"dX_dw", s, block.dw}};
-    }
-    arrays.push_back(std::move(fields));
-    grid.blocks.push_back(block.points);
-  }
-  if (ext == ".vts") {
-    if (grid.blocks.size() != 1) {
-      return Usage(
-          absl::StrCat(grid.blocks.size(), " blocks: write .vtm, or choose one with --block"));
-    }
-    SG_RETURN_IF_ERROR(WriteVts(out, grid.blocks[0], arrays[0]));
-  } else if (ext == ".vtm") {
-    SG_RETURN_IF_ERROR(WriteVtm(out, grid, arrays));
-  } else {
-    SG_RETURN_IF_ERROR(
-        WritePlot3dFile(out, grid,
-                        DefaultPlot3dFormat(grid, ext == ".x" ? Plot3dEncoding::kBinaryLittleEndian
-                                                              : Plot3dEncoding::kAscii)));
-  }
-  return points;
 }
 
 }  // namespace
