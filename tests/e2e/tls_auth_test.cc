@@ -2,20 +2,12 @@
 // round trips (CLI, C++ and Python clients) with certificates made by `openssl` at test time,
 // plaintext refused by a TLS server and on non-loopback addresses without --insecure, the
 // tokens file reloaded on SIGHUP, and no token ever in the server's output.
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -46,71 +38,28 @@ struct Result {
   std::string out;  // stdout and stderr
 };
 
-// Runs `[VAR=VALUE...] PROGRAM ARGS` (bounded by `timeout` 60 s) and collects its output and exit code.
+// Runs `[VAR=VALUE...] PROGRAM ARGS` (bounded by `timeout` 60 s) and collects its output and
+// exit code.
 Result Shell(const std::string& command) {
-  FILE* pipe = popen(absl::StrCat("timeout 60 env ", command, " 2>&1").c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+  Result result;
+  result.exit_code = RunShell(absl::StrCat("timeout 60 env ", command), &result.out);
+  return result;
 }
 
-std::string ReadFile(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// `splinegrid serve` as a child process with its output in a log file; killed if still running
-// when destroyed.
-class Server {
+// `splinegrid serve --threads=2 FLAGS...` as a child process (tests/store/server_process.h),
+// with the waits these tests need.
+class Server : public ChildProcess {
  public:
-  Server(const std::vector<std::string>& flags, std::string log) : log_(std::move(log)) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      setpgid(0, 0);
-      const int fd = open(log_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      std::vector<std::string> args = {kBinary, "serve", "--threads=2"};
-      args.insert(args.end(), flags.begin(), flags.end());
-      std::vector<char*> argv;
-      for (std::string& arg : args) argv.push_back(arg.data());
-      argv.push_back(nullptr);
-      execv(kBinary.c_str(), argv.data());
-      _exit(127);
-    }
-  }
-  ~Server() {
-    if (Running()) Stop(SIGKILL);
-  }
+  Server(const std::vector<std::string>& flags, std::string log)
+      : ChildProcess(ServeArgv(flags), std::move(log)) {}
 
-  bool Running() {
-    if (exit_code_ >= 0) return false;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == 0) return true;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return false;
-  }
-  // Waits up to `timeout` for the exit: its code, or -1.
-  int Wait(absl::Duration timeout) {
-    const absl::Time end = absl::Now() + timeout;
-    while (Running() && absl::Now() < end) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return exit_code_;
-  }
-  int Stop(int signal = SIGTERM) {
-    if (Running()) kill(pid_, signal);
-    return Wait(absl::Seconds(20));
-  }
-  void Signal(int signal) { kill(pid_, signal); }
+  bool Running() { return running(); }
+  int Stop(int signal = SIGTERM) { return ChildProcess::Stop(signal, absl::Seconds(20)); }
+  void Signal(int signal) { kill(pid(), signal); }
   // Waits until the port accepts connections (false if the server exits or 20 s pass).
   bool WaitForPort(int port) {
     const absl::Time end = absl::Now() + absl::Seconds(20);
-    while (absl::Now() < end && Running()) {
+    while (absl::Now() < end && running()) {
       if (PortOpen(port)) return true;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -130,12 +79,14 @@ class Server {
     }
     return false;
   }
-  std::string Log() const { return ReadFile(log_); }
+  std::string Log() const { return ReadLog(); }
 
  private:
-  pid_t pid_ = -1;
-  int exit_code_ = -1;
-  std::string log_;
+  static std::vector<std::string> ServeArgv(const std::vector<std::string>& flags) {
+    std::vector<std::string> argv = {kBinary, "serve", "--threads=2"};
+    argv.insert(argv.end(), flags.begin(), flags.end());
+    return argv;
+  }
 };
 
 class TlsAuthTest : public ::testing::Test {
