@@ -238,9 +238,11 @@ absl::StatusOr<StructuredBlock> PlanarBlock(const StructuredBlock& block,
 
 namespace {
 
-// PlanarView, or with `pass_2d_blocks` AsPlanarGrid.
+// PlanarView, or with `pass_2d_blocks` AsPlanarGrid; the layouts of the 3D blocks into
+// `*layouts` when not null.
 absl::StatusOr<MultiBlockGrid> Planarize(const MultiBlockGrid& grid,
-                                         const PlanarViewOptions& options, bool pass_2d_blocks) {
+                                         const PlanarViewOptions& options, bool pass_2d_blocks,
+                                         std::vector<TwoPlaneLayout>* layouts = nullptr) {
   MultiBlockGrid planar;
   planar.blocks.reserve(grid.blocks.size());
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
@@ -252,6 +254,10 @@ absl::StatusOr<MultiBlockGrid> Planarize(const MultiBlockGrid& grid,
     if (!block.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("block ", b, ": ", block.status().message()));
     }
+    if (layouts != nullptr) {
+      SG_ASSIGN_OR_RETURN(TwoPlaneLayout layout, DetectTwoPlaneBlock(grid.blocks[b], options));
+      layouts->push_back(layout);
+    }
     planar.blocks.push_back(*std::move(block));
   }
   return planar;
@@ -262,6 +268,58 @@ absl::StatusOr<MultiBlockGrid> Planarize(const MultiBlockGrid& grid,
 absl::StatusOr<MultiBlockGrid> PlanarView(const MultiBlockGrid& grid,
                                           const PlanarViewOptions& options) {
   return Planarize(grid, options, /*pass_2d_blocks=*/false);
+}
+
+absl::StatusOr<MultiBlockGrid> PlanarView(const MultiBlockGrid& grid,
+                                          const PlanarViewOptions& options,
+                                          std::vector<TwoPlaneLayout>* layouts) {
+  layouts->clear();
+  return Planarize(grid, options, /*pass_2d_blocks=*/false, layouts);
+}
+
+absl::StatusOr<StructuredBlock> TwoPlaneBlock(const StructuredBlock& planar,
+                                              const TwoPlaneLayout& layout) {
+  if (planar.spatial_dim() != 2 || planar.extent(2) != 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("restoring two planes: the block must be 2D with nk = 1, not spatial_dim ",
+                     planar.spatial_dim(), " and nk = ", planar.extent(2)));
+  }
+  const int d = layout.plane_direction;
+  const int c = layout.normal_coordinate;
+  if (d < 0 || d > 2 || c < 0 || c > 2) {
+    return absl::InvalidArgumentError(absl::StrCat("restoring two planes: plane_direction ", d,
+                                                   " and normal_coordinate ", c,
+                                                   " must be from 0 to 2"));
+  }
+  const auto [a, b] = OtherDirections(d);
+  const int kept[2] = {c == 0 ? 1 : 0, c == 2 ? 1 : 2};
+  Extents extents;
+  extents[d] = 2;
+  extents[a] = planar.extent(0);
+  extents[b] = planar.extent(1);
+  StructuredBlock block(extents, 3);
+  const bool has_iblank = planar.iblank().size() == static_cast<size_t>(planar.num_points());
+  if (has_iblank) block.iblank().resize(static_cast<size_t>(block.num_points()));
+  for (int plane = 0; plane < 2; ++plane) {
+    for (int ib = 0; ib < planar.extent(1); ++ib) {
+      for (int ia = 0; ia < planar.extent(0); ++ia) {
+        int index[3];
+        index[d] = plane;
+        index[a] = ia;
+        index[b] = ib;
+        const double* from = planar.Point(ia, ib, 0);
+        double* to = block.Point(index[0], index[1], index[2]);
+        to[kept[0]] = from[0];
+        to[kept[1]] = from[1];
+        to[c] = layout.plane_values[plane];
+        if (has_iblank) {
+          block.iblank()[block.Index(index[0], index[1], index[2])] =
+              planar.iblank()[planar.Index(ia, ib, 0)];
+        }
+      }
+    }
+  }
+  return block;
 }
 
 absl::StatusOr<MultiBlockGrid> AsPlanarGrid(const MultiBlockGrid& grid,

@@ -12,6 +12,8 @@
 #ifndef SPLINEGRID_CORE_IO_PLANAR_VIEW_H_
 #define SPLINEGRID_CORE_IO_PLANAR_VIEW_H_
 
+#include <vector>
+
 #include "absl/status/statusor.h"
 #include "core/grid/structured_grid.h"
 
@@ -50,6 +52,19 @@ absl::StatusOr<StructuredBlock> PlanarBlock(const StructuredBlock& block,
 // a two-plane block (and why).
 absl::StatusOr<MultiBlockGrid> PlanarView(const MultiBlockGrid& grid,
                                           const PlanarViewOptions& options = {});
+// The same, with every block's layout in `*layouts` (one per block, in block order), which
+// TwoPlaneBlock needs to restore the file's 3D form.
+absl::StatusOr<MultiBlockGrid> PlanarView(const MultiBlockGrid& grid,
+                                          const PlanarViewOptions& options,
+                                          std::vector<TwoPlaneLayout>* layouts);
+
+// The inverse of PlanarBlock: the 3D block with extent 2 along layout.plane_direction whose
+// plane p holds the points of 2D `planar` (extents (n_a, n_b, 1), any resolution) with the
+// normal coordinate set to layout.plane_values[p]; iblank, when present, on both planes.
+// INVALID_ARGUMENT when `planar` is not 2D with nk = 1 or the layout's indices are out of range.
+// Writing an evaluated planar grid back as the two-plane file it came from uses this.
+absl::StatusOr<StructuredBlock> TwoPlaneBlock(const StructuredBlock& planar,
+                                              const TwoPlaneLayout& layout);
 
 // The 2D grid of `grid` whether stored in 2D or as two planes: blocks with spatial_dim 2 are
 // copied unchanged, 3D blocks must be two-plane blocks and are replaced by their planar view.

@@ -42,6 +42,23 @@ std::string DescribeBlockValue(const Extents& extents, int spatial_dim, int64_t 
                       ", ", p / (int64_t{extents[0]} * extents[1]), ")");
 }
 
+int64_t SlabPoints(const Extents& extents, Plot3dLayout layout) {
+  return layout == Plot3dLayout::kPlanes ? int64_t{extents[0]} * extents[1] : NumPoints(extents);
+}
+
+int64_t WholeLayoutIndex(const Extents& extents, int values_per_point, Plot3dLayout layout,
+                         int64_t index_in_block) {
+  if (layout == Plot3dLayout::kWhole) return index_in_block;
+  const int64_t n = SlabPoints(extents, layout);
+  const int64_t slab = index_in_block / (n * values_per_point);
+  const int64_t rest = index_in_block % (n * values_per_point);
+  return (rest / n) * NumPoints(extents) + slab * n + rest % n;
+}
+
+const char* LayoutName(Plot3dLayout layout) {
+  return layout == Plot3dLayout::kPlanes ? "planes" : "whole";
+}
+
 BlockValue LocateBlockValue(const std::vector<Extents>& extents, int values_per_point,
                             int64_t offset) {
   BlockValue located;
@@ -124,11 +141,14 @@ std::string DescribePlot3dFormat(const Plot3dFormat& format) {
       break;
   }
   if (format.encoding != Plot3dEncoding::kAscii) {
+    if (format.framing == Plot3dFraming::kCStream) absl::StrAppend(&encoding, " C-stream");
     absl::StrAppend(&encoding, format.bytes_per_real == 4 ? " single" : " double", " precision");
   }
-  return absl::StrCat(encoding, " ", format.spatial_dim, "D, ",
-                      format.has_block_count ? "block-count line" : "no block-count line", ", ",
-                      format.has_iblank ? "iblank" : "no iblank");
+  return absl::StrCat(
+      encoding, " ", format.spatial_dim, "D, ",
+      format.has_block_count ? "block-count line" : "no block-count line", ", ",
+      format.has_iblank ? "iblank" : "no iblank",
+      format.spatial_dim == 3 && format.layout == Plot3dLayout::kPlanes ? ", planes layout" : "");
 }
 
 Plot3dFormat DefaultPlot3dFormat(const MultiBlockGrid& grid, Plot3dEncoding encoding) {
@@ -147,6 +167,12 @@ Plot3dFormat DefaultPlot3dFormat(const MultiBlockGrid& grid, Plot3dEncoding enco
 
 absl::StatusOr<MultiBlockGrid> ParsePlot3d(std::string_view bytes, std::string_view source_name,
                                            Plot3dFormat* detected) {
+  return ParsePlot3d(bytes, source_name, Plot3dReadOptions(), detected);
+}
+
+absl::StatusOr<MultiBlockGrid> ParsePlot3d(std::string_view bytes, std::string_view source_name,
+                                           const Plot3dReadOptions& options,
+                                           Plot3dFormat* detected) {
   if (bytes.empty()) {
     return absl::InvalidArgumentError(absl::StrCat(ErrorPrefix(source_name), "the file is empty"));
   }
@@ -154,13 +180,36 @@ absl::StatusOr<MultiBlockGrid> ParsePlot3d(std::string_view bytes, std::string_v
   const bool binary = !std::all_of(bytes.begin(), bytes.begin() + probe, [](char c) {
     return IsTextByte(static_cast<unsigned char>(c));
   });
-  return binary ? plot3d_internal::ParsePlot3dBinary(bytes, source_name, detected)
-                : plot3d_internal::ParsePlot3dText(bytes, source_name, detected);
+  if (!binary) return plot3d_internal::ParsePlot3dText(bytes, source_name, options, detected);
+  // Fortran records first (their markers make the layout explicit), then a C stream.
+  bool looks_fortran = false;
+  absl::StatusOr<MultiBlockGrid> fortran =
+      plot3d_internal::ParsePlot3dBinary(bytes, source_name, options, detected, &looks_fortran);
+  if (fortran.ok()) return fortran;
+  // Two well-formed records: a damaged Fortran file (reading it as a stream could find a
+  // layout that adds up by chance, e.g. a cut file).
+  if (looks_fortran) return fortran.status();
+  bool layout_found = false;
+  absl::StatusOr<MultiBlockGrid> stream =
+      plot3d_internal::ParsePlot3dStream(bytes, source_name, options, detected, &layout_found);
+  // A stream layout adding up to the file size exactly is the file's layout; its error (a
+  // non-finite coordinate) is the file's fault.
+  if (stream.ok() || layout_found) return stream;
+  return absl::InvalidArgumentError(absl::StrCat(
+      ErrorPrefix(source_name), "not a Plot3D text file (byte 0x",
+      absl::Hex(static_cast<unsigned char>(bytes[0]), absl::kZeroPad2), " at the start), ",
+      fortran.status().message(), ", and not a C-stream file: ", stream.status().message()));
 }
 
 absl::StatusOr<MultiBlockGrid> ReadPlot3dFile(const std::string& path, Plot3dFormat* detected) {
+  return ReadPlot3dFile(path, Plot3dReadOptions(), detected);
+}
+
+absl::StatusOr<MultiBlockGrid> ReadPlot3dFile(const std::string& path,
+                                              const Plot3dReadOptions& options,
+                                              Plot3dFormat* detected) {
   SG_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
-  return ParsePlot3d(bytes, path, detected);
+  return ParsePlot3d(bytes, path, options, detected);
 }
 
 absl::StatusOr<std::string> EncodePlot3d(const MultiBlockGrid& grid, const Plot3dFormat& format) {

@@ -1,61 +1,17 @@
-// Plot3D Fortran unformatted (binary) files: record scanning, layout detection, reading, writing.
-#include <bit>
+// Plot3D Fortran unformatted (binary) files: record scanning, layout detection, reading; the
+// binary writer (Fortran records or C stream) and the slab reader/writer both framings share.
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/plot3d_internal.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid::plot3d_internal {
 namespace {
 
 // Largest record a 4-byte marker can describe.
 constexpr int64_t kMaxRecordBytes = std::numeric_limits<int32_t>::max();
-
-// Reads and writes fixed-size numbers in one byte order.
-class ByteOrder {
- public:
-  // Numbers stored big-endian when `big_endian`, else little-endian.
-  explicit ByteOrder(bool big_endian)
-      : swap_(big_endian != (std::endian::native == std::endian::big)) {}
-
-  // The int32 at `p`.
-  int32_t Int32(const char* p) const { return static_cast<int32_t>(Load32(p)); }
-  // The float (as double) at `p`.
-  double Float32(const char* p) const { return std::bit_cast<float>(Load32(p)); }
-  // The double at `p`.
-  double Float64(const char* p) const {
-    uint64_t bits;
-    std::memcpy(&bits, p, 8);
-    return std::bit_cast<double>(swap_ ? __builtin_bswap64(bits) : bits);
-  }
-  // Stores `value` at `p`.
-  void PutInt32(int32_t value, char* p) const { Store32(static_cast<uint32_t>(value), p); }
-  // Stores `value` at `p`.
-  void PutFloat32(float value, char* p) const { Store32(std::bit_cast<uint32_t>(value), p); }
-  // Stores `value` at `p`.
-  void PutFloat64(double value, char* p) const {
-    uint64_t bits = std::bit_cast<uint64_t>(value);
-    if (swap_) bits = __builtin_bswap64(bits);
-    std::memcpy(p, &bits, 8);
-  }
-
- private:
-  // The 4 bytes at `p` in native order.
-  uint32_t Load32(const char* p) const {
-    uint32_t bits;
-    std::memcpy(&bits, p, 4);
-    return swap_ ? __builtin_bswap32(bits) : bits;
-  }
-  // Stores the 4 bytes of `bits` at `p`.
-  void Store32(uint32_t bits, char* p) const {
-    if (swap_) bits = __builtin_bswap32(bits);
-    std::memcpy(p, &bits, 4);
-  }
-
-  bool swap_;
-};
 
 // A Fortran record: payload bytes [offset + 4, offset + 4 + length).
 struct Record {
@@ -133,7 +89,8 @@ std::string BlockAt(int64_t block, const Record& record) {
 
 // Parses `bytes` as records in byte order `big_endian` (see plot3d.h).
 absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::string_view source,
-                                                  bool big_endian, Plot3dFormat* detected) {
+                                                  bool big_endian, const Plot3dReadOptions& options,
+                                                  Plot3dFormat* detected) {
   const std::string prefix = ErrorPrefix(source);
   const ByteOrder order(big_endian);
   RecordReader reader(bytes, order);
@@ -187,38 +144,83 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
           absl::StrCat(prefix, "block ", b, ": ", TooManyPointsMessage(extents[b])));
     }
   }
-  // Validate every block record against the file before allocating anything.
-  std::vector<Record> records(static_cast<size_t>(num_blocks));
-  int bytes_per_real = 0;
-  bool has_iblank = false;
-  for (int64_t b = 0; b < num_blocks; ++b) {
-    Record& record = records[b];
-    if (!reader.Next(&record)) {
-      return missing(
-          absl::StrCat("block ", b, " of ", num_blocks, " (record ", reader.records_read(), ")"));
+  // Validate every block record against the file before allocating anything. The first block
+  // record fixes precision, iblank and the layout: a record of one k-plane (nk > 1) means the
+  // planes layout, one record per plane.
+  BinaryValues values{order, /*bytes_per_real=*/0, /*has_iblank=*/false};  // 0: no match yet
+  Plot3dLayout layout = Plot3dLayout::kWhole;
+  {
+    Record first_block;
+    RecordReader probe = reader;
+    if (!probe.Next(&first_block)) {
+      const std::string what =
+          absl::StrCat("block 0 of ", num_blocks, " (record ", reader.records_read(), ")");
+      reader = probe;  // its position and error describe the failure
+      return missing(what);
     }
-    if (b == 0) {
+    // Whole single precision and planes double precision agree in length for nk = 2: the
+    // number of records that follow decides (one per block, or one per k-plane).
+    int64_t records_left = 1;
+    for (Record skip; probe.Next(&skip);) ++records_left;
+    const int64_t plane = int64_t{extents[0][0]} * extents[0][1];
+    bool count_matches = false;
+    for (Plot3dLayout candidate : {Plot3dLayout::kWhole, Plot3dLayout::kPlanes}) {
+      if (candidate == Plot3dLayout::kPlanes && (dim == 2 || extents[0][2] == 1)) continue;
+      const int64_t n = candidate == Plot3dLayout::kWhole ? points[0] : plane;
+      int64_t slabs = 0;
+      for (int64_t b = 0; b < num_blocks; ++b) {
+        slabs += candidate == Plot3dLayout::kWhole ? 1 : extents[b][2];
+      }
       for (int real : {4, 8}) {
         for (bool iblank : {false, true}) {
-          if (record.length == points[0] * (dim * real + (iblank ? 4 : 0))) {
-            bytes_per_real = real;
-            has_iblank = iblank;
+          const BinaryValues v{order, real, iblank};
+          if (first_block.length != v.SlabBytes(n, dim)) continue;
+          // The first match, or a later one whose record count fits where the first's did not.
+          if (values.bytes_per_real == 0 || (!count_matches && slabs == records_left)) {
+            values = v;
+            layout = candidate;
+            count_matches = slabs == records_left;
           }
         }
       }
-      if (bytes_per_real == 0) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            prefix, BlockAt(b, record), " holds ", record.length, " bytes; its ", points[0],
-            " points need ", points[0] * dim * 4, " (single precision), ", points[0] * dim * 8,
-            " (double), ", points[0] * (dim * 4 + 4), " (single + iblank) or ",
-            points[0] * (dim * 8 + 4), " (double + iblank)"));
-      }
-    } else if (const int64_t need = points[b] * (dim * bytes_per_real + (has_iblank ? 4 : 0));
-               record.length != need) {
+    }
+    if (values.bytes_per_real == 0) {
+      const int64_t p = points[0];
       return absl::InvalidArgumentError(absl::StrCat(
-          prefix, BlockAt(b, record), " holds ", record.length, " bytes; its ", points[b],
-          " points need ", need, " (", bytes_per_real == 4 ? "single" : "double", " precision",
-          has_iblank ? " + iblank" : "", ", as block 0)"));
+          prefix, BlockAt(0, first_block), " holds ", first_block.length, " bytes; its ", p,
+          " points need ", p * dim * 4, " (single precision), ", p * dim * 8, " (double), ",
+          p * (dim * 4 + 4), " (single + iblank) or ", p * (dim * 8 + 4), " (double + iblank)",
+          dim == 3 && extents[0][2] > 1
+              ? absl::StrCat(", or a record per k-plane of ", plane, " points (planes layout)")
+              : std::string()));
+    }
+  }
+  if (options.layout.has_value() && *options.layout != layout && dim == 3 && extents[0][2] > 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        prefix, "the records hold the ", LayoutName(layout), " layout (block 0 record of ",
+        values.SlabBytes(SlabPoints(extents[0], layout), dim), " bytes), but the ",
+        LayoutName(*options.layout), " layout was requested"));
+  }
+  std::vector<std::vector<Record>> records(static_cast<size_t>(num_blocks));
+  for (int64_t b = 0; b < num_blocks; ++b) {
+    const int64_t n = SlabPoints(extents[b], layout);
+    const int64_t slabs = points[b] / n;
+    records[b].resize(static_cast<size_t>(slabs));
+    for (int64_t k = 0; k < slabs; ++k) {
+      Record& record = records[b][k];
+      const std::string what = layout == Plot3dLayout::kWhole
+                                   ? absl::StrCat("block ", b, " of ", num_blocks)
+                                   : absl::StrCat("block ", b, " plane k = ", k);
+      if (!reader.Next(&record)) {
+        return missing(absl::StrCat(what, " (record ", reader.records_read(), ")"));
+      }
+      if (const int64_t need = values.SlabBytes(n, dim); record.length != need) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            prefix, BlockAt(b, record), " holds ", record.length, " bytes; ",
+            layout == Plot3dLayout::kWhole ? "its " : "a k-plane of its ", n, " points need ", need,
+            " (", values.bytes_per_real == 4 ? "single" : "double", " precision",
+            values.has_iblank ? " + iblank" : "", ", as block 0)"));
+      }
     }
   }
   if (reader.position() < static_cast<int64_t>(bytes.size())) {
@@ -230,32 +232,27 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
   grid.blocks.reserve(static_cast<size_t>(num_blocks));
   for (int64_t b = 0; b < num_blocks; ++b) {
     StructuredBlock block(extents[b], dim);
-    const std::span<double> coords = block.coords();
-    const char* data = bytes.data() + records[b].payload();
-    for (int s = 0; s < dim; ++s) {
-      for (int64_t p = 0; p < points[b]; ++p) {
-        const int64_t k = s * points[b] + p;
-        const char* at = data + k * bytes_per_real;
-        const double value = bytes_per_real == 8 ? order.Float64(at) : order.Float32(at);
-        if (!std::isfinite(value)) {
-          return absl::InvalidArgumentError(absl::StrCat(
-              prefix, "block ", b, ", ", DescribeBlockValue(extents[b], dim, k), " at byte offset ",
-              at - bytes.data(), " (record ", records[b].index, "): ", value, " is not finite"));
-        }
-        coords[p * dim + s] = value;
-      }
-    }
-    if (has_iblank) {
-      const char* iblank = data + dim * points[b] * bytes_per_real;
-      block.iblank().resize(static_cast<size_t>(points[b]));
-      for (int64_t p = 0; p < points[b]; ++p) block.iblank()[p] = order.Int32(iblank + 4 * p);
+    if (values.has_iblank) block.iblank().resize(static_cast<size_t>(points[b]));
+    const int64_t n = SlabPoints(extents[b], layout);
+    for (size_t k = 0; k < records[b].size(); ++k) {
+      const Record& record = records[b][k];
+      SG_RETURN_IF_ERROR(ReadBinarySlab(bytes, bytes.data() + record.payload(), values, b,
+                                        static_cast<int64_t>(k) * n, n, source,
+                                        absl::StrCat(" (record ", record.index, ")"), &block));
     }
     grid.blocks.push_back(std::move(block));
   }
   if (detected != nullptr) {
-    *detected = Plot3dFormat{
-        big_endian ? Plot3dEncoding::kBinaryBigEndian : Plot3dEncoding::kBinaryLittleEndian, dim,
-        has_block_count, has_iblank, bytes_per_real};
+    Plot3dFormat format;
+    format.encoding =
+        big_endian ? Plot3dEncoding::kBinaryBigEndian : Plot3dEncoding::kBinaryLittleEndian;
+    format.spatial_dim = dim;
+    format.has_block_count = has_block_count;
+    format.has_iblank = values.has_iblank;
+    format.bytes_per_real = values.bytes_per_real;
+    format.framing = Plot3dFraming::kFortranRecords;
+    format.layout = layout;
+    *detected = format;
   }
   return grid;
 }
@@ -269,10 +266,91 @@ bool FirstRecordValid(std::string_view bytes, bool big_endian, std::string* erro
   return false;
 }
 
+// Whether the first two records of `bytes` are well formed in `order`, or the file is exactly
+// one record.
+bool TwoRecordsValid(std::string_view bytes, bool big_endian) {
+  RecordReader reader(bytes, ByteOrder(big_endian));
+  Record record;
+  if (!reader.Next(&record)) return false;
+  return reader.Next(&record) || reader.error().empty();
+}
+
 }  // namespace
 
+absl::Status ReadBinarySlab(std::string_view file, const char* data, const BinaryValues& values,
+                            int64_t b, int64_t first, int64_t n, std::string_view source,
+                            std::string_view where, StructuredBlock* block) {
+  const int dim = block->spatial_dim();
+  const std::span<double> coords = block->coords();
+  const int real = values.bytes_per_real;
+  for (int s = 0; s < dim; ++s) {
+    for (int64_t q = 0; q < n; ++q) {
+      const char* at = data + (s * n + q) * real;
+      const double value = real == 8 ? values.order.Float64(at) : values.order.Float32(at);
+      // Subnormal as stored: in single precision test the float, not the widened double.
+      const bool subnormal =
+          values.reject_subnormal &&
+          (real == 8 ? std::fpclassify(value) == FP_SUBNORMAL
+                     : std::fpclassify(static_cast<float>(value)) == FP_SUBNORMAL);
+      if (!std::isfinite(value) || subnormal) {
+        const int64_t p = first + q;
+        return absl::Status(
+            subnormal ? absl::StatusCode::kOutOfRange : absl::StatusCode::kInvalidArgument,
+            absl::StrCat(ErrorPrefix(source), "block ", b, ", ",
+                         DescribeBlockValue(block->extents(), dim, s * block->num_points() + p),
+                         " at byte offset ", at - file.data(), std::string(where), ": ", value,
+                         subnormal ? " is subnormal (integers read as reals: not this layout)"
+                                   : " is not finite"));
+      }
+      coords[(first + q) * dim + s] = value;
+    }
+  }
+  if (values.has_iblank) {
+    const char* iblank = data + dim * n * real;
+    for (int64_t q = 0; q < n; ++q) {
+      const int32_t value = values.order.Int32(iblank + 4 * q);
+      // iblank is 1 (field), 0 (hole) or a block number (negative: interpolated from it).
+      if (values.reject_subnormal && (value > kMaxBlocks || value < -kMaxBlocks)) {
+        return absl::OutOfRangeError(
+            absl::StrCat(ErrorPrefix(source), "block ", b, ", iblank of point ", first + q, " = ",
+                         value, " is not a block number (reals read as iblank: not this layout)"));
+      }
+      block->iblank()[first + q] = value;
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status WriteBinarySlab(const StructuredBlock& block, int64_t b, int64_t first, int64_t n,
+                             const BinaryValues& values, char* out) {
+  const int dim = block.spatial_dim();
+  const int real = values.bytes_per_real;
+  const std::span<const double> coords = block.coords();
+  for (int s = 0; s < dim; ++s) {
+    for (int64_t q = 0; q < n; ++q, out += real) {
+      const double value = coords[(first + q) * dim + s];
+      if (real == 8) {
+        values.order.PutFloat64(value, out);
+      } else if (std::abs(value) > std::numeric_limits<float>::max()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "Plot3D block ", b, ", ",
+            DescribeBlockValue(block.extents(), dim, s * block.num_points() + first + q), ": ",
+            value, " does not fit single precision"));
+      } else {
+        values.order.PutFloat32(static_cast<float>(value), out);
+      }
+    }
+  }
+  if (values.has_iblank) {
+    for (int64_t q = 0; q < n; ++q, out += 4) values.order.PutInt32(block.iblank()[first + q], out);
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<MultiBlockGrid> ParsePlot3dBinary(std::string_view bytes, std::string_view source,
-                                                 Plot3dFormat* detected) {
+                                                 const Plot3dReadOptions& options,
+                                                 Plot3dFormat* detected, bool* looks_fortran) {
+  *looks_fortran = false;
   // ParsePlot3d never passes empty bytes; the check keeps bytes[0] below in bounds for any caller.
   if (bytes.empty()) {
     return absl::InvalidArgumentError(absl::StrCat(ErrorPrefix(source), "the file is empty"));
@@ -281,78 +359,77 @@ absl::StatusOr<MultiBlockGrid> ParsePlot3dBinary(std::string_view bytes, std::st
   const bool little = FirstRecordValid(bytes, false, &little_error);
   const bool big = FirstRecordValid(bytes, true, &big_error);
   if (!little && !big) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        ErrorPrefix(source), "not a Plot3D text file (byte 0x",
-        absl::Hex(static_cast<unsigned char>(bytes[0]), absl::kZeroPad2),
-        " at the start) and not a Fortran unformatted file in either byte order: little-endian ",
-        little_error, "; big-endian ", big_error));
+    return absl::InvalidArgumentError(
+        absl::StrCat("not a Fortran unformatted file in either byte order: little-endian ",
+                     little_error, "; big-endian ", big_error));
   }
+  *looks_fortran = TwoRecordsValid(bytes, false) || TwoRecordsValid(bytes, true);
   if (little && big) {  // only for contrived markers: take the first byte order that parses
-    absl::StatusOr<MultiBlockGrid> grid = ParseWithByteOrder(bytes, source, false, detected);
+    absl::StatusOr<MultiBlockGrid> grid =
+        ParseWithByteOrder(bytes, source, false, options, detected);
     if (grid.ok()) return grid;
-    absl::StatusOr<MultiBlockGrid> swapped = ParseWithByteOrder(bytes, source, true, detected);
+    absl::StatusOr<MultiBlockGrid> swapped =
+        ParseWithByteOrder(bytes, source, true, options, detected);
     return swapped.ok() ? std::move(swapped) : std::move(grid);
   }
-  return ParseWithByteOrder(bytes, source, big, detected);
+  return ParseWithByteOrder(bytes, source, big, options, detected);
 }
 
 absl::StatusOr<std::string> EncodePlot3dBinary(const MultiBlockGrid& grid,
                                                const Plot3dFormat& format) {
-  const ByteOrder order(format.encoding == Plot3dEncoding::kBinaryBigEndian);
+  const BinaryValues values{ByteOrder(format.encoding == Plot3dEncoding::kBinaryBigEndian),
+                            format.bytes_per_real, format.has_iblank};
+  const bool records = format.framing == Plot3dFraming::kFortranRecords;
+  const int64_t marker_bytes = records ? 8 : 0;  // per record
   const int dim = format.spatial_dim;
-  const int real = format.bytes_per_real;
+  const Plot3dLayout layout = dim == 3 ? format.layout : Plot3dLayout::kWhole;
   const int64_t num_blocks = static_cast<int64_t>(grid.blocks.size());
-  int64_t total = (format.has_block_count ? 12 : 0) + 8 + 4 * dim * num_blocks;
+  if (records && 4 * dim * num_blocks > kMaxRecordBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("Plot3D: the dimensions record of ", num_blocks,
+                     " blocks exceeds what a 4-byte Fortran record marker can describe"));
+  }
+  int64_t total =
+      (format.has_block_count ? 4 + marker_bytes : 0) + marker_bytes + 4 * dim * num_blocks;
   for (int64_t b = 0; b < num_blocks; ++b) {
-    const int64_t length = grid.blocks[b].num_points() * (dim * real + (format.has_iblank ? 4 : 0));
-    if (length > kMaxRecordBytes || 4 * dim * num_blocks > kMaxRecordBytes) {
+    const int64_t n = SlabPoints(grid.blocks[b].extents(), layout);
+    const int64_t length = values.SlabBytes(n, dim);
+    if (records && length > kMaxRecordBytes) {
       return absl::InvalidArgumentError(
           absl::StrCat("Plot3D block ", b, ": its record of ", length,
                        " bytes exceeds what a 4-byte Fortran record marker can describe"));
     }
-    total += length + 8;
+    total += (length + marker_bytes) * (grid.blocks[b].num_points() / n);
   }
   std::string out(static_cast<size_t>(total), '\0');
   char* p = out.data();
+  // Starts a record of `length` payload bytes at p (markers only with Fortran records); returns
+  // where the next record starts and leaves p at the payload.
   auto begin_record = [&](int64_t length) {
-    order.PutInt32(static_cast<int32_t>(length), p);
-    order.PutInt32(static_cast<int32_t>(length), p + 4 + length);
+    if (!records) return p + length;
+    values.order.PutInt32(static_cast<int32_t>(length), p);
+    values.order.PutInt32(static_cast<int32_t>(length), p + 4 + length);
     p += 4;
-    return p + length + 4;  // where the next record starts
+    return p + length + 4;
   };
   if (format.has_block_count) {
     char* next = begin_record(4);
-    order.PutInt32(static_cast<int32_t>(num_blocks), p);
+    values.order.PutInt32(static_cast<int32_t>(num_blocks), p);
     p = next;
   }
   char* next = begin_record(4 * dim * num_blocks);
   for (const StructuredBlock& block : grid.blocks) {
-    for (int d = 0; d < dim; ++d, p += 4) order.PutInt32(block.extent(d), p);
+    for (int d = 0; d < dim; ++d, p += 4) values.order.PutInt32(block.extent(d), p);
   }
   p = next;
   for (int64_t b = 0; b < num_blocks; ++b) {
     const StructuredBlock& block = grid.blocks[b];
-    const int64_t points = block.num_points();
-    next = begin_record(points * (dim * real + (format.has_iblank ? 4 : 0)));
-    const std::span<const double> coords = block.coords();
-    for (int s = 0; s < dim; ++s) {
-      for (int64_t i = 0; i < points; ++i, p += real) {
-        const double value = coords[i * dim + s];
-        if (real == 8) {
-          order.PutFloat64(value, p);
-        } else if (std::abs(value) > std::numeric_limits<float>::max()) {
-          return absl::InvalidArgumentError(absl::StrCat(
-              "Plot3D block ", b, ", ", DescribeBlockValue(block.extents(), dim, s * points + i),
-              ": ", value, " does not fit single precision"));
-        } else {
-          order.PutFloat32(static_cast<float>(value), p);
-        }
-      }
+    const int64_t n = SlabPoints(block.extents(), layout);
+    for (int64_t first = 0; first < block.num_points(); first += n) {
+      next = begin_record(values.SlabBytes(n, dim));
+      SG_RETURN_IF_ERROR(WriteBinarySlab(block, b, first, n, values, p));
+      p = next;
     }
-    if (format.has_iblank) {
-      for (int64_t i = 0; i < points; ++i, p += 4) order.PutInt32(block.iblank()[i], p);
-    }
-    p = next;
   }
   return out;
 }

@@ -17,9 +17,11 @@ namespace splinegrid {
 // Text (the first 4 bytes printable or whitespace, as ParsePlot3d decides): with T tokens
 // (runs between whitespace/commas, and null values: a comma after a comma or at the start), R
 // repeats and V values once repeats are expanded, 8 max(size / 24 + 16, 2 T) + 32 R + 8 V; binary:
-// 2 x the size (4-byte floats become doubles). Not counted: ~100 bytes of bookkeeping per block,
+// 2 x the size (4-byte floats become doubles; Fortran records or C stream, whose hypotheses are
+// read one at a time, each grid freed before the next). Not counted: ~100 bytes of bookkeeping per block,
 // which matters only for files of many tiny blocks (at most ~10 x the size of such a file). Must be
-// kept in step with the parser (plot3d_text.cc, fortran_text.cc, plot3d_binary.cc).
+// kept in step with the parser (plot3d_text.cc, fortran_text.cc, plot3d_binary.cc,
+// plot3d_stream.cc).
 int64_t Plot3dParseBytesBound(std::string_view bytes);
 
 }  // namespace splinegrid

@@ -50,15 +50,17 @@ struct Attempt {
   std::vector<Extents> extents;  // extents of the blocks whose header was accepted
   int64_t header_values = 0;     // values before the first coordinate
   int64_t expected_values = 0;   // header + coordinates + iblank implied by the header
+  Plot3dLayout layout = Plot3dLayout::kWhole;
 
   // Values per point in a block's data.
   int values_per_point() const { return hypothesis.spatial_dim + (hypothesis.has_iblank ? 1 : 0); }
 };
 
-// Tests `hypothesis` against `list`.
-Attempt Evaluate(const FortranList& list, const Hypothesis& hypothesis) {
+// Tests `hypothesis` against `list`, with 3D blocks in `layout`.
+Attempt Evaluate(const FortranList& list, const Hypothesis& hypothesis, Plot3dLayout layout) {
   Attempt a;
   a.hypothesis = hypothesis;
+  a.layout = hypothesis.spatial_dim == 3 ? layout : Plot3dLayout::kWhole;
   const int dim = hypothesis.spatial_dim;
   const int64_t integers = static_cast<int64_t>(list.line_break_after.size());
   auto fail = [&](Failure failure, int64_t at) {
@@ -100,18 +102,21 @@ Attempt Evaluate(const FortranList& list, const Hypothesis& hypothesis) {
   if (a.expected_values != list.num_values) return fail(Failure::kCountMismatch, 0);
   a.stage = Stage::kContent;
   if (hypothesis.has_iblank) {
-    int64_t first = a.header_values;
+    int64_t first = a.header_values;  // first value of the slab
     for (a.block = 0; a.block < num_blocks; ++a.block) {
       const int64_t points = NumPoints(a.extents[a.block]);
-      first += points * dim;
-      FortranValueCursor cursor(list, first);
-      for (int64_t p = 0; p < points; ++p) {
-        const double value = cursor.Next();
-        if (!(std::abs(value) <= 2147483647.0) || value != std::floor(value)) {
-          return fail(Failure::kBadIblank, first + p);
+      const int64_t n = SlabPoints(a.extents[a.block], a.layout);
+      for (int64_t slab = 0; slab < points; slab += n) {
+        first += n * dim;
+        FortranValueCursor cursor(list, first);
+        for (int64_t p = 0; p < n; ++p) {
+          const double value = cursor.Next();
+          if (!(std::abs(value) <= 2147483647.0) || value != std::floor(value)) {
+            return fail(Failure::kBadIblank, first + p);
+          }
         }
+        first += n;
       }
-      first += points;
     }
   }
   a.block = -1;
@@ -145,9 +150,11 @@ std::string DescribeValue(const Attempt& a, int64_t value) {
   const BlockValue located =
       LocateBlockValue(a.extents, a.values_per_point(), value - a.header_values);
   if (located.block >= static_cast<int64_t>(a.extents.size())) return "after the last block";
+  const Extents& extents = a.extents[located.block];
   return absl::StrCat("block ", located.block, ", ",
-                      DescribeBlockValue(a.extents[located.block], a.hypothesis.spatial_dim,
-                                         located.index_in_block));
+                      DescribeBlockValue(extents, a.hypothesis.spatial_dim,
+                                         WholeLayoutIndex(extents, a.values_per_point(), a.layout,
+                                                          located.index_in_block)));
 }
 
 // The error message for failed attempt `a` (without the prefix).
@@ -227,12 +234,14 @@ void AppendReal(double value, std::string* out) {
 }  // namespace
 
 absl::StatusOr<MultiBlockGrid> ParsePlot3dText(std::string_view text, std::string_view source,
+                                               const Plot3dReadOptions& options,
                                                Plot3dFormat* detected) {
+  const Plot3dLayout layout = options.layout.value_or(Plot3dLayout::kWhole);
   const FortranList list = TokenizeFortranList(text, 1 + 3 * kMaxBlocks);
   std::optional<Attempt> match;
   std::optional<Attempt> best;
   for (const Hypothesis& hypothesis : kHypotheses) {
-    Attempt attempt = Evaluate(list, hypothesis);
+    Attempt attempt = Evaluate(list, hypothesis, layout);
     if (attempt.stage == Stage::kMatch) {
       match = std::move(attempt);
       break;
@@ -266,18 +275,29 @@ absl::StatusOr<MultiBlockGrid> ParsePlot3dText(std::string_view text, std::strin
     StructuredBlock block(extents, dim);
     const std::span<double> coords = block.coords();
     const int64_t points = block.num_points();
-    for (int s = 0; s < dim; ++s) {
-      for (int64_t p = 0; p < points; ++p) coords[p * dim + s] = cursor.Next();
-    }
-    if (a.hypothesis.has_iblank) {
-      block.iblank().resize(static_cast<size_t>(points));
-      for (int64_t p = 0; p < points; ++p) block.iblank()[p] = static_cast<int>(cursor.Next());
+    const int64_t n = SlabPoints(extents, a.layout);
+    if (a.hypothesis.has_iblank) block.iblank().resize(static_cast<size_t>(points));
+    for (int64_t first = 0; first < points; first += n) {
+      for (int s = 0; s < dim; ++s) {
+        for (int64_t p = first; p < first + n; ++p) coords[p * dim + s] = cursor.Next();
+      }
+      if (a.hypothesis.has_iblank) {
+        for (int64_t p = first; p < first + n; ++p) {
+          block.iblank()[p] = static_cast<int>(cursor.Next());
+        }
+      }
     }
     grid.blocks.push_back(std::move(block));
   }
   if (detected != nullptr) {
-    *detected = Plot3dFormat{Plot3dEncoding::kAscii, dim, a.hypothesis.has_block_count,
-                             a.hypothesis.has_iblank, 8};
+    Plot3dFormat format;
+    format.encoding = Plot3dEncoding::kAscii;
+    format.spatial_dim = dim;
+    format.has_block_count = a.hypothesis.has_block_count;
+    format.has_iblank = a.hypothesis.has_iblank;
+    format.bytes_per_real = 8;
+    format.layout = a.layout;
+    *detected = format;
   }
   return grid;
 }
@@ -296,19 +316,22 @@ std::string EncodePlot3dText(const MultiBlockGrid& grid, const Plot3dFormat& for
     if (dim == 3) absl::StrAppend(&out, " ", block.extent(2));
     out.push_back('\n');
   }
+  const Plot3dLayout layout = dim == 3 ? format.layout : Plot3dLayout::kWhole;
   for (const StructuredBlock& block : grid.blocks) {
     const std::span<const double> coords = block.coords();
-    const int64_t points = block.num_points();
-    for (int s = 0; s < dim; ++s) {
-      for (int64_t p = 0; p < points; ++p) {
-        AppendReal(coords[p * dim + s], &out);
-        out.push_back((p + 1) % kRealsPerLine == 0 || p + 1 == points ? '\n' : ' ');
+    const int64_t n = SlabPoints(block.extents(), layout);
+    for (int64_t first = 0; first < block.num_points(); first += n) {
+      for (int s = 0; s < dim; ++s) {
+        for (int64_t q = 0; q < n; ++q) {
+          AppendReal(coords[(first + q) * dim + s], &out);
+          out.push_back((q + 1) % kRealsPerLine == 0 || q + 1 == n ? '\n' : ' ');
+        }
       }
-    }
-    if (format.has_iblank) {
-      for (int64_t p = 0; p < points; ++p) {
-        absl::StrAppend(&out, block.iblank()[p]);
-        out.push_back((p + 1) % kIntegersPerLine == 0 || p + 1 == points ? '\n' : ' ');
+      if (format.has_iblank) {
+        for (int64_t q = 0; q < n; ++q) {
+          absl::StrAppend(&out, block.iblank()[first + q]);
+          out.push_back((q + 1) % kIntegersPerLine == 0 || q + 1 == n ? '\n' : ' ');
+        }
       }
     }
   }

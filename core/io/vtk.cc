@@ -1,5 +1,6 @@
 #include "core/io/vtk.h"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cstring>
@@ -8,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
+#include "core/io/vtk_compress.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -98,10 +100,10 @@ void AppendAscii(const StructuredBlock& block, const ArrayToWrite& array, std::s
   out->push_back('\n');
 }
 
-// Appends the UInt64 byte count and the raw bytes of `array` in machine byte order.
-void AppendRaw(const StructuredBlock& block, const ArrayToWrite& array, std::string* out) {
-  const uint64_t size = array.bytes(block.num_points());
-  out->append(reinterpret_cast<const char*>(&size), sizeof(size));
+// Appends the raw bytes of `array` (`tuples` of it) in machine byte order.
+void AppendRawBytes(const StructuredBlock& block, const ArrayToWrite& array, int64_t tuples,
+                    std::string* out) {
+  const uint64_t size = array.bytes(tuples);
   if (array.is_points) {
     const size_t start = out->size();
     out->resize(start + size);
@@ -117,9 +119,27 @@ void AppendRaw(const StructuredBlock& block, const ArrayToWrite& array, std::str
   }
 }
 
+// Appends `array` as appended data: the UInt64 byte count and the raw bytes, or with
+// options.compress the zlib blocks (vtk_compress.h). Returns the bytes appended.
+uint64_t AppendData(const StructuredBlock& block, const ArrayToWrite& array, int64_t tuples,
+                    const VtkWriteOptions& options, std::string* out) {
+  const size_t start = out->size();
+  if (options.compress) {
+    std::string raw;
+    raw.reserve(array.bytes(tuples));
+    AppendRawBytes(block, array, tuples, &raw);
+    AppendVtkZlibBlocks(raw, options.compression_level, out);
+  } else {
+    const uint64_t size = array.bytes(tuples);
+    out->append(reinterpret_cast<const char*>(&size), sizeof(size));
+    AppendRawBytes(block, array, tuples, out);
+  }
+  return out->size() - start;
+}
+
 // OK when `arrays` are valid point data for a block of `num_points` points.
 absl::Status ValidateArrays(std::span<const VtkPointArray> arrays, int64_t num_points,
-                            bool iblank_added) {
+                            int64_t num_cells, bool iblank_added) {
   std::set<std::string> names;
   if (iblank_added) names.insert("iblank");
   for (const VtkPointArray& array : arrays) {
@@ -136,11 +156,14 @@ absl::Status ValidateArrays(std::span<const VtkPointArray> arrays, int64_t num_p
           absl::StrCat("VTK point array '", array.name, "': ", array.num_components,
                        " components; must be from 1 to ", kMaxComponents));
     }
-    const int64_t expected = num_points * array.num_components;
+    const bool cells = array.location == VtkArrayLocation::kCell;
+    const int64_t tuples = cells ? num_cells : num_points;
+    const int64_t expected = tuples * array.num_components;
     if (static_cast<int64_t>(array.values.size()) != expected) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "VTK point array '", array.name, "' has ", array.values.size(), " values; ", num_points,
-          " points x ", array.num_components, " components need ", expected));
+      return absl::InvalidArgumentError(
+          absl::StrCat("VTK ", cells ? "cell" : "point", " array '", array.name, "' has ",
+                       array.values.size(), " values; ", tuples, cells ? " cells" : " points",
+                       " x ", array.num_components, " components need ", expected));
     }
   }
   return absl::OkStatus();
@@ -160,30 +183,50 @@ std::string DataArrayTag(const ArrayToWrite& array, const VtkWriteOptions& optio
   return tag;
 }
 
-}  // namespace
-
-absl::StatusOr<std::string> EncodeVts(const StructuredBlock& block,
-                                      std::span<const VtkPointArray> arrays,
-                                      const VtkWriteOptions& options) {
-  const int64_t num_points = block.num_points();
-  const bool write_iblank =
-      options.write_iblank && block.iblank().size() == static_cast<size_t>(num_points);
-  SG_RETURN_IF_ERROR(ValidateArrays(arrays, num_points, write_iblank));
-  std::vector<ArrayToWrite> point_data;
-  std::string active;  // Scalars="..." / Vectors="..." of PointData
+// Appends the opening tag's role attributes (Scalars="..." Vectors="...") for `arrays` of
+// `location`: the first 1- and 3-component arrays become ParaView's active ones.
+std::string ActiveAttributes(std::span<const VtkPointArray> arrays, VtkArrayLocation location) {
+  std::string active;
   for (const VtkPointArray& array : arrays) {
-    ArrayToWrite data;
-    data.type = "Float64";
-    data.name = array.name;
-    data.num_components = array.num_components;
-    data.doubles = array.values;
-    point_data.push_back(std::move(data));
+    if (array.location != location) continue;
     const char* role = array.num_components == 1   ? "Scalars"
                        : array.num_components == 3 ? "Vectors"
                                                    : nullptr;
     if (role != nullptr && active.find(role) == std::string::npos) {
       absl::StrAppend(&active, " ", role, "=\"", XmlEscape(array.name), "\"");
     }
+  }
+  return active;
+}
+
+}  // namespace
+
+int64_t VtkNumCells(const StructuredBlock& block) {
+  int64_t cells = 1;
+  for (int d = 0; d < 3; ++d) cells *= std::max(block.extent(d) - 1, 1);
+  return cells;
+}
+
+absl::StatusOr<std::string> EncodeVts(const StructuredBlock& block,
+                                      std::span<const VtkPointArray> arrays,
+                                      const VtkWriteOptions& options) {
+  const int64_t num_points = block.num_points();
+  const int64_t num_cells = VtkNumCells(block);
+  const bool write_iblank =
+      options.write_iblank && block.iblank().size() == static_cast<size_t>(num_points);
+  SG_RETURN_IF_ERROR(ValidateArrays(arrays, num_points, num_cells, write_iblank));
+  if (options.compression_level < 1 || options.compression_level > 9) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "VTK compression_level = ", options.compression_level, ": must be from 1 to 9"));
+  }
+  std::vector<ArrayToWrite> point_data, cell_data;
+  for (const VtkPointArray& array : arrays) {
+    ArrayToWrite data;
+    data.type = "Float64";
+    data.name = array.name;
+    data.num_components = array.num_components;
+    data.doubles = array.values;
+    (array.location == VtkArrayLocation::kCell ? cell_data : point_data).push_back(data);
   }
   if (write_iblank) {
     ArrayToWrite iblank;
@@ -201,31 +244,43 @@ absl::StatusOr<std::string> EncodeVts(const StructuredBlock& block,
   const std::string extent = absl::StrCat("0 ", block.extent(0) - 1, " 0 ", block.extent(1) - 1,
                                           " 0 ", block.extent(2) - 1);
   const bool ascii = options.data_format == VtkDataFormat::kAscii;
+  const bool compress = !ascii && options.compress;
   std::string out = absl::StrCat(
       "<?xml version=\"1.0\"?>\n<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"",
-      MachineByteOrder(), "\" header_type=\"UInt64\">\n  <StructuredGrid WholeExtent=\"", extent,
-      "\">\n    <Piece Extent=\"", extent, "\">\n      <PointData", active, ">\n");
-  uint64_t offset = 0;
-  auto add_array = [&](const ArrayToWrite& array, const char* indent) {
-    absl::StrAppend(&out, indent, DataArrayTag(array, options, offset));
+      MachineByteOrder(), "\" header_type=\"UInt64\"",
+      compress ? " compressor=\"vtkZLibDataCompressor\"" : "",
+      ">\n  <StructuredGrid WholeExtent=\"", extent, "\">\n    <Piece Extent=\"", extent, "\">\n");
+  // Appended data are produced with the tags, since compressed sizes fix the next offset.
+  std::string appended;
+  auto add_array = [&](const ArrayToWrite& array, int64_t tuples) {
+    const char* indent = "        ";
+    absl::StrAppend(&out, indent, DataArrayTag(array, options, appended.size()));
     if (ascii) {
       out += ">\n";
       AppendAscii(block, array, &out);
       absl::StrAppend(&out, indent, "</DataArray>\n");
     } else {
       out += "/>\n";
-      offset += sizeof(uint64_t) + array.bytes(num_points);
+      AppendData(block, array, tuples, options, &appended);
     }
   };
-  for (const ArrayToWrite& array : point_data) add_array(array, "        ");
-  out += "      </PointData>\n      <Points>\n";
-  add_array(points, "        ");
+  absl::StrAppend(&out, "      <PointData", ActiveAttributes(arrays, VtkArrayLocation::kPoint),
+                  ">\n");
+  for (const ArrayToWrite& array : point_data) add_array(array, num_points);
+  out += "      </PointData>\n";
+  if (!cell_data.empty()) {
+    absl::StrAppend(&out, "      <CellData", ActiveAttributes(arrays, VtkArrayLocation::kCell),
+                    ">\n");
+    for (const ArrayToWrite& array : cell_data) add_array(array, num_cells);
+    out += "      </CellData>\n";
+  }
+  out += "      <Points>\n";
+  add_array(points, num_points);
   out += "      </Points>\n    </Piece>\n  </StructuredGrid>\n";
   if (!ascii) {
-    out.reserve(out.size() + offset + 64);
+    out.reserve(out.size() + appended.size() + 64);
     out += "  <AppendedData encoding=\"raw\">\n   _";
-    for (const ArrayToWrite& array : point_data) AppendRaw(block, array, &out);
-    AppendRaw(block, points, &out);
+    out += appended;
     out += "\n  </AppendedData>\n";
   }
   out += "</VTKFile>\n";
@@ -244,7 +299,7 @@ absl::Status WriteVts(const std::string& path, const StructuredBlock& block,
 
 absl::Status WriteVtm(const std::string& path, const MultiBlockGrid& grid,
                       std::span<const std::vector<VtkPointArray>> block_arrays,
-                      const VtkWriteOptions& options) {
+                      const VtkWriteOptions& options, std::span<const int> block_numbers) {
   const std::filesystem::path vtm(path);
   if (vtm.extension() != ".vtm" || vtm.stem().empty()) {
     return absl::InvalidArgumentError(
@@ -254,6 +309,20 @@ absl::Status WriteVtm(const std::string& path, const MultiBlockGrid& grid,
     return absl::InvalidArgumentError(absl::StrCat("writing '", path, "': point arrays given for ",
                                                    block_arrays.size(), " blocks, the grid has ",
                                                    grid.blocks.size()));
+  }
+  if (!block_numbers.empty()) {
+    if (block_numbers.size() != grid.blocks.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("writing '", path, "': ", block_numbers.size(),
+                                                     " block numbers for ", grid.blocks.size(),
+                                                     " blocks"));
+    }
+    std::set<int> seen;
+    for (int n : block_numbers) {
+      if (n < 0 || !seen.insert(n).second) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("writing '", path, "': block number ", n, " is negative or given twice"));
+      }
+    }
   }
   const std::string name = vtm.stem().string();
   const std::filesystem::path directory = vtm.parent_path() / name;
@@ -269,15 +338,16 @@ absl::Status WriteVtm(const std::string& path, const MultiBlockGrid& grid,
       "byte_order=\"",
       MachineByteOrder(), "\" header_type=\"UInt64\">\n  <vtkMultiBlockDataSet>\n");
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
-    const std::string file = absl::StrCat(name, "_", b, ".vts");
+    const int64_t number = block_numbers.empty() ? static_cast<int64_t>(b) : block_numbers[b];
+    const std::string file = absl::StrCat(name, "_", number, ".vts");
     const std::span<const VtkPointArray> arrays =
         block_arrays.empty() ? std::span<const VtkPointArray>() : block_arrays[b];
     absl::Status status = WriteVts((directory / file).string(), grid.blocks[b], arrays, options);
     if (!status.ok()) {
       return absl::Status(status.code(),
-                          absl::StrCat("block ", b, " of '", path, "': ", status.message()));
+                          absl::StrCat("block ", number, " of '", path, "': ", status.message()));
     }
-    absl::StrAppend(&xml, "    <DataSet index=\"", b, "\" name=\"block_", b, "\" file=\"",
+    absl::StrAppend(&xml, "    <DataSet index=\"", b, "\" name=\"block_", number, "\" file=\"",
                     XmlEscape(absl::StrCat(name, "/", file)), "\"/>\n");
   }
   xml += "  </vtkMultiBlockDataSet>\n</VTKFile>\n";

@@ -282,16 +282,19 @@ TEST_F(Plot3dMalformedBinaryTest, NonFiniteValuesAreRejected) {
 
 TEST_F(Plot3dMalformedBinaryTest, GarbageIsNeitherTextNorRecords) {
   EXPECT_THAT(ParseError(std::string("\x01\x02\x03\x04\x05\x06\x07\x08", 8)),
-              HasSubstr("not a Plot3D text file (byte 0x01 at the start) and not a Fortran "
+              HasSubstr("not a Plot3D text file (byte 0x01 at the start), not a Fortran "
                         "unformatted file in either byte order"));
+  EXPECT_THAT(ParseError(std::string("\x01\x02\x03\x04\x05\x06\x07\x08", 8)),
+              HasSubstr("and not a C-stream file: no combination of byte order"));
 }
 
 // Found while writing the fuzz targets (a first tests/fuzz/plot3d_binary.cc called this reader
 // directly): its "neither text nor records" message read bytes[0] of empty input. ParsePlot3d
 // rejects empty files before calling it; the reader itself must too.
 TEST(Plot3dBinaryReaderTest, EmptyInputIsRejectedWithoutReadingIt) {
+  bool looks_fortran = true;
   const absl::StatusOr<MultiBlockGrid> grid =
-      plot3d_internal::ParsePlot3dBinary(std::string_view(), kSource, nullptr);
+      plot3d_internal::ParsePlot3dBinary(std::string_view(), kSource, {}, nullptr, &looks_fortran);
   ASSERT_FALSE(grid.ok());
   EXPECT_EQ(grid.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(MessageOf(grid.status()), HasSubstr("plot3d 'bad.fmt': the file is empty"));

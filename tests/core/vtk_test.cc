@@ -2,6 +2,7 @@
 #include "core/io/vtk.h"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -10,6 +11,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
+#include "core/io/vtk_compress.h"
+#include "core/io/vtk_pvd.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/io_test_util.h"
@@ -43,10 +46,18 @@ std::vector<size_t> DataArrayTags(const std::string& xml) {
   return tags;
 }
 
-// The raw appended bytes of the array at `offset` (after its UInt64 size header).
+// The raw appended bytes of the array at `offset` (after its UInt64 size header, or decoded
+// from zlib blocks when the file says compressor="vtkZLibDataCompressor").
 std::string AppendedArray(const std::string& vts, uint64_t offset) {
   const size_t data = vts.find("<AppendedData encoding=\"raw\">");
   const size_t underscore = vts.find('_', data);
+  if (vts.find("compressor=\"vtkZLibDataCompressor\"") != std::string::npos) {
+    int64_t consumed = 0;
+    absl::StatusOr<std::string> raw =
+        DecodeVtkZlibBlocks(std::string_view(vts).substr(underscore + 1 + offset), &consumed);
+    EXPECT_TRUE(raw.ok()) << raw.status();
+    return raw.ok() ? *raw : std::string();
+  }
   uint64_t size = 0;
   std::memcpy(&size, vts.data() + underscore + 1 + offset, sizeof(size));
   return vts.substr(underscore + 1 + offset + sizeof(size), size);
@@ -78,7 +89,9 @@ class VtkTest : public testing::Test {
 };
 
 TEST_F(VtkTest, AppendedRawVtsHasExtentsOffsetsAndData) {
-  absl::StatusOr<std::string> vts = EncodeVts(block_, arrays_);
+  VtkWriteOptions raw;
+  raw.compress = false;
+  absl::StatusOr<std::string> vts = EncodeVts(block_, arrays_, raw);
   ASSERT_TRUE(vts.ok()) << vts.status();
   EXPECT_EQ(Attribute(*vts, "<VTKFile", "type"), "StructuredGrid");
   EXPECT_EQ(Attribute(*vts, "<VTKFile", "header_type"), "UInt64");
@@ -245,6 +258,111 @@ TEST_F(VtkTest, ReportsUnwritablePathsAndBadArguments) {
   std::vector<std::vector<VtkPointArray>> too_few(2);
   status = WriteVtm((dir / "flow.vtm").string(), grid, too_few);
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(VtkTest, CompressedArraysDecodeToTheRawBytesAndAreSmaller) {
+  // A smooth 60 x 50 block: several 32 KiB blocks per array, the last one partial.
+  const StructuredBlock block = MakeSimpleGrid(3, {{60, 50, 3}}).blocks[0];
+  std::vector<double> field(static_cast<size_t>(block.num_points()));
+  for (size_t p = 0; p < field.size(); ++p) field[p] = std::sin(0.01 * static_cast<double>(p));
+  const std::vector<VtkPointArray> arrays = {VtkPointArray{"f", 1, field}};
+  VtkWriteOptions raw_options;
+  raw_options.compress = false;
+  absl::StatusOr<std::string> raw = EncodeVts(block, arrays, raw_options);
+  absl::StatusOr<std::string> compressed = EncodeVts(block, arrays);
+  ASSERT_TRUE(raw.ok() && compressed.ok());
+  EXPECT_EQ(Attribute(*compressed, "<VTKFile", "compressor"), "vtkZLibDataCompressor");
+  EXPECT_EQ(Attribute(*raw, "<VTKFile", "compressor"), "");
+  EXPECT_LT(compressed->size(), raw->size() * 3 / 4);
+  const std::vector<size_t> raw_tags = DataArrayTags(*raw);
+  const std::vector<size_t> tags = DataArrayTags(*compressed);
+  ASSERT_EQ(tags.size(), 2u);  // f, Points
+  for (size_t a = 0; a < tags.size(); ++a) {
+    const uint64_t offset = std::stoull(Attribute(*compressed, "<DataArray", "offset", tags[a]));
+    const uint64_t raw_offset = std::stoull(Attribute(*raw, "<DataArray", "offset", raw_tags[a]));
+    EXPECT_EQ(AppendedArray(*compressed, offset), AppendedArray(*raw, raw_offset));
+  }
+  // The header of the points array: 9000 x 24 bytes = 6 full blocks and one of 19392 bytes.
+  const size_t underscore = compressed->find('_', compressed->find("<AppendedData"));
+  const uint64_t points_offset =
+      std::stoull(Attribute(*compressed, "<DataArray", "offset", tags[1]));
+  uint64_t header[3];
+  std::memcpy(header, compressed->data() + underscore + 1 + points_offset, sizeof(header));
+  EXPECT_EQ(header[0], 7u);
+  EXPECT_EQ(header[1], 32768u);
+  EXPECT_EQ(header[2], 9000u * 24 - 6 * 32768);
+}
+
+TEST_F(VtkTest, CellArraysGoToCellData) {
+  const std::vector<double> quality = {0.5, 0.25, 1.0, -0.5, 0.75, 0.125};  // 3 x 2 cells
+  const std::vector<VtkPointArray> arrays = {
+      VtkPointArray{"pressure", 1, pressure_},
+      VtkPointArray{"quality", 1, quality, VtkArrayLocation::kCell}};
+  EXPECT_EQ(VtkNumCells(block_), 6);
+  VtkWriteOptions options;
+  options.data_format = VtkDataFormat::kAscii;
+  absl::StatusOr<std::string> vts = EncodeVts(block_, arrays, options);
+  ASSERT_TRUE(vts.ok()) << vts.status();
+  const size_t cell_data = vts->find("<CellData");
+  ASSERT_NE(cell_data, std::string::npos);
+  EXPECT_EQ(Attribute(*vts, "<CellData", "Scalars"), "quality");
+  EXPECT_EQ(Attribute(*vts, "<DataArray", "Name", cell_data), "quality");
+  EXPECT_LT(vts->find("Name=\"pressure\""), cell_data);
+  const std::vector<VtkPointArray> wrong = {
+      VtkPointArray{"quality", 1, pressure_, VtkArrayLocation::kCell}};
+  absl::StatusOr<std::string> refused = EncodeVts(block_, wrong);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(MessageOf(refused.status()),
+              HasSubstr("cell array 'quality' has 12 values; 6 cells x 1 components need 6"));
+}
+
+TEST_F(VtkTest, MultiBlockFilesCarryTheGivenBlockNumbers) {
+  const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "vtk_numbers";
+  std::filesystem::remove_all(dir);
+  const MultiBlockGrid grid = MakeSimpleGrid(3, {{2, 2, 2}, {3, 2, 1}});
+  const std::vector<int> numbers = {0, 3};
+  const std::string path = (dir / "wing.vtm").string();
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(WriteVtm(path, grid, {}, {}, numbers).ok());
+  absl::StatusOr<std::string> vtm = ReadFileToString(path);
+  ASSERT_TRUE(vtm.ok());
+  EXPECT_THAT(*vtm, HasSubstr("<DataSet index=\"1\" name=\"block_3\" file=\"wing/wing_3.vts\"/>"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "wing" / "wing_3.vts"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "wing" / "wing_1.vts"));
+  const std::vector<int> repeated = {2, 2};
+  EXPECT_EQ(WriteVtm(path, grid, {}, {}, repeated).code(), absl::StatusCode::kInvalidArgument);
+  const std::vector<int> one = {2};
+  EXPECT_EQ(WriteVtm(path, grid, {}, {}, one).code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(VtkPvdTest, ListsTimeStepsAndRefusesBadOnes) {
+  const std::vector<PvdEntry> entries = {{0.01, "run/run_1.vts"}, {0.025, "run/run_2.vts"}};
+  absl::StatusOr<std::string> pvd = EncodePvd(entries);
+  ASSERT_TRUE(pvd.ok()) << pvd.status();
+  EXPECT_THAT(*pvd, HasSubstr("<VTKFile type=\"Collection\" version=\"0.1\">"));
+  EXPECT_THAT(*pvd, HasSubstr("<DataSet timestep=\"0.025\" group=\"\" part=\"0\" "
+                              "file=\"run/run_2.vts\"/>"));
+  EXPECT_EQ(EncodePvd({}).status().code(), absl::StatusCode::kInvalidArgument);
+  const std::vector<PvdEntry> repeated = {{1.0, "a.vts"}, {1.0, "b.vts"}};
+  EXPECT_THAT(MessageOf(EncodePvd(repeated).status()), HasSubstr("not finite or repeats"));
+  const std::vector<PvdEntry> nan = {{std::nan(""), "a.vts"}};
+  EXPECT_EQ(EncodePvd(nan).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(VtkCompressTest, CorruptDataIsRefused) {
+  std::string out;
+  AppendVtkZlibBlocks(std::string(100000, 'a'), 6, &out);
+  int64_t consumed = 0;
+  absl::StatusOr<std::string> raw = DecodeVtkZlibBlocks(out, &consumed);
+  ASSERT_TRUE(raw.ok());
+  EXPECT_EQ(*raw, std::string(100000, 'a'));
+  EXPECT_EQ(consumed, static_cast<int64_t>(out.size()));
+  EXPECT_FALSE(
+      DecodeVtkZlibBlocks(std::string_view(out).substr(0, out.size() - 3), &consumed).ok());
+  std::string damaged = out;
+  damaged[damaged.size() - 5] ^= 0x55;
+  EXPECT_FALSE(DecodeVtkZlibBlocks(damaged, &consumed).ok());
+  EXPECT_FALSE(DecodeVtkZlibBlocks("short", &consumed).ok());
 }
 
 }  // namespace

@@ -61,6 +61,36 @@ StructuredBlock Box(const Extents& extents, int spatial_dim, bool iblank) {
   return block;
 }
 
+// C streams (no record markers) of both byte orders and precisions, with and without block
+// count and iblank, and Fortran records in the planes layout (a record per k-plane).
+void Plot3dStreamAndPlanesSeeds() {
+  for (bool iblank : {false, true}) {
+    for (bool count : {false, true}) {
+      MultiBlockGrid grid;
+      grid.blocks.push_back(Box(Extents{3, 2, 2}, 3, iblank));
+      if (count) grid.blocks.push_back(Box(Extents{2, 2, 3}, 3, iblank));
+      for (Plot3dEncoding encoding :
+           {Plot3dEncoding::kBinaryLittleEndian, Plot3dEncoding::kBinaryBigEndian}) {
+        for (int bytes_per_real : {4, 8}) {
+          Plot3dFormat format{.encoding = encoding,
+                              .spatial_dim = 3,
+                              .has_block_count = count,
+                              .has_iblank = iblank,
+                              .bytes_per_real = bytes_per_real};
+          const std::string suffix = absl::StrCat(
+              encoding == Plot3dEncoding::kBinaryBigEndian ? "be" : "le", "_r", bytes_per_real,
+              "_3d", count ? "_count" : "", iblank ? "_iblank" : "");
+          format.framing = Plot3dFraming::kCStream;
+          Write("plot3d_binary", "stream_" + suffix, EncodePlot3d(grid, format).value());
+          format.framing = Plot3dFraming::kFortranRecords;
+          format.layout = Plot3dLayout::kPlanes;
+          Write("plot3d_binary", "planes_" + suffix, EncodePlot3d(grid, format).value());
+        }
+      }
+    }
+  }
+}
+
 // Every Plot3D flavour: text and binary (both byte orders, single and double), block count or
 // not, 2D or 3D, iblank or not; one and two blocks; and the real 29 x 9 grid.
 void Plot3dSeeds(const MultiBlockGrid& naca) {
@@ -102,6 +132,7 @@ void Plot3dSeeds(const MultiBlockGrid& naca) {
   format.encoding = Plot3dEncoding::kBinaryBigEndian;
   format.bytes_per_real = 4;
   Write("plot3d_binary", "naca0012_29x9_2d_be_r4", EncodePlot3d(naca, format).value());
+  Plot3dStreamAndPlanesSeeds();
 }
 
 void AirfoilSeeds() {
