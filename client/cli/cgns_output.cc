@@ -1,0 +1,93 @@
+#include "client/cli/cgns_output.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
+#include "io/cgns/cgns_io.h"
+#include "proto/convert/archive_convert.h"
+#include "proto/convert/convert.h"
+#include "proto/convert/source_boundaries_convert.h"
+
+namespace splinegrid::cli {
+
+bool IsCgnsPath(const std::string& path) {
+  return std::filesystem::path(path).extension() == ".cgns";
+}
+
+absl::StatusOr<CgnsOutputContext> FetchCgnsOutputContext(client::Client& client,
+                                                         const v1::EvaluateGridRequest& request) {
+  if (request.has_counts() || request.has_index_box()) {
+    return absl::InvalidArgumentError(
+        "-o *.cgns writes whole blocks at a refinement level (boundary conditions and "
+        "connectivity map by index): use --level, not --res or --box");
+  }
+  if (request.derivatives()) {
+    return absl::InvalidArgumentError(
+        "-o *.cgns holds grid points only: --derivs has no place in it (write .vts/.vtm)");
+  }
+  if (request.refinement_level() > 20) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--level ", request.refinement_level(), " is beyond CGNS index ranges"));
+  }
+  CgnsOutputContext context;
+  context.level = request.refinement_level();
+  context.single_precision = request.precision() == v1::PRECISION_FLOAT;
+  v1::GetGridRequest get;
+  get.set_name(request.name());
+  get.set_view(v1::GRID_VIEW_FULL);
+  if (request.has_step()) {
+    get.set_step(request.step());
+  } else {
+    get.set_revision(request.revision());
+  }
+  *get.mutable_blocks() = request.blocks();
+  SG_ASSIGN_OR_RETURN(context.grid, client.Get(get));
+  return context;
+}
+
+absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, const client::EvaluatedGrid& result,
+                                        const CgnsOutputContext* context) {
+  MultiBlockGrid grid;
+  CgnsWriteOptions options;
+  int64_t points = 0;
+  for (const client::EvaluatedBlock& block : result.blocks) {
+    grid.blocks.push_back(block.points);
+    options.source_blocks.push_back(block.block);
+    points += block.points.num_points();
+  }
+  if (context != nullptr) {
+    const v1::SourceGrid& source = context->grid.source();
+    options.index_scale = 1 << context->level;
+    options.single_precision = context->single_precision;
+    for (const v1::Extents& e : source.blocks()) options.source_extents.push_back(ParseExtents(e));
+    SG_ASSIGN_OR_RETURN(
+        const SourceBoundaries boundaries,
+        ParseSourceBoundaries(source.boundaries(), options.source_extents, "source.boundaries"));
+    v1::StoredConnectivity stored;
+    *stored.mutable_matches() = source.connectivity();
+    SG_ASSIGN_OR_RETURN(
+        const Connectivity connectivity,
+        ParseStoredConnectivity(stored, options.source_extents, "source.connectivity"));
+    options.block_names = boundaries.block_names;
+    options.conditions = boundaries.conditions;
+    options.matches = connectivity.matches;
+  }
+  std::vector<std::string> notes;
+  if (context != nullptr && !options.matches.empty() &&
+      context->grid.revision().report().max_gap() > 0.0) {
+    // Tolerance fits are watertight (gap 0); a fit to control counts may not be.
+    notes.push_back(absl::StrCat(
+        "revision ", context->grid.revision().revision(), " leaves its matched boundaries up to ",
+        context->grid.revision().report().max_gap(),
+        " apart (its report's max_gap); the 1-to-1 connections are written by index, so their "
+        "points differ by that much"));
+  }
+  SG_RETURN_IF_ERROR(WriteCgnsFile(out, grid, options, &notes));
+  for (const std::string& note : notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+  return points;
+}
+
+}  // namespace splinegrid::cli
