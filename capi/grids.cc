@@ -1,0 +1,160 @@
+// splinegrid.h: importing, fitting, describing and deleting grids.
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "capi/client_state.h"
+#include "capi/splinegrid.h"
+#include "client/client.h"
+#include "core/grid/sampling.h"
+#include "core/grid/structured_grid.h"
+#include "core/io/file_util.h"
+#include "core/util/status_macros.h"
+
+namespace {
+
+namespace client = splinegrid::client;
+namespace v1 = splinegrid::v1;
+using splinegrid::capi::Guard;
+using splinegrid::capi::RequireString;
+
+splinegrid::capi::ClientState* StateOf(sg_client* c) {
+  return c == nullptr ? nullptr : c->state.get();
+}
+
+// The basic view of `grid` (its source's shape, latest revision).
+absl::StatusOr<v1::Grid> GetGrid(sg_client* c, const char* grid) {
+  SG_RETURN_IF_ERROR(RequireString(grid, "grid"));
+  SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+  return connected->Get(client::GridName(grid));
+}
+
+// The file name of `path`, as the new grid's display name.
+std::string BaseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+}  // namespace
+
+extern "C" {
+
+sg_status sg_import_plot3d(sg_client* c, const char* path, const char* grid_id, int32_t planar_view,
+                           char* id, size_t id_size) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    SG_RETURN_IF_ERROR(RequireString(path, "path"));
+    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+    SG_ASSIGN_OR_RETURN(const std::string bytes, splinegrid::ReadFileToString(path));
+    SG_ASSIGN_OR_RETURN(const v1::Grid grid,
+                        connected->ImportPlot3d(bytes, grid_id == nullptr ? "" : grid_id,
+                                                BaseName(path), planar_view != 0));
+    return splinegrid::capi::CopyOut(client::GridId(grid.name()), id, id_size, "id");
+  });
+}
+
+sg_status sg_import_points(sg_client* c, const char* grid_id, int32_t spatial_dim,
+                           const int32_t extents[3], const double* points, int64_t count, char* id,
+                           size_t id_size) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    if (spatial_dim != 2 && spatial_dim != 3) {
+      return absl::InvalidArgumentError(absl::StrCat("spatial_dim: ", spatial_dim, " (2 or 3)"));
+    }
+    if (extents == nullptr) return absl::InvalidArgumentError("extents: NULL");
+    const splinegrid::Extents e = {extents[0], extents[1], extents[2]};
+    SG_RETURN_IF_ERROR(splinegrid::ValidateExtents(e, "extents"));
+    const int64_t needed = splinegrid::NumPoints(e) * spatial_dim;
+    if (count != needed) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("count: ", count, " values in points; extents ", e[0], " x ", e[1], " x ",
+                       e[2], " with spatial_dim ", spatial_dim, " need ", needed));
+    }
+    if (points == nullptr) return absl::InvalidArgumentError("points: NULL");
+    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+    splinegrid::MultiBlockGrid source;
+    source.blocks.emplace_back(e, spatial_dim);
+    std::copy(points, points + needed, source.blocks.front().coords().begin());
+    SG_RETURN_IF_ERROR(splinegrid::ValidateFinite(source.blocks.front(), "points"));
+    const std::string wanted = grid_id == nullptr ? "" : grid_id;
+    SG_ASSIGN_OR_RETURN(const v1::Grid grid, connected->ImportPoints(source, wanted, wanted));
+    return splinegrid::capi::CopyOut(client::GridId(grid.name()), id, id_size, "id");
+  });
+}
+
+sg_status sg_fit(sg_client* c, const char* grid, double tolerance, sg_fit_result* result) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    SG_RETURN_IF_ERROR(RequireString(grid, "grid"));
+    v1::FitSpec spec;
+    if (tolerance > 0.0 && std::isfinite(tolerance)) {
+      spec.set_tolerance(tolerance);
+    } else if (tolerance == 0.0) {
+      spec.mutable_boundary_tolerances();  // the defaults by kind
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "tolerance: ", tolerance, " (give a length > 0, or 0 for tolerances by boundary kind)"));
+    }
+    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+    SG_ASSIGN_OR_RETURN(const v1::FitGridResponse fit,
+                        connected->Fit(client::GridName(grid), spec));
+    if (result != nullptr) {
+      *result = sg_fit_result{fit.revision(), fit.num_points(), fit.num_control_points(),
+                              fit.max_deviation(), fit.seconds()};
+    }
+    return absl::OkStatus();
+  });
+}
+
+sg_status sg_grid_info_get(sg_client* c, const char* grid, sg_grid_info* info) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    if (info == nullptr) return absl::InvalidArgumentError("info: NULL");
+    SG_ASSIGN_OR_RETURN(const v1::Grid got, GetGrid(c, grid));
+    *info =
+        sg_grid_info{got.latest_revision(), got.source().blocks_size(), got.source().spatial_dim()};
+    return absl::OkStatus();
+  });
+}
+
+sg_status sg_block_extents(sg_client* c, const char* grid, int32_t block, int32_t level,
+                           int32_t extents[3]) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    if (extents == nullptr) return absl::InvalidArgumentError("extents: NULL");
+    if (level < 0 || level > splinegrid::kMaxRefinementLevel) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("level: ", level, " (0 to ", splinegrid::kMaxRefinementLevel, ")"));
+    }
+    SG_ASSIGN_OR_RETURN(const v1::Grid got, GetGrid(c, grid));
+    if (block < 0 || block >= got.source().blocks_size()) {
+      return absl::InvalidArgumentError(absl::StrCat("block: ", block, " (the grid has ",
+                                                     got.source().blocks_size(), " blocks)"));
+    }
+    const v1::Extents& e = got.source().blocks(block);
+    int32_t refined[3];
+    const int64_t counts[3] = {e.i(), e.j(), e.k()};
+    for (int d = 0; d < 3; ++d) {
+      const int64_t n = counts[d] > 1 ? ((counts[d] - 1) << level) + 1 : counts[d];
+      if (n > INT32_MAX) {
+        return absl::OutOfRangeError(
+            absl::StrCat("level: ", level, " gives ", n, " points in direction ", d));
+      }
+      refined[d] = static_cast<int32_t>(n);
+    }
+    std::copy(refined, refined + 3, extents);
+    return absl::OkStatus();
+  });
+}
+
+sg_status sg_delete(sg_client* c, const char* grid) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    SG_RETURN_IF_ERROR(RequireString(grid, "grid"));
+    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+    return connected->Delete(client::GridName(grid));
+  });
+}
+
+}  // extern "C"
