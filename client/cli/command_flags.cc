@@ -1,0 +1,143 @@
+#include "client/cli/command_flags.h"
+
+#include <algorithm>
+
+namespace splinegrid::cli {
+namespace {
+
+// The fit flags (commands.cc SpecFromFlags and ParseFairFlag): fit and offset both build a
+// FitSpec from them.
+#define SG_FIT_SPEC_FLAGS                                                                    \
+  "tol", "ctl", "order", "max_ctl", "kinds", "ref_length", "wall", "interface", "outer",     \
+      "interior", "edge", "face", "fair", "allow_folds"
+
+std::vector<CommandSpec> MakeCommands() {
+  return {
+      {"serve",
+       "serve [--address localhost:50051] [--store memory|dir:PATH|redis://H:P[/DB]] [flags]",
+       "run the gRPC server (in the foreground; SIGTERM drains and stops it)",
+       /*client=*/false,
+       {"address", "store", "threads", "memory_budget_mb", "keep_revisions", "log_calls",
+        "log_format", "drain_notice", "shutdown_grace", "import_idle_timeout",
+        "max_output_points", "max_running_long_tasks", "max_queued_long_calls_per_principal",
+        "max_streams_per_principal", "tls_cert", "tls_key", "tls_client_ca", "insecure",
+        "tokens", "metrics_address", "metrics_insecure", "cgns_decoder"},
+       {"Plaintext only on a loopback address unless --insecure; --tls_cert and --tls_key "
+        "enable TLS."}},
+      {"fit",
+       "fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] | --ctl a,b,c] "
+       "[--fair tol|LAMBDA] [--allow_folds]",
+       "import a Plot3D grid and fit it (revision 1); prints the fit report",
+       /*client=*/true,
+       {"name", "planar", "plot3d_layout", SG_FIT_SPEC_FLAGS},
+       {"--kinds: tolerances 0.15e-3 (wall), 2e-3 (interface), 8e-3 (outer) times the reference "
+        "length (the largest extent of a wall, e.g. the chord; --ref_length overrides).",
+        "A fit whose cells fold at levels 0..2 is refused (exit 1, nothing stored); with "
+        "--allow_folds it is stored and the command exits 3."}},
+      {"fair", "fair NAME [--revision R] [--fair tol|LAMBDA] [--allow_folds]",
+       "a faired revision of a grid (default: the largest weight within its tolerances)",
+       /*client=*/true,
+       {"revision", "fair", "allow_folds"},
+       {}},
+      {"curvature", "curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]",
+       "wall curvature of a revision (CSV with -o)",
+       /*client=*/true,
+       {"revision", "level", "block", "o"},
+       {}},
+      {"airfoil", "airfoil FILE.dat [--tol 1e-4] [--fair tol|LAMBDA|off] [-o OUT.csv]",
+       "fit an airfoil's coordinates locally (no server); curvature CSV with -o",
+       /*client=*/false,
+       {"tol", "fair", "o"},
+       {"The connection flags (--server, --json, TLS ...) are accepted and ignored."}},
+      {"get", "get NAME [--revision R | --step N] [--full]",
+       "a grid's description (with --full its knots and control points)",
+       /*client=*/true,
+       {"revision", "step", "full"},
+       {}},
+      {"list", "list", "the grids held by the server", /*client=*/true, {}, {}},
+      {"rm", "rm NAME", "delete a grid and its revisions", /*client=*/true, {}, {}},
+      {"health", "health [--service S]", "the server's health status (exit 1 unless SERVING)",
+       /*client=*/true,
+       {"service"},
+       {}},
+      {"eval",
+       "eval NAME (--level L | --res a,b,c) [--revision R | --step N | --steps A:B] [--block b] "
+       "[--box i0:i1,j0:j1[,k0:k1]] [--derivs] [--float32] -o OUT.{vts,vtm,x,xyz,pvd}",
+       "evaluate a revision at a refinement level or resolution into a file",
+       /*client=*/true,
+       {"o", "level", "res", "revision", "step", "block", "box", "derivs", "float32", "steps",
+        "compress", "jacobian", "quality", "deviation"},
+       {}},
+      {"deform",
+       "deform NAME [--rotate DEG [--about X,Y[,Z]] [--axis X,Y,Z]] [--translate DX,DY[,DZ]] "
+       "[--boundary wall|outer|interface|BLOCK:FACE[:A0:A1[:B0:B1]],...] [--reference R] "
+       "[--base R] [--time T] [--step N] [flags]",
+       "rigidly move part of a grid's boundary; the interior follows (a new revision)",
+       /*client=*/true,
+       {"rotate", "about", "axis", "translate", "boundary", "reference", "base", "time", "step",
+        "check_level", "propagation", "decay_radius", "rigid_radius", "smoothing"},
+       {"A fold is FAILED_PRECONDITION (exit 1), nothing stored."}},
+      {"offset",
+       "offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] [--points 257] "
+       "[--method offsets|transfinite|elliptic] [--tol T | --kinds ... | --ctl a,b,c] "
+       "[-o OUT.{vts,x,xyz}]",
+       "an O-grid around an airfoil file (GenerateGrid), stored and fitted",
+       /*client=*/true,
+       {"name", "o", "layers", "first", "far", "points", "method", "orthogonalize",
+        "profile_tol", SG_FIT_SPEC_FLAGS},
+       {"The profile file is Selig or Lednicer; -o writes the grid at level 0."}},
+      {"watch", "watch NAME [--after R]",
+       "one line per new revision of a grid until ^C or its deletion",
+       /*client=*/true,
+       {"after"},
+       {}},
+      {"export", "export NAME -o FILE.sgrid",
+       "write a grid with its source and revisions to an archive",
+       /*client=*/true,
+       {"o"},
+       {}},
+      {"import", "import FILE.sgrid [--name NEW]",
+       "a grid from an archive; revisions keep their numbers (a Plot3D file: use fit)",
+       /*client=*/true,
+       {"name"},
+       {}},
+  };
+}
+
+#undef SG_FIT_SPEC_FLAGS
+
+}  // namespace
+
+const std::vector<CommandSpec>& Commands() {
+  static const std::vector<CommandSpec>* const commands =
+      new std::vector<CommandSpec>(MakeCommands());
+  return *commands;
+}
+
+const std::vector<std::string>& ClientFlags() {
+  static const std::vector<std::string>* const flags = new std::vector<std::string>{
+      "server", "json", "timeout", "token", "tls_ca", "tls_cert", "tls_key", "tls_server_name"};
+  return *flags;
+}
+
+const CommandSpec* FindCommand(absl::string_view name) {
+  for (const CommandSpec& command : Commands()) {
+    if (command.name == name) return &command;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> AcceptedFlags(const CommandSpec& command) {
+  std::vector<std::string> flags = command.flags;
+  // serve has transport flags of its own (--tls_cert is the server's certificate there). Every
+  // other command takes the connection flags, the local airfoil too (it ignores them), so that
+  // scripts and aliases (`alias sg='splinegrid --server=h:50051'`) may pass them to any command.
+  if (command.name != "serve") {
+    for (const std::string& flag : ClientFlags()) {
+      if (std::find(flags.begin(), flags.end(), flag) == flags.end()) flags.push_back(flag);
+    }
+  }
+  return flags;
+}
+
+}  // namespace splinegrid::cli

@@ -1,0 +1,213 @@
+// The command table of the CLI (client/cli/command_flags.h) against the flags really defined,
+// and the command-line check (command_line.h) on the forms users type, including every
+// `splinegrid ...` span the READMEs quote.
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "absl/flags/reflection.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+#include "client/cli/command_flags.h"
+#include "client/cli/command_help.h"
+#include "client/cli/command_line.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace splinegrid::cli {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+std::set<std::string> ListedFlags() {
+  std::set<std::string> listed;
+  for (const CommandSpec& command : Commands()) {
+    for (const std::string& flag : AcceptedFlags(command)) listed.insert(flag);
+  }
+  return listed;
+}
+
+// Every flag this project defines in the binary's sources (not Abseil's own --flagfile ...).
+std::vector<std::string> ProjectFlags() {
+  std::vector<std::string> names;
+  for (const auto& [name, flag] : absl::GetAllFlags()) {
+    // Abseil reports the defining file without its leading slashes.
+    if (absl::StrContains(flag->Filename(), absl::StripPrefix(SPLINEGRID_SOURCE_DIR, "/"))) {
+      names.push_back(std::string(name));
+    }
+  }
+  return names;
+}
+
+TEST(CommandFlags, EveryDefinedFlagIsListedForSomeCommand) {
+  const std::set<std::string> listed = ListedFlags();
+  const std::vector<std::string> defined = ProjectFlags();
+  ASSERT_GT(defined.size(), 50u) << "the CLI's flags are not linked in";
+  for (const std::string& name : defined) {
+    EXPECT_TRUE(listed.count(name))
+        << "--" << name << " is defined but listed for no command in client/cli/command_flags.cc";
+  }
+}
+
+TEST(CommandFlags, EveryListedNameIsADefinedFlag) {
+  for (const std::string& name : ListedFlags()) {
+    EXPECT_NE(absl::FindCommandLineFlag(name), nullptr)
+        << "client/cli/command_flags.cc lists --" << name << ", which is not a flag";
+  }
+}
+
+TEST(CommandFlags, CommandsAreUniqueAndDescribed) {
+  std::set<std::string> names;
+  for (const CommandSpec& command : Commands()) {
+    EXPECT_TRUE(names.insert(command.name).second) << command.name;
+    EXPECT_TRUE(absl::StartsWith(command.usage, command.name)) << command.usage;
+    EXPECT_FALSE(command.summary.empty()) << command.name;
+  }
+  EXPECT_EQ(FindCommand("nosuch"), nullptr);
+  ASSERT_NE(FindCommand("fit"), nullptr);
+}
+
+absl::StatusOr<CommandLine> Check(const std::string& line) {
+  return CheckCommandLine(absl::StrSplit(line, ' ', absl::SkipEmpty()));
+}
+
+TEST(CommandLineCheck, RefusesAFlagOfAnotherCommandNamingItsOwner) {
+  const auto line = Check("list --rotate 10 --level 3");
+  ASSERT_FALSE(line.ok());
+  EXPECT_EQ(line.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(line.status().message(),
+              HasSubstr("--rotate is not a flag of list; it belongs to deform"));
+  // A connection flag given to serve: the group is named. The local airfoil accepts them (and
+  // ignores them), so that scripts may pass --server to every command.
+  const auto serve = Check("serve --server localhost:1");
+  ASSERT_FALSE(serve.ok());
+  EXPECT_THAT(serve.status().message(),
+              HasSubstr("--server is not a flag of serve; it belongs to the commands that "
+                        "talk to a server"));
+  EXPECT_TRUE(Check("airfoil a.dat --server localhost:1 --json").ok());
+}
+
+TEST(CommandLineCheck, SuggestsTheClosestFlagOfTheCommand) {
+  const auto line = Check("eval g --levl 2 -o x.vts");
+  ASSERT_FALSE(line.ok());
+  EXPECT_THAT(line.status().message(), HasSubstr("unknown flag --levl for eval"));
+  EXPECT_THAT(line.status().message(), HasSubstr("did you mean --level?"));
+  const auto far = Check("list --zzzzzzzz");
+  ASSERT_FALSE(far.ok());
+  EXPECT_THAT(far.status().message(), Not(HasSubstr("did you mean")));
+}
+
+TEST(CommandLineCheck, SuggestsTheClosestCommand) {
+  const auto line = Check("evl g");
+  ASSERT_FALSE(line.ok());
+  EXPECT_THAT(line.status().message(), HasSubstr("unknown command 'evl'; did you mean eval?"));
+  EXPECT_FALSE(Check("help nosuch").ok());
+  EXPECT_FALSE(Check("").ok());  // no command
+}
+
+TEST(CommandLineCheck, SkipsValuesAndKnowsBoolFlags) {
+  // A value that looks like a command or a flag is a value.
+  const auto fit = Check("fit --name list grid.x --kinds --nokinds --allow_folds=false");
+  ASSERT_TRUE(fit.ok()) << fit.status();
+  EXPECT_EQ(fit->command->name, "fit");
+  const auto deform = Check("deform g --translate -0.1,0 --rotate=-3");
+  ASSERT_TRUE(deform.ok()) << deform.status();
+  // A bool flag takes no separate value: `list` here is the command.
+  const auto json = Check("--json list");
+  ASSERT_TRUE(json.ok()) << json.status();
+  EXPECT_EQ(json->command->name, "list");
+  // After --, everything is positional.
+  const auto rm = Check("rm -- --rotate");
+  ASSERT_TRUE(rm.ok()) << rm.status();
+  // --noFLAG only for bool flags.
+  EXPECT_FALSE(Check("eval g --nolevel -o x.vts").ok());
+}
+
+TEST(CommandLineCheck, HelpAndVersionForms) {
+  for (const char* form : {"help", "--help", "-h", "-help"}) {
+    const auto line = Check(form);
+    ASSERT_TRUE(line.ok()) << form;
+    EXPECT_EQ(line->action, CommandLine::Action::kHelp) << form;
+    EXPECT_EQ(line->command, nullptr) << form;
+  }
+  for (const char* form : {"help fit", "fit --help", "fit -h", "fit --tol 3 --help"}) {
+    const auto line = Check(form);
+    ASSERT_TRUE(line.ok()) << form;
+    EXPECT_EQ(line->action, CommandLine::Action::kHelp) << form;
+    ASSERT_NE(line->command, nullptr) << form;
+    EXPECT_EQ(line->command->name, "fit") << form;
+  }
+  const auto version = Check("--version");
+  ASSERT_TRUE(version.ok());
+  EXPECT_EQ(version->action, CommandLine::Action::kVersion);
+}
+
+TEST(CommandHelp, ListsTheCommandsFlagsWithHelpAndDefaults) {
+  const std::string fit = CommandHelp(*FindCommand("fit"));
+  EXPECT_THAT(fit, HasSubstr("usage: splinegrid fit FILE"));
+  EXPECT_THAT(fit, HasSubstr("--tol VALUE  (default: 0)"));
+  EXPECT_THAT(fit, HasSubstr("largest allowed deviation"));
+  EXPECT_THAT(fit, HasSubstr("--server VALUE  (default: \"localhost:50051\")"));
+  EXPECT_THAT(fit, Not(HasSubstr("--rotate")));
+  const std::string airfoil = CommandHelp(*FindCommand("airfoil"));
+  EXPECT_THAT(airfoil, Not(HasSubstr("--server VALUE")));  // accepted, ignored, not listed
+  const std::string overview = OverviewHelp("9.9.9");
+  EXPECT_THAT(overview, HasSubstr("splinegrid 9.9.9"));
+  for (const CommandSpec& command : Commands()) EXPECT_THAT(overview, HasSubstr(command.name));
+}
+
+TEST(EditDistance, CountsEdits) {
+  EXPECT_EQ(EditDistance("level", "level"), 0);
+  EXPECT_EQ(EditDistance("levl", "level"), 1);
+  EXPECT_EQ(EditDistance("", "abc"), 3);
+  EXPECT_EQ(EditDistance("kitten", "sitting"), 3);
+  EXPECT_EQ(ClosestName("revison", {"revision", "reference"}), "revision");
+  EXPECT_EQ(ClosestName("xyz", {"revision"}), "");
+}
+
+// Every `splinegrid CMD ...` the READMEs quote in backticks or in code blocks uses flags its
+// command accepts (placeholders such as FILE or [--name NEW] are fine: the check is about
+// names). The complete command lines of the quick start also run through the real binary
+// (tests/e2e/cli_conventions_test.cc).
+std::vector<std::string> ReadmeCommandLines() {
+  std::vector<std::string> lines;
+  const std::regex span(R"((?:build/)?\bsplinegrid ([a-z]+)((?: [^`\n#&]*)?))");
+  for (const char* file : {"/README.md", "/python/README.md", "/deploy/README.md",
+                           "/docker/README.md"}) {
+    std::ifstream in(std::string(SPLINEGRID_SOURCE_DIR) + file);
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string all = text.str();
+    for (std::sregex_iterator it(all.begin(), all.end(), span), end; it != end; ++it) {
+      if (FindCommand((*it)[1].str()) == nullptr) continue;  // prose: "splinegrid is a ..."
+      lines.push_back((*it)[1].str() + (*it)[2].str());
+    }
+  }
+  return lines;
+}
+
+TEST(CommandLineCheck, EveryReadmeCommandUsesFlagsItsCommandAccepts) {
+  const std::vector<std::string> lines = ReadmeCommandLines();
+  ASSERT_GT(lines.size(), 15u);
+  for (std::string line : lines) {
+    // Drop the syntax of usage lines: brackets, alternatives, ellipses.
+    for (char& c : line) {
+      if (c == '[' || c == ']' || c == '(' || c == ')') c = ' ';
+    }
+    std::vector<std::string> words;
+    for (absl::string_view word : absl::StrSplit(line, ' ', absl::SkipEmpty())) {
+      if (word == "|" || word == "..." || word == "\\") continue;
+      words.emplace_back(word);
+    }
+    const auto checked = CheckCommandLine(words);
+    EXPECT_TRUE(checked.ok()) << "README: splinegrid " << line << "\n  " << checked.status();
+  }
+}
+
+}  // namespace
+}  // namespace splinegrid::cli
