@@ -14,16 +14,19 @@ merge: repeated fields append. The helpers below rely on that.
 
 from __future__ import annotations
 
-from typing import Iterator, Union
+from typing import Any, Iterator, Union
 
 import numpy as np
+import numpy.typing as npt
 
 Buffer = Union[bytes, memoryview]
+Array = npt.NDArray[Any]  # a NumPy array of any dtype (float64/float32 for bulk numbers)
+Dtype = np.dtype[Any]
 
 VARINT, FIXED64, LENGTH_DELIMITED, FIXED32 = 0, 1, 2, 5
 
-DOUBLE = np.dtype("<f8")
-FLOAT = np.dtype("<f4")
+DOUBLE: Dtype = np.dtype("<f8")
+FLOAT: Dtype = np.dtype("<f4")
 
 
 def encode_varint(value: int) -> bytes:
@@ -61,7 +64,7 @@ def length_delimited(field: int, payload: bytes) -> bytes:
     return encode_varint(field << 3 | LENGTH_DELIMITED) + encode_varint(len(payload)) + payload
 
 
-def packed_doubles(field: int, values: np.ndarray) -> bytes:
+def packed_doubles(field: int, values: npt.ArrayLike) -> bytes:
     """A packed ``repeated double`` field holding ``values`` (any shape, read in C order)."""
     return length_delimited(field, np.ascontiguousarray(values, dtype="<f8").tobytes())
 
@@ -100,9 +103,9 @@ class FloatFields:
     """
 
     def __init__(self) -> None:
-        self._pieces: dict[int, list[np.ndarray]] = {}
+        self._pieces: dict[int, list[Array]] = {}
 
-    def add(self, field: int, wire_type: int, value: memoryview, dtype: np.dtype) -> None:
+    def add(self, field: int, wire_type: int, value: memoryview, dtype: Dtype) -> None:
         unpacked = FIXED64 if dtype.itemsize == 8 else FIXED32
         if wire_type not in (LENGTH_DELIMITED, unpacked):
             raise ValueError(f"field {field}: wire type {wire_type} is not {dtype} data")
@@ -110,7 +113,7 @@ class FloatFields:
             raise ValueError(f"field {field}: {len(value)} bytes is not a whole number of values")
         self._pieces.setdefault(field, []).append(np.frombuffer(value, dtype=dtype))
 
-    def get(self, field: int, dtype: np.dtype) -> np.ndarray:
+    def get(self, field: int, dtype: Dtype) -> Array:
         """The values of ``field`` in ``dtype``'s byte order (empty if it was absent)."""
         pieces = self._pieces.get(field)
         if not pieces:

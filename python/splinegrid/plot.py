@@ -20,7 +20,7 @@ matplotlib.use("Agg")  # files only: no display on a server
 
 import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
 
-from splinegrid.client import WallCurvatureLine  # noqa: E402
+from splinegrid.results import WallCurvatureLine  # noqa: E402
 
 __all__ = ["plot_wall_curvature"]
 

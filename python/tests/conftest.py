@@ -1,0 +1,55 @@
+"""Shared fixtures: the real server binary on a loopback port, and paths of the shared data."""
+
+import os
+import pathlib
+import socket
+import subprocess
+import time
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+DATA = REPO.parent / "shared" / "data"
+
+
+def server_binary() -> pathlib.Path:
+    """``SPLINEGRID_SERVER`` (set by the CTest registration), else ``REPO/build/splinegrid``."""
+    return pathlib.Path(os.environ.get("SPLINEGRID_SERVER", REPO / "build" / "splinegrid"))
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server():
+    """``host:port`` of a real ``splinegrid serve`` (in-memory store) for the module's tests.
+    Skipped when the binary is not built (pytest run by hand before a CMake build); CTest
+    always passes it."""
+    binary = server_binary()
+    if not binary.is_file():
+        pytest.skip(f"{binary} is not built (set SPLINEGRID_SERVER)")
+    port = _free_port()
+    process = subprocess.Popen([str(binary), "serve", f"--address=127.0.0.1:{port}",
+                                "--drain_notice=0s", "--shutdown_grace=1s"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 20
+    try:
+        while True:
+            with socket.socket() as s:
+                if s.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            if process.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError(f"splinegrid serve did not start: "
+                                   f"{process.stderr.read().decode() if process.stderr else ''}")
+            time.sleep(0.05)
+        yield f"127.0.0.1:{port}"
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
