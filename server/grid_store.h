@@ -27,7 +27,9 @@
 #include "absl/time/time.h"
 #include "core/deform/deform_quality.h"
 #include "core/fit/grid_fit.h"
+#include "core/grid/source_boundaries.h"
 #include "core/grid/structured_grid.h"
+#include "core/io/plot3d_source_format.h"
 #include "server/memory_budget.h"
 
 namespace splinegrid::server {
@@ -82,6 +84,11 @@ struct SourcePoints {
   MultiBlockGrid grid;
   Connectivity connectivity;  // found at import
   std::string format;         // how it arrived, e.g. "plot3d ascii 2d single-block"
+  // The file's boundary conditions (CGNS imports): default face kinds of fits, written back
+  // with evaluations.
+  SourceBoundaries boundaries;
+  // Plot3D imports: the file's layout, for writing evaluations back the same way.
+  std::optional<Plot3dSourceFormat> plot3d;
   MemoryReservation memory;
 };
 
@@ -229,6 +236,14 @@ class GridStore {
   // Up to `limit` grids with ids greater than `after`, in id order, and whether more follow.
   virtual absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(
       const std::string& after, int limit, bool* more) = 0;
+
+  // How many grids and revisions the store holds (metrics). Reads no revision: for a shared
+  // store one round trip that counts keys, not a listing.
+  struct Counts {
+    int64_t grids = 0;
+    int64_t revisions = 0;
+  };
+  virtual absl::StatusOr<Counts> Count() = 0;
 
   // OK while the store can serve; otherwise why not (UNAVAILABLE: e.g. Redis is unreachable).
   // Cheap: health checks poll it.

@@ -158,4 +158,14 @@ absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> MemoryStore::List
   return page;
 }
 
+absl::StatusOr<GridStore::Counts> MemoryStore::Count() {
+  Counts counts;
+  std::lock_guard<std::mutex> lock(mu_);
+  for (const auto& [id, grid] : grids_) {
+    ++counts.grids;
+    counts.revisions += static_cast<int64_t>(grid->revisions.size());
+  }
+  return counts;
+}
+
 }  // namespace splinegrid::server

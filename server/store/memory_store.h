@@ -53,6 +53,7 @@ class MemoryStore final : public GridStore {
   absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(const std::string& after,
                                                                       int limit,
                                                                       bool* more) override;
+  absl::StatusOr<Counts> Count() override;
 
  private:
   // The mutex that serialises the writers of grid `id`.

@@ -143,6 +143,12 @@ class RedisStore final : public GridStore {
   absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(const std::string& after,
                                                                       int limit,
                                                                       bool* more) override;
+  absl::StatusOr<Counts> Count() override {
+    SG_ASSIGN_OR_RETURN(RedisReply reply,
+                        pool_.Run(CountScript(), {keys_.Index()}, {keys_.Grid("")}));
+    const RedisValue value = reply.value();
+    return Counts{value[0].AsInt().value_or(0), value[1].AsInt().value_or(0)};
+  }
   absl::Status Available() const override {
     std::lock_guard<std::mutex> lock(health_mu_);
     return available_;
