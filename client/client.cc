@@ -225,12 +225,21 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
 absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const std::string& grid_id,
                                               const std::string& display_name, bool planar_view,
                                               const ProgressFn& progress) {
+  v1::Plot3dSource options;
+  options.set_planar_view(planar_view);
+  return ImportPlot3d(bytes, grid_id, display_name, options, progress);
+}
+
+absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const std::string& grid_id,
+                                              const std::string& display_name,
+                                              const v1::Plot3dSource& options,
+                                              const ProgressFn& progress) {
   v1::ImportGridRequest head;
   v1::ImportHeader* header = head.mutable_header();
   header->set_grid_id(grid_id);
   header->set_display_name(display_name);
+  *header->mutable_plot3d() = options;
   header->mutable_plot3d()->set_total_bytes(static_cast<int64_t>(bytes.size()));
-  header->mutable_plot3d()->set_planar_view(planar_view);
   v1::Grid grid;
   SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
     auto writer = stub_->ImportGrid(context, &grid);
@@ -238,6 +247,30 @@ absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const st
     v1::ImportGridRequest request;
     for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
       request.set_plot3d_chunk(bytes.substr(at, kUploadChunkBytes));
+      open = writer->Write(request);
+      if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  }));
+  return grid;
+}
+
+absl::StatusOr<v1::Grid> Client::ImportCgns(const std::string& bytes, const std::string& grid_id,
+                                            const std::string& display_name,
+                                            const ProgressFn& progress) {
+  v1::ImportGridRequest head;
+  v1::ImportHeader* header = head.mutable_header();
+  header->set_grid_id(grid_id);
+  header->set_display_name(display_name);
+  header->mutable_cgns()->set_total_bytes(static_cast<int64_t>(bytes.size()));
+  v1::Grid grid;
+  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
+    auto writer = stub_->ImportGrid(context, &grid);
+    bool open = writer->Write(head);
+    v1::ImportGridRequest request;
+    for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
+      request.set_cgns_chunk(bytes.substr(at, kUploadChunkBytes));
       open = writer->Write(request);
       if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
     }

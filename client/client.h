@@ -183,6 +183,16 @@ class Client {
   absl::StatusOr<v1::Grid> ImportPlot3d(const std::string& bytes, const std::string& grid_id,
                                         const std::string& display_name, bool planar_view,
                                         const ProgressFn& progress = {});
+  // The same with every Plot3dSource option (planar_view, layout); total_bytes is set here.
+  absl::StatusOr<v1::Grid> ImportPlot3d(const std::string& bytes, const std::string& grid_id,
+                                        const std::string& display_name,
+                                        const v1::Plot3dSource& options,
+                                        const ProgressFn& progress = {});
+  // Uploads a CGNS file's bytes as a new grid (the server decodes them; the response's
+  // source.boundaries holds the file's boundary conditions and the import's notes).
+  absl::StatusOr<v1::Grid> ImportCgns(const std::string& bytes, const std::string& grid_id,
+                                      const std::string& display_name,
+                                      const ProgressFn& progress = {});
   // Uploads in-memory points as a new grid.
   absl::StatusOr<v1::Grid> ImportPoints(const MultiBlockGrid& grid, const std::string& grid_id,
                                         const std::string& display_name,

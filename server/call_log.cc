@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/util/quote.h"
+#include "server/call_metrics.h"
 
 namespace splinegrid::server {
 namespace {
@@ -54,8 +55,11 @@ std::string CallLog::Line(const absl::Status& status, absl::Time now) const {
 }
 
 void CallLog::Finish(const absl::Status& status) const {
+  const absl::Time now = absl::Now();
+  // The metrics count the calls the log lines show, whether or not lines are written.
+  CallMetrics::Global().Record(method_, status.code(), now - start_);
   if (!enabled_) return;
-  const std::string line = Line(status, absl::Now());
+  const std::string line = Line(status, now);
   std::fwrite(line.data(), 1, line.size(), stderr);
 }
 

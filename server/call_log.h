@@ -32,7 +32,8 @@ class CallLog {
   void set_grid(std::string grid) { grid_ = std::move(grid); }
   void set_principal(std::string principal) { principal_ = std::move(principal); }
 
-  // Writes the line (once per call).
+  // Writes the line (once per call) and counts the call in CallMetrics (server/call_metrics.h),
+  // also when lines are off.
   void Finish(const absl::Status& status) const;
 
   // The line Finish writes at `now`, with its newline.

@@ -73,7 +73,10 @@ grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext
       [this, request, response, cancel](const Caller&) -> absl::Status {
         SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
         SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-        SG_ASSIGN_OR_RETURN(const GridFitOptions options, ParseFitSpec(request->spec()));
+        SG_ASSIGN_OR_RETURN(GridFitOptions options, ParseFitSpec(request->spec()));
+        // The imported file's boundary conditions are the default kinds of their faces.
+        options.face_kinds = WithDefaultFaceKinds(std::move(options.face_kinds),
+                                                  grid->source->boundaries.face_kinds);
         return FitAndStore(*grid, options, RevisionOrigin::kFit, 0, cancel, response);
       });
 }

@@ -5,6 +5,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "proto/convert/convert.h"
+#include "proto/convert/plot3d_format_convert.h"
+#include "proto/convert/source_boundaries_convert.h"
 #include "server/store/revision_codec.h"
 
 namespace splinegrid::server {
@@ -68,10 +70,16 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   src->set_num_points(points);
   src->set_format(grid.source->format);
+  if (grid.source->plot3d.has_value()) {
+    EncodePlot3dSourceFormat(*grid.source->plot3d, src->mutable_plot3d());
+  }
   const std::vector<BoundaryMatch>& matches = grid.source->connectivity.matches;
   src->set_num_matches(static_cast<int>(matches.size()));
   if (view == v1::GRID_VIEW_FULL) {
     for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
+  }
+  if (!grid.source->boundaries.empty()) {  // small: every view (the import notes are here)
+    EncodeSourceBoundaries(grid.source->boundaries, src->mutable_boundaries());
   }
   for (const auto& r : grid.revisions) {
     EncodeRevisionInfo(RevisionSummary::Of(*r), out->add_revisions());

@@ -1,9 +1,11 @@
-// SplineGridService::ImportGrid: a client stream of a header and then Plot3D bytes or points.
+// SplineGridService::ImportGrid: a client stream of a header and then Plot3D or CGNS bytes, or
+// points. CGNS files are decoded in a child process (server/cgns_decoder.h).
 // Data are appended on gRPC's thread (copies only); parsing and validation run on the pool.
 // Memory is allocated and charged to the budget as data arrive, never from the header's
 // announced sizes; a stream that sends nothing for --import_idle_timeout is ended.
 #include <algorithm>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -13,6 +15,8 @@
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
+#include "proto/convert/plot3d_format_convert.h"
+#include "server/cgns_decoder.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
 #include "server/idle_watchdog.h"
@@ -128,7 +132,9 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     }
     switch (message.part_case()) {
       case v1::ImportGridRequest::kPlot3DChunk:
-        return AcceptBytes(message.plot3d_chunk());
+        return AcceptBytes(message.plot3d_chunk(), /*cgns=*/false);
+      case v1::ImportGridRequest::kCgnsChunk:
+        return AcceptBytes(message.cgns_chunk(), /*cgns=*/true);
       case v1::ImportGridRequest::kPoints:
         return AcceptPoints(message.points());
       default:
@@ -155,8 +161,16 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
       }
       return absl::OkStatus();  // charged as the bytes arrive (AcceptBytes)
     }
+    if (header.has_cgns()) {
+      if (header.cgns().total_bytes() <= 0) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "header.cgns.total_bytes = ", header.cgns().total_bytes(), "; must be positive"));
+      }
+      // A server without its decoder says so before the upload, not after.
+      return FindCgnsDecoder(state_->options.cgns_decoder).status();  // bytes: AcceptBytes
+    }
     if (!header.has_points()) {
-      return absl::InvalidArgumentError("header: set plot3d or points as the source");
+      return absl::InvalidArgumentError("header: set plot3d, cgns or points as the source");
     }
     const int s = header.points().spatial_dim();
     if (s != 2 && s != 3) {
@@ -181,25 +195,27 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     return absl::OkStatus();
   }
 
-  absl::Status AcceptBytes(const std::string& chunk) {
-    if (!header_.has_plot3d()) {
-      return absl::InvalidArgumentError("plot3d_chunk sent, but the header announced points");
+  // The file's bytes: plot3d_chunk for a Plot3D header, cgns_chunk for a CGNS header.
+  absl::Status AcceptBytes(const std::string& chunk, bool cgns) {
+    const char* field = cgns ? "cgns" : "plot3d";
+    if (cgns ? !header_.has_cgns() : !header_.has_plot3d()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, "_chunk sent, but the header announced another source"));
     }
-    if (static_cast<int64_t>(bytes_.size() + chunk.size()) > header_.plot3d().total_bytes()) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "plot3d_chunk: more than header.plot3d.total_bytes = ", header_.plot3d().total_bytes(),
-          " bytes arrived"));
+    const int64_t total = cgns ? header_.cgns().total_bytes() : header_.plot3d().total_bytes();
+    if (static_cast<int64_t>(bytes_.size() + chunk.size()) > total) {
+      return absl::InvalidArgumentError(absl::StrCat(field, "_chunk: more than header.", field,
+                                                     ".total_bytes = ", total, " bytes arrived"));
     }
-    SG_RETURN_IF_ERROR(MakeRoom(bytes_, chunk.size(),
-                                static_cast<size_t>(header_.plot3d().total_bytes()),
-                                "the Plot3D upload"));
+    SG_RETURN_IF_ERROR(MakeRoom(bytes_, chunk.size(), static_cast<size_t>(total),
+                                cgns ? "the CGNS upload" : "the Plot3D upload"));
     bytes_.append(chunk);
     return absl::OkStatus();
   }
 
   absl::Status AcceptPoints(const v1::PointChunk& chunk) {
     if (!header_.has_points()) {
-      return absl::InvalidArgumentError("points sent, but the header announced a Plot3D file");
+      return absl::InvalidArgumentError("points sent, but the header announced a file");
     }
     const int b = chunk.block();
     if (b < 0 || b >= static_cast<int>(extents_.size())) {
@@ -222,9 +238,30 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     return header_.points().spatial_dim() * NumPoints(extents_[b]);
   }
 
+  // Decodes a CGNS upload in a child process (on the pool); its boundaries go to `boundaries`
+  // and its stated 1-to-1 connections to connections_ (compared with the found ones in Store).
+  absl::StatusOr<MultiBlockGrid> BuildCgnsSource(std::string* format, SourceBoundaries* boundaries) {
+    if (static_cast<int64_t>(bytes_.size()) != header_.cgns().total_bytes()) {
+      return absl::InvalidArgumentError(absl::StrCat("cgns: ", bytes_.size(),
+                                                     " bytes arrived but the header announced ",
+                                                     header_.cgns().total_bytes()));
+    }
+    SG_ASSIGN_OR_RETURN(ImportedGrid imported,
+                        DecodeCgnsUpload(bytes_, state_->options.cgns_decoder, &state_->budget,
+                                         &grid_memory_, [this] { return context_->IsCancelled(); }));
+    bytes_ = std::string();
+    SG_RETURN_IF_ERROR(state_->budget.Resize(&grid_memory_, SourceBytes(imported.grid),
+                                             "the imported grid"));
+    *format = std::move(imported.format);
+    *boundaries = std::move(imported.boundaries);
+    connections_ = std::move(imported.connections);
+    return std::move(imported.grid);
+  }
+
   // Builds the source grid from what arrived (on the pool).
-  absl::StatusOr<MultiBlockGrid> BuildSource(std::string* format) {
+  absl::StatusOr<MultiBlockGrid> BuildSource(std::string* format, SourceBoundaries* boundaries) {
     if (!have_header_) return absl::InvalidArgumentError("ImportGrid received no header");
+    if (header_.has_cgns()) return BuildCgnsSource(format, boundaries);
     if (header_.has_plot3d()) {
       if (static_cast<int64_t>(bytes_.size()) != header_.plot3d().total_bytes()) {
         return absl::InvalidArgumentError(absl::StrCat("plot3d: ", bytes_.size(),
@@ -236,14 +273,18 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
       // make a few bytes stand for gigabytes); then exactly the grid's.
       SG_RETURN_IF_ERROR(state_->budget.Resize(&grid_memory_, Plot3dParseBytesBound(bytes_),
                                                "parsing the Plot3D upload"));
-      SG_ASSIGN_OR_RETURN(MultiBlockGrid grid, ParsePlot3d(bytes_, "upload", &detected));
+      Plot3dReadOptions read_options;
+      read_options.layout = Plot3dLayoutFromProto(header_.plot3d().layout());
+      SG_ASSIGN_OR_RETURN(MultiBlockGrid grid,
+                          ParsePlot3d(bytes_, "upload", read_options, &detected));
       SG_RETURN_IF_ERROR(
           state_->budget.Resize(&grid_memory_, SourceBytes(grid), "the imported grid"));
       *format = absl::StrCat("plot3d ", DescribePlot3dFormat(detected));
+      plot3d_format_.emplace().file = detected;  // kept so evaluations can be written back alike
       if (header_.plot3d().planar_view()) {
         SG_RETURN_IF_ERROR(
             state_->budget.Resize(&grid_memory_, 2 * SourceBytes(grid), "the planar view"));
-        SG_ASSIGN_OR_RETURN(grid, PlanarView(grid));
+        SG_ASSIGN_OR_RETURN(grid, PlanarView(grid, {}, &plot3d_format_->two_planes));
         absl::StrAppend(format, ", planar view");
       }
       return grid;
@@ -274,7 +315,8 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
 
   absl::Status Store() {
     auto source = std::make_shared<SourcePoints>();
-    SG_ASSIGN_OR_RETURN(source->grid, BuildSource(&source->format));
+    SG_ASSIGN_OR_RETURN(source->grid, BuildSource(&source->format, &source->boundaries));
+    source->plot3d = std::move(plot3d_format_);
     bytes_ = std::string();
     if (source->grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
     // A grid that cannot be fitted (all points equal, a direction of zero length, cells of no
@@ -287,6 +329,10 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
         state_->budget.Resize(&grid_memory_, SourceBytes(source->grid), "the imported grid"));
     source->memory = std::move(grid_memory_);
     SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
+    for (std::string& note : CompareConnections(connections_, source->connectivity,
+                                                source->boundaries.block_names)) {
+      source->boundaries.notes.push_back(std::move(note));
+    }
     auto grid = std::make_shared<StoredGrid>();
     grid->display_name = header_.display_name();
     grid->owner = caller_.owner();
@@ -317,9 +363,11 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
   v1::ImportHeader header_;
   MemoryReservation upload_;       // what arrived (capacity), charged as it grows
   MemoryReservation grid_memory_;  // the grid being built: the parser's bound, then its size
-  std::string bytes_;                         // Plot3D file
+  std::string bytes_;                         // Plot3D or CGNS file
+  std::optional<Plot3dSourceFormat> plot3d_format_;  // Plot3D source: its layout, once parsed
   std::vector<Extents> extents_;              // points source: the header's blocks
   std::vector<std::vector<double>> coords_;   // and their coordinates so far
+  std::vector<StatedConnection> connections_;  // CGNS source: the file's 1-to-1 connections
   IdleWatch idle_;  // ends the call when nothing arrives for import_idle_timeout
   std::mutex mu_;   // orders the reads' Finish/StartRead against the idle watch's Finish
   bool ended_ = false;  // guarded by mu_: Finish was called from OnReadDone or OnIdle

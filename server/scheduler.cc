@@ -129,4 +129,16 @@ void Scheduler::Run(bool may_run_long) {
   }
 }
 
+Scheduler::QueueLengths Scheduler::queue_lengths() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  QueueLengths lengths;
+  lengths.cheap = static_cast<int>(cheap_.size());
+  for (const auto& [principal, queue] : long_) {
+    if (queue.tasks.empty()) continue;
+    lengths.long_tasks += static_cast<int>(queue.tasks.size());
+    lengths.long_by_principal.emplace_back(principal, static_cast<int>(queue.tasks.size()));
+  }
+  return lengths;
+}
+
 }  // namespace splinegrid::server

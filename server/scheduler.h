@@ -30,6 +30,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
@@ -78,6 +79,14 @@ class Scheduler {
   int num_threads() const { return static_cast<int>(threads_.size()); }
   int max_running_long() const { return max_running_long_; }
 
+  // Tasks waiting for a worker now, for the metrics endpoint (takes the lock: not for hot paths).
+  struct QueueLengths {
+    int cheap = 0;
+    int long_tasks = 0;
+    std::vector<std::pair<std::string, int>> long_by_principal;  // principals with any waiting
+  };
+  QueueLengths queue_lengths() const;
+
  private:
   struct LongTask {
     std::function<void()> run;
@@ -95,7 +104,7 @@ class Scheduler {
 
   const SchedulerOptions options_;
   const int max_running_long_;
-  std::mutex mu_;
+  mutable std::mutex mu_;
   std::condition_variable cheap_cv_;  // waited on by cheap-only workers
   std::condition_variable any_cv_;    // waited on by long-capable workers
   std::deque<std::function<void()>> cheap_;

@@ -11,6 +11,8 @@
 #include "server/auth/transport.h"
 #include "server/listen_address.h"
 #include "server/memory_limit.h"
+#include "server/metrics_endpoint.h"
+#include "server/metrics_text.h"
 #include "server/store/open_store.h"
 
 namespace splinegrid::server {
@@ -196,6 +198,21 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
                  "splinegrid: warning: bearer tokens travel in plaintext (--insecure without "
                  "TLS): anyone on the network path can read and reuse them\n");
   }
+  // The metrics endpoint lives from here until the server has shut down: scrapes see the drain.
+  std::unique_ptr<MetricsEndpoint> metrics;
+  if (!options.metrics_address.empty()) {
+    const ServiceState* state = &(*server)->state();
+    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> started =
+        MetricsEndpoint::Start(options.metrics_address, options.metrics_insecure,
+                               [state] { return MetricsText(*state); });
+    if (!started.ok()) {
+      (*server)->Shutdown();
+      return started.status();
+    }
+    metrics = *std::move(started);
+    std::fprintf(stderr, "splinegrid: metrics on port %d (%s, GET /metrics, plaintext HTTP)\n",
+                 metrics->port(), options.metrics_address.c_str());
+  }
   int received = 0;
   while (sigwait(&signals, &received) == 0 && received == SIGHUP) {
     const absl::StatusOr<int> tokens = (*server)->ReloadTokens();
@@ -221,6 +238,7 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
                "stopping\n",
                signal_name, absl::FormatDuration(options.shutdown_grace).c_str());
   (*server)->Shutdown();
+  metrics.reset();  // before the state its scrapes read
   server->reset();
   std::fprintf(stderr, "splinegrid: stopped\n");
   return absl::OkStatus();

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/time/time.h"
+#include "server/cgns_decoder.h"
 #include "server/scheduler.h"
 
 namespace splinegrid::server {
@@ -38,6 +39,9 @@ struct ServerOptions {
   // An ImportGrid or ImportArchive stream that receives no message for this long is ended with
   // DEADLINE_EXCEEDED, releasing what it holds; zero or negative: never.
   absl::Duration import_idle_timeout = absl::Seconds(60);
+  // The child process that decodes CGNS uploads (server/cgns_decoder.h); its executable empty:
+  // splinegrid-cgns-decode beside the running binary.
+  CgnsDecoderOptions cgns_decoder;
   // The most points one EvaluateGrid or EvaluatePoints call may ask for (OUT_OF_RANGE beyond).
   int64_t max_output_points = int64_t{1} << 30;
   // Deformed revisions kept per grid: publishing a revision drops the older ones (fitted and
@@ -71,6 +75,12 @@ struct ServerOptions {
   // The tokens file (server/auth/token_file.h): calls need `authorization: Bearer TOKEN` and
   // the token's role. Empty: no tokens, every caller is an admin. Reloaded on SIGHUP.
   std::string tokens_file;
+
+  // ---- Metrics (server/metrics_endpoint.h) ----
+  // HOST:PORT of the Prometheus endpoint (GET /metrics, plaintext HTTP); empty: none. A host
+  // that is not loopback needs metrics_insecure.
+  std::string metrics_address;
+  bool metrics_insecure = false;
 };
 
 }  // namespace splinegrid::server

@@ -46,6 +46,13 @@ int StreamLimits::open(const std::string& principal) const {
   return it == open_.end() ? 0 : it->second;
 }
 
+int StreamLimits::open_total() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  int total = 0;
+  for (const auto& [principal, open] : open_) total += open;
+  return total;
+}
+
 void StreamLimits::Close(const std::string& principal) {
   std::lock_guard<std::mutex> lock(mu_);
   const auto it = open_.find(principal);

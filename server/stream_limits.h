@@ -48,6 +48,8 @@ class StreamLimits {
 
   // Streams `principal` holds open now.
   int open(const std::string& principal) const;
+  // Streams open now, all principals together (for the metrics endpoint).
+  int open_total() const;
 
  private:
   friend class StreamSlot;

@@ -21,6 +21,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "client/cli/cgns_output.h"
+#include "client/cli/eval_command.h"
+#include "client/cli/eval_output.h"
 #include "client/cli/flags.h"
 #include "client/cli/grid_output.h"
 #include "client/cli/output.h"
@@ -32,7 +35,9 @@
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "core/io/record_file.h"
+#include "proto/convert/plot3d_format_convert.h"
 #include "core/util/status_macros.h"
+#include "io/cgns/cgns_io.h"
 #include "server/server.h"
 
 namespace splinegrid::cli {
@@ -147,6 +152,7 @@ absl::Status Serve(const Args& args) {
   options.worker_threads = absl::GetFlag(FLAGS_threads);
   options.memory_budget_bytes = absl::GetFlag(FLAGS_memory_budget_mb) << 20;
   options.import_idle_timeout = absl::GetFlag(FLAGS_import_idle_timeout);
+  options.cgns_decoder.executable = absl::GetFlag(FLAGS_cgns_decoder);
   options.max_output_points = absl::GetFlag(FLAGS_max_output_points);
   options.shutdown_grace = absl::GetFlag(FLAGS_shutdown_grace);
   options.log_calls = absl::GetFlag(FLAGS_log_calls);
@@ -162,6 +168,9 @@ absl::Status Serve(const Args& args) {
   options.max_queued_long_calls_per_principal =
       absl::GetFlag(FLAGS_max_queued_long_calls_per_principal);
   options.max_streams_per_principal = absl::GetFlag(FLAGS_max_streams_per_principal);
+  // The Prometheus endpoint.
+  options.metrics_address = absl::GetFlag(FLAGS_metrics_address);
+  options.metrics_insecure = absl::GetFlag(FLAGS_metrics_insecure);
   return server::RunServerUntilSignal(options);
 }
 
@@ -277,6 +286,15 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   return spec;
 }
 
+// --plot3d_layout: "" (detect), "whole" or "planes".
+absl::StatusOr<v1::Plot3dLayout> Plot3dLayoutFlag() {
+  const std::string text = absl::GetFlag(FLAGS_plot3d_layout);
+  if (text.empty()) return v1::PLOT3D_LAYOUT_UNSPECIFIED;
+  if (text == "whole") return v1::PLOT3D_LAYOUT_WHOLE;
+  if (text == "planes") return v1::PLOT3D_LAYOUT_PLANES;
+  return Usage(absl::StrCat("--plot3d_layout = '", text, "': give whole or planes"));
+}
+
 // After a stored fit: FAILED_PRECONDITION with exit status kExitQualityNotMet (3) when
 // --allow_folds let the server store a revision whose cells fold (its report says quality_met =
 // false), so that a script cannot mistake it for a good grid, nor for a call that failed (1).
@@ -302,19 +320,35 @@ absl::Status Fit(const Args& args) {
   const std::string id =
       absl::GetFlag(FLAGS_name).empty() ? IdFromPath(path) : absl::GetFlag(FLAGS_name);
   auto client = Connect();
+  // A CGNS file (by extension or signature) is decoded by the server, BCs included; it is
+  // stored as its zones are (--planar is about two-plane Plot3D files).
+  const bool cgns = IsCgnsPath(path) || LooksLikeCgns(bytes);
+  // --plot3d_layout: the value order of 3D text and C-stream files (Fortran records show it).
+  SG_ASSIGN_OR_RETURN(const v1::Plot3dLayout layout, Plot3dLayoutFlag());
+  Plot3dReadOptions read_options;
+  read_options.layout = Plot3dLayoutFromProto(layout);
   // Only two-plane files get the planar view; anything else is stored as read.
   bool planar = false;
-  if (absl::GetFlag(FLAGS_planar)) {
-    absl::StatusOr<MultiBlockGrid> local = ParsePlot3d(bytes, path);
+  if (!cgns && absl::GetFlag(FLAGS_planar)) {
+    absl::StatusOr<MultiBlockGrid> local = ParsePlot3d(bytes, path, read_options);
     if (!local.ok()) return local.status();
     planar = IsTwoPlaneGrid(*local);
   }
+  v1::Plot3dSource plot3d_options;
+  plot3d_options.set_planar_view(planar);
+  plot3d_options.set_layout(layout);
   ProgressLine upload("upload");
+  const std::string grid_id = client::GridName(id).substr(6);
+  const std::string display_name = std::filesystem::path(path).filename().string();
   SG_ASSIGN_OR_RETURN(const v1::Grid grid,
-                      client->ImportPlot3d(bytes, client::GridName(id).substr(6),
-                                           std::filesystem::path(path).filename().string(), planar,
-                                           upload.callback()));
+                      cgns ? client->ImportCgns(bytes, grid_id, display_name, upload.callback())
+                           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options,
+                                                  upload.callback()));
   upload.Done();
+  // What the import mapped with a choice or left out (CGNS), never silently.
+  for (const std::string& note : grid.source().boundaries().notes()) {
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+  }
   absl::StatusOr<v1::FitGridResponse> fit = client->Fit(grid.name(), spec);
   if (!fit.ok()) {
     (void)client->Delete(grid.name());  // do not leave an unfitted grid behind
@@ -358,7 +392,8 @@ absl::Status Eval(const Args& args) {
   if (args.size() != 1 || out.empty()) {
     return Usage(
         "usage: splinegrid eval NAME (--level L | --res a,b,c) [--revision R | --step N] "
-        "[--block b] -o OUT.{vts,vtm,x,xyz}");
+        "[--block b] [--derivs] [--jacobian] [--quality] [--deviation] [--nocompress] "
+        "-o OUT.{vts,vtm,x,xyz,cgns}, or --steps A:B -o OUT.pvd");
   }
   v1::EvaluateGridRequest request;
   request.set_name(args[0]);
@@ -405,12 +440,35 @@ absl::Status Eval(const Args& args) {
   }
   request.set_derivatives(absl::GetFlag(FLAGS_derivs));
   request.set_precision(absl::GetFlag(FLAGS_float32) ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
+  // Output fields, the source's Plot3D layout and ParaView time series (eval_command.h).
+  SG_ASSIGN_OR_RETURN(const EvalOutputOptions eval_options,
+                      EvalOutputOptionsFromFlags(out, &request));
+  if (IsSeriesPath(out)) {
+    auto series_client = Connect();
+    SG_ASSIGN_OR_RETURN(const EvalGridFacts facts,
+                        FetchEvalFacts(*series_client, request, eval_options));
+    SG_ASSIGN_OR_RETURN(const std::string summary,
+                        RunEvalSeries(*series_client, request, out, facts, eval_options));
+    std::fwrite(summary.data(), 1, summary.size(), stdout);
+    return absl::OkStatus();
+  }
   SG_RETURN_IF_ERROR(CheckGridOutput(out));
+  auto client = Connect();
+  // A CGNS file also carries the grid's boundary conditions and connectivity at the level.
+  std::optional<CgnsOutputContext> cgns;
+  if (IsCgnsPath(out)) {
+    SG_ASSIGN_OR_RETURN(cgns, FetchCgnsOutputContext(*client, request));
+  }
+  std::optional<EvalGridFacts> facts;  // VTK and Plot3D outputs (eval_output.h)
+  if (!cgns) {
+    SG_ASSIGN_OR_RETURN(facts, FetchEvalFacts(*client, request, eval_options));
+  }
   ProgressLine download("evaluate");
-  SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result,
-                      Connect()->Evaluate(request, download.callback()));
+  SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client->Evaluate(request, download.callback()));
   download.Done();
-  SG_ASSIGN_OR_RETURN(const int64_t points, WriteEvaluatedGrid(out, result));
+  SG_ASSIGN_OR_RETURN(const int64_t points,
+                      cgns ? WriteCgnsOutput(out, result, &*cgns)
+                           : WriteEvaluation(out, result, *facts, eval_options));
   v1::EvaluationHeader summary;  // for --json
   summary.set_revision(result.revision);
   summary.set_total_points(points);

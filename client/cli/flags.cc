@@ -35,6 +35,9 @@ ABSL_FLAG(double, tol, 0.0, "fit: largest allowed deviation, in the grid's lengt
 ABSL_FLAG(std::string, ctl, "", "fit: control points per direction, e.g. 24,16 or 24,16,8");
 ABSL_FLAG(int, order, 4, "fit: spline order (degree + 1)");
 ABSL_FLAG(bool, planar, true, "fit: store the 2D view of grids held as two planes (CFL3D style)");
+ABSL_FLAG(std::string, plot3d_layout, "",
+          "fit: whole or planes, the value order of 3D Plot3D text and C-stream files (Fortran "
+          "record files are detected); default whole");
 ABSL_FLAG(int, max_ctl, 0, "fit --tol/--kinds: most control points per direction (0: no cap)");
 ABSL_FLAG(bool, kinds, false,
           "fit: tolerances by boundary kind (defaults 0.15e-3 wall, 2e-3 interface, 8e-3 outer "
@@ -68,8 +71,17 @@ ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)
 ABSL_FLAG(std::string, o, "",
           "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv; "
           "export: the archive (.sgrid)");
-ABSL_FLAG(bool, derivs, false, "eval: also dX/du, dX/dv, dX/dw (written to VTK files)");
+ABSL_FLAG(bool, derivs, false,
+          "eval: also dX/du, dX/dv[, dX/dw] (VTK point arrays; with .x/.xyz a Plot3D function "
+          "file NAME.f beside it)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
+ABSL_FLAG(std::string, steps, "",
+          "eval: a:b, the deformed revisions of time steps a to b as a ParaView series (-o NAME.pvd)");
+ABSL_FLAG(bool, compress, true, "eval: zlib-compress VTK XML data (--nocompress: raw)");
+ABSL_FLAG(bool, jacobian, false, "eval: VTK point field 'jacobian' of the spline mapping");
+ABSL_FLAG(bool, quality, false, "eval: VTK cell field 'scaled_jacobian' (1 ideal, <= 0 folded)");
+ABSL_FLAG(bool, deviation, false,
+          "eval: VTK point field 'deviation' from the source points (--level 0 only)");
 
 ABSL_FLAG(
     double, rotate, 0.0,
@@ -131,6 +143,9 @@ ABSL_FLAG(int64_t, memory_budget_mb, 0,
 ABSL_FLAG(absl::Duration, import_idle_timeout, absl::Seconds(60),
           "serve: an ImportGrid or ImportArchive stream that sends nothing for this long is "
           "ended (DEADLINE_EXCEEDED) and its memory released (0: never)");
+ABSL_FLAG(std::string, cgns_decoder, "",
+          "serve: the executable that decodes CGNS uploads in a child process (empty: "
+          "splinegrid-cgns-decode beside this binary)");
 ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,
           "serve: the most points one evaluation may ask for");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(10),
@@ -157,3 +172,11 @@ ABSL_FLAG(int, max_streams_per_principal,
           splinegrid::server::ServerOptions().max_streams_per_principal,
           "serve: streaming calls (watch, eval, import, export) one caller may hold open "
           "(RESOURCE_EXHAUSTED beyond)");
+
+// serve: the Prometheus endpoint (server/metrics_endpoint.h).
+ABSL_FLAG(std::string, metrics_address, "",
+          "serve: HOST:PORT of a Prometheus endpoint, GET /metrics in plaintext HTTP (empty: "
+          "none; a host that is not loopback needs --metrics_insecure)");
+ABSL_FLAG(bool, metrics_insecure, false,
+          "serve: allow --metrics_address on a host that is not loopback (the metrics are "
+          "unauthenticated plaintext: a trusted network only)");

@@ -29,6 +29,7 @@ ABSL_DECLARE_FLAG(double, tol);
 ABSL_DECLARE_FLAG(std::string, ctl);
 ABSL_DECLARE_FLAG(int, order);
 ABSL_DECLARE_FLAG(bool, planar);
+ABSL_DECLARE_FLAG(std::string, plot3d_layout);
 ABSL_DECLARE_FLAG(int, max_ctl);
 ABSL_DECLARE_FLAG(bool, kinds);
 ABSL_DECLARE_FLAG(double, wall);
@@ -51,6 +52,11 @@ ABSL_DECLARE_FLAG(std::string, box);
 ABSL_DECLARE_FLAG(std::string, o);
 ABSL_DECLARE_FLAG(bool, derivs);
 ABSL_DECLARE_FLAG(bool, float32);
+ABSL_DECLARE_FLAG(std::string, steps);
+ABSL_DECLARE_FLAG(bool, compress);
+ABSL_DECLARE_FLAG(bool, jacobian);
+ABSL_DECLARE_FLAG(bool, quality);
+ABSL_DECLARE_FLAG(bool, deviation);
 // deform
 ABSL_DECLARE_FLAG(double, rotate);
 ABSL_DECLARE_FLAG(std::string, about);
@@ -84,6 +90,7 @@ ABSL_DECLARE_FLAG(std::string, store);
 ABSL_DECLARE_FLAG(int, threads);
 ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);
 ABSL_DECLARE_FLAG(absl::Duration, import_idle_timeout);
+ABSL_DECLARE_FLAG(std::string, cgns_decoder);
 ABSL_DECLARE_FLAG(int64_t, max_output_points);
 ABSL_DECLARE_FLAG(absl::Duration, shutdown_grace);
 ABSL_DECLARE_FLAG(bool, log_calls);
@@ -94,5 +101,8 @@ ABSL_DECLARE_FLAG(int, keep_revisions);
 ABSL_DECLARE_FLAG(int, max_running_long_tasks);
 ABSL_DECLARE_FLAG(int, max_queued_long_calls_per_principal);
 ABSL_DECLARE_FLAG(int, max_streams_per_principal);
+// serve: the Prometheus endpoint (server/metrics_endpoint.h)
+ABSL_DECLARE_FLAG(std::string, metrics_address);
+ABSL_DECLARE_FLAG(bool, metrics_insecure);
 
 #endif  // SPLINEGRID_CLIENT_CLI_FLAGS_H_

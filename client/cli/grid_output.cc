@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "client/cli/cgns_output.h"
 #include "core/io/plot3d.h"
 #include "core/io/vtk.h"
 #include "core/util/status_macros.h"
@@ -13,9 +14,9 @@ namespace splinegrid::cli {
 
 absl::Status CheckGridOutput(const std::string& out) {
   const std::string ext = std::filesystem::path(out).extension().string();
-  if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz") {
+  if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz" && ext != ".cgns") {
     return absl::InvalidArgumentError(
-        absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x or .xyz"));
+        absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x, .xyz or .cgns"));
   }
   return absl::OkStatus();
 }
@@ -23,6 +24,8 @@ absl::Status CheckGridOutput(const std::string& out) {
 absl::StatusOr<int64_t> WriteEvaluatedGrid(const std::string& out,
                                            const client::EvaluatedGrid& result) {
   const std::string ext = std::filesystem::path(out).extension().string();
+  // Points only (eval passes its grid's boundary conditions to WriteCgnsOutput itself).
+  if (ext == ".cgns") return WriteCgnsOutput(out, result, nullptr);
   MultiBlockGrid grid;
   std::vector<std::vector<VtkPointArray>> arrays;
   int64_t points = 0;

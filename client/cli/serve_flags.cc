@@ -8,6 +8,7 @@
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "server/listen_address.h"
+#include "server/metrics_endpoint.h"
 
 namespace splinegrid::cli {
 namespace {
@@ -63,6 +64,10 @@ absl::Status CheckServeFlags(server::LogFormat* format) {
       CheckDuration("drain_notice", absl::GetFlag(FLAGS_drain_notice), absl::Hours(1)));
   SG_RETURN_IF_ERROR(CheckDuration("import_idle_timeout", absl::GetFlag(FLAGS_import_idle_timeout),
                                    absl::Hours(24 * 365)));
+  if (const std::string metrics = absl::GetFlag(FLAGS_metrics_address); !metrics.empty()) {
+    SG_RETURN_IF_ERROR(
+        server::CheckMetricsAddress(metrics, absl::GetFlag(FLAGS_metrics_insecure)));
+  }
   const std::string log_format = absl::GetFlag(FLAGS_log_format);
   if (log_format == "text") {
     *format = server::LogFormat::kText;

@@ -4,6 +4,8 @@
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
+#include "proto/convert/plot3d_format_convert.h"
+#include "proto/convert/source_boundaries_convert.h"
 #include "server/grid_id.h"
 #include "server/store/revision_codec.h"
 
@@ -17,12 +19,18 @@ v1::ArchiveHeader EncodeGridHeader(const StoredGrid& grid, int64_t num_revisions
   EncodeStoredTime(grid.create_time, header.mutable_create_time());
   const SourcePoints& source = *grid.source;
   header.set_source_format(source.format);
+  if (source.plot3d.has_value()) {
+    EncodePlot3dSourceFormat(*source.plot3d, header.mutable_source_plot3d());
+  }
   header.set_spatial_dim(source.grid.blocks.front().spatial_dim());
   for (const StructuredBlock& block : source.grid.blocks) {
     EncodeExtents(block.extents(), header.add_source_blocks());
     if (!block.iblank().empty()) header.set_source_iblank(true);
   }
   EncodeStoredConnectivity(source.connectivity, header.mutable_connectivity());
+  if (!source.boundaries.empty()) {
+    EncodeSourceBoundaries(source.boundaries, header.mutable_source_boundaries());
+  }
   int64_t chunks = 0;
   // Count exactly as ForEachSourceChunk cuts (it cannot fail on a stored grid).
   ForEachSourceChunk(source.grid, kSourceChunkValues, [&](const v1::SourceChunk&) {
@@ -123,6 +131,17 @@ absl::Status GridAssembler::FinishSource(const std::string& event) {
     source_.reset();
     SG_ASSIGN_OR_RETURN(points->connectivity, ParseStoredConnectivity(header_->connectivity(), points->grid));
     points->format = header_->source_format();
+    if (header_->has_source_plot3d()) {
+      SG_ASSIGN_OR_RETURN(points->plot3d,
+                          ParsePlot3dSourceFormat(header_->source_plot3d(),
+                                                  static_cast<int>(points->grid.blocks.size()),
+                                                  "header.source_plot3d"));
+    }
+    std::vector<Extents> extents;
+    for (const StructuredBlock& block : points->grid.blocks) extents.push_back(block.extents());
+    SG_ASSIGN_OR_RETURN(points->boundaries,
+                        ParseSourceBoundaries(header_->source_boundaries(), extents,
+                                              "header.source_boundaries"));
     points->memory = std::move(source_memory_);
     grid_->source = std::move(points);
   return absl::OkStatus();

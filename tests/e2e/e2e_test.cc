@@ -194,7 +194,8 @@ TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
   const std::string xyz = (dir_ / "rae.xyz").string();
   ASSERT_EQ(Cli(absl::StrCat("eval rae --res=300,50 -o ", xyz)).exit_code, 0);
   const MultiBlockGrid back = ReadPlot3dFile(xyz).value();
-  EXPECT_EQ(back.blocks[0].extents(), (Extents{300, 50, 1}));
+  // rae2822_257x97.fmt holds two planes (CFL3D): written back as two planes, not as 2D.
+  EXPECT_EQ(back.blocks[0].extents(), (Extents{2, 300, 50}));
 
   const std::string vtm = (dir_ / "both.vtm").string();
   ASSERT_EQ(Cli(absl::StrCat("eval rae --level=0 --derivs -o ", vtm)).exit_code, 0);
