@@ -10,7 +10,13 @@ namespace splinegrid::capi {
 
 void ClientState::SetError(std::string message) {
   std::lock_guard<std::mutex> lock(mu_);
-  errors_[std::this_thread::get_id()] = std::move(message);
+  // A success erases the thread's entry, so a program that starts and ends threads does not
+  // grow the map: it holds only the threads whose last call failed.
+  if (message.empty()) {
+    errors_.erase(std::this_thread::get_id());
+  } else {
+    errors_[std::this_thread::get_id()] = std::move(message);
+  }
 }
 
 const char* ClientState::Error() const {

@@ -24,6 +24,14 @@ std::vector<std::string> ServiceMethods() {
 // The Prometheus text form of a bucket bound: shortest decimal ("0.0001", "2.5", "300").
 std::string Bound(double bound) { return absl::StrFormat("%g", bound); }
 
+// The row index of `code` (absl::StatusCode 0..16, OK to UNAUTHENTICATED); any other value
+// counts as UNKNOWN.
+int CodeIndex(absl::StatusCode code) {
+  constexpr int kCanonical = static_cast<int>(absl::StatusCode::kUnauthenticated) + 1;
+  const int c = static_cast<int>(code);
+  return c >= 0 && c < kCanonical ? c : static_cast<int>(absl::StatusCode::kUnknown);
+}
+
 }  // namespace
 
 CallMetrics& CallMetrics::Global() {
@@ -48,10 +56,9 @@ CallMetrics::Row* CallMetrics::Find(absl::string_view method) const {
 
 void CallMetrics::Record(absl::string_view method, absl::StatusCode code,
                          absl::Duration latency) {
+  static_assert(kCodes == static_cast<int>(absl::StatusCode::kUnauthenticated) + 1);
   Row& row = *Find(method);
-  const int c = static_cast<int>(code);
-  row.calls[c >= 0 && c < kCodes ? c : static_cast<int>(absl::StatusCode::kUnknown)].fetch_add(
-      1, std::memory_order_relaxed);
+  row.calls[CodeIndex(code)].fetch_add(1, std::memory_order_relaxed);
   const double seconds = absl::ToDoubleSeconds(latency);
   const size_t bucket =
       std::lower_bound(kBucketBounds.begin(), kBucketBounds.end(), seconds) -
@@ -63,7 +70,7 @@ void CallMetrics::Record(absl::string_view method, absl::StatusCode code,
 }
 
 uint64_t CallMetrics::calls(absl::string_view method, absl::StatusCode code) const {
-  return Find(method)->calls[static_cast<int>(code)].load(std::memory_order_relaxed);
+  return Find(method)->calls[CodeIndex(code)].load(std::memory_order_relaxed);
 }
 
 void CallMetrics::AppendText(std::string* out) const {

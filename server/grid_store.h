@@ -237,11 +237,12 @@ class GridStore {
   virtual absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> List(
       const std::string& after, int limit, bool* more) = 0;
 
-  // How many grids and revisions the store holds (metrics). Reads no revision: for a shared
-  // store one round trip that counts keys, not a listing.
+  // How many grids and revisions the store holds (metrics). Cheap: reads no revision and lists
+  // nothing; a shared store counts its index in one command and leaves `revisions` unknown
+  // (counting them would walk every grid inside Redis, blocking its other clients).
   struct Counts {
     int64_t grids = 0;
-    int64_t revisions = 0;
+    std::optional<int64_t> revisions;
   };
   virtual absl::StatusOr<Counts> Count() = 0;
 

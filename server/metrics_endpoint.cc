@@ -95,7 +95,9 @@ absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(absl::st
                                                    gai_strerror(error)));
   }
   std::unique_ptr<MetricsEndpoint> endpoint(new MetricsEndpoint(std::move(render)));
-  unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ERROR_LOG;
+  // AUTO picks epoll or poll: select() would refuse a scrape whose socket number is above
+  // FD_SETSIZE (1024), which a busy server's connections reach.
+  unsigned flags = MHD_USE_AUTO_INTERNAL_THREAD | MHD_USE_ERROR_LOG;
   if (found->ai_family == AF_INET6) flags |= MHD_USE_IPv6;
   endpoint->daemon_ = MHD_start_daemon(
       flags, /*port=*/0, /*apc=*/nullptr, nullptr, &Handle, endpoint.get(),

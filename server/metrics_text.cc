@@ -17,13 +17,16 @@ void Gauge(std::string* out, absl::string_view name, absl::string_view help, int
 }
 
 // Grids and revisions held by the store (GridStore::Count: no listing, no revision read); a
-// store that cannot count (Redis down) gives no lines rather than a wrong zero.
+// store that cannot count (Redis down) gives no lines rather than a wrong zero, and a count the
+// store does not keep (revisions in Redis) no line either.
 void AppendStoreGauges(const ServiceState& state, std::string* out) {
   absl::StatusOr<GridStore::Counts> counts = state.store->Count();
   if (!counts.ok()) return;
   Gauge(out, "splinegrid_grids", "Grids held by the store.", counts->grids);
-  Gauge(out, "splinegrid_revisions", "Revisions held by the store, all grids together.",
-        counts->revisions);
+  if (counts->revisions) {
+    Gauge(out, "splinegrid_revisions", "Revisions held by the store, all grids together.",
+          *counts->revisions);
+  }
 }
 
 // Resident set size from /proc/self/statm (pages), or -1 where there is none.

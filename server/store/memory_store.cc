@@ -160,10 +160,11 @@ absl::StatusOr<std::vector<std::shared_ptr<const StoredGrid>>> MemoryStore::List
 
 absl::StatusOr<GridStore::Counts> MemoryStore::Count() {
   Counts counts;
+  counts.revisions = 0;
   std::lock_guard<std::mutex> lock(mu_);
   for (const auto& [id, grid] : grids_) {
     ++counts.grids;
-    counts.revisions += static_cast<int64_t>(grid->revisions.size());
+    *counts.revisions += static_cast<int64_t>(grid->revisions.size());
   }
   return counts;
 }

@@ -111,17 +111,4 @@ return 1
   return *script;
 }
 
-const RedisScript& CountScript() {
-  static const RedisScript* script = new RedisScript(R"lua(
-local ids = redis.call('ZRANGE', KEYS[1], 0, -1)
-local revisions = 0
-for _, id in ipairs(ids) do
-  local gen = redis.call('HGET', ARGV[1] .. id, 'gen')
-  if gen then revisions = revisions + redis.call('ZCARD', ARGV[1] .. id .. ':' .. gen .. ':nums') end
-end
-return {#ids, revisions}
-)lua");
-  return *script;
-}
-
 }  // namespace splinegrid::server

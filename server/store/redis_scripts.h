@@ -70,11 +70,6 @@ const RedisScript& GetScript();
 // Returns 1 (deleted), 0 (no such grid) or -1 (the owner is another one: nothing deleted).
 const RedisScript& DeleteScript();
 
-// Counts the visible grids and their revisions (metrics), reading no value.
-// KEYS: index. ARGV: the key prefix of the grid records ("...grid:").
-// Returns {grids, revisions}.
-const RedisScript& CountScript();
-
 }  // namespace splinegrid::server
 
 #endif  // SPLINEGRID_SERVER_STORE_REDIS_SCRIPTS_H_

@@ -144,10 +144,8 @@ class RedisStore final : public GridStore {
                                                                       int limit,
                                                                       bool* more) override;
   absl::StatusOr<Counts> Count() override {
-    SG_ASSIGN_OR_RETURN(RedisReply reply,
-                        pool_.Run(CountScript(), {keys_.Index()}, {keys_.Grid("")}));
-    const RedisValue value = reply.value();
-    return Counts{value[0].AsInt().value_or(0), value[1].AsInt().value_or(0)};
+    SG_ASSIGN_OR_RETURN(RedisReply reply, pool_.Command({"ZCARD", keys_.Index()}));
+    return Counts{reply.value().AsInt().value_or(0), std::nullopt};
   }
   absl::Status Available() const override {
     std::lock_guard<std::mutex> lock(health_mu_);
