@@ -16,18 +16,12 @@
 #include "core/fit/grid_fit.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::bench {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string SharedDataPath(const std::string& relative) {
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
-}
 
 struct PitchGrid {
   std::vector<FittedBlock> blocks;

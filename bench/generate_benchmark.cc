@@ -21,6 +21,7 @@
 #include "core/generate/elliptic.h"
 #include "core/generate/profile_grid.h"
 #include "core/io/airfoil.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid::bench {
 namespace {
@@ -28,11 +29,7 @@ namespace {
 constexpr const char* kAirfoils[] = {"naca0012", "rae2822", "sc20714"};
 
 std::string AirfoilPath(const std::string& name) {
-  const std::string relative = "airfoils/" + name + ".dat";
-  if (const char* dir = std::getenv("SPLINEGRID_SHARED_DATA")) {
-    return std::string(dir) + "/" + relative;
-  }
-  return std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/" + relative;
+  return SharedDataPath("airfoils/" + name + ".dat");
 }
 
 void BM_GenerateOGrid(benchmark::State& state) {

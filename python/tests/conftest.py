@@ -9,7 +9,9 @@ import time
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
-DATA = REPO.parent / "shared" / "data"
+# The shared data set: $SPLINEGRID_SHARED_DATA, else ../shared/data beside the repository (as
+# tests/core/test_data.h finds it).
+DATA = pathlib.Path(os.environ.get("SPLINEGRID_SHARED_DATA", REPO.parent / "shared" / "data"))
 
 
 def server_binary() -> pathlib.Path:

@@ -18,6 +18,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/io_test_util.h"
+#include "tests/core/test_data.h"
 
 namespace splinegrid {
 namespace {
@@ -241,7 +242,7 @@ class CgnsToPlot3dTest : public testing::Test {
     }
     dir_ = std::filesystem::path(testing::TempDir()) / "plot3d_stream_test";
     std::filesystem::create_directories(dir_);
-    source_ = std::string(SPLINEGRID_SOURCE_DIR) + "/../shared/data/surfaces/ffd_box_6x2x6.fmt";
+    source_ = SharedDataPath("surfaces/ffd_box_6x2x6.fmt");
     absl::StatusOr<MultiBlockGrid> grid = ReadPlot3dFile(source_);
     ASSERT_TRUE(grid.ok()) << grid.status();
     grid_ = *std::move(grid);
