@@ -3,9 +3,9 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <spawn.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <filesystem>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
 #include "core/util/quote.h"
@@ -70,144 +71,223 @@ class TempUpload {
   std::string path_;
 };
 
-// In the child between fork and exec (async-signal-safe calls only): limits, stdout to the
-// pipe, stdin and stderr to /dev/null (HDF5 prints its error stacks there), every other
-// descriptor closed, then the decoder.
-[[noreturn]] void RunChild(const char* executable, char* const argv[], int out_fd,
-                           const CgnsDecoderOptions& options) {
-  const rlim_t memory = static_cast<rlim_t>(options.memory_limit_bytes);
-  const rlimit as = {memory, memory};
-  const rlim_t cpu =
-      static_cast<rlim_t>(std::max<int64_t>(1, absl::ToInt64Seconds(options.cpu_limit)));
-  const rlimit cpu_limit = {cpu, cpu + 5};  // SIGXCPU at the soft limit, SIGKILL at the hard
-  const rlimit no_core = {0, 0};
-  if (setrlimit(RLIMIT_AS, &as) != 0 || setrlimit(RLIMIT_CPU, &cpu_limit) != 0 ||
-      setrlimit(RLIMIT_CORE, &no_core) != 0) {
-    _exit(126);
-  }
-  const int null_fd = open("/dev/null", O_RDWR);
-  if (null_fd < 0 || dup2(null_fd, 0) < 0 || dup2(null_fd, 2) < 0 || dup2(out_fd, 1) < 0)
-    _exit(126);
-  // Nothing else of the server's crosses into the child: not its listening sockets, client
-  // connections or Redis connection, whether or not they were opened close-on-exec.
-  if (close_range(3, ~0U, 0) != 0) _exit(126);
-  execv(executable, argv);
-  _exit(127);
+// The limits, set by the shell the child starts as (posix_spawn cannot set them), before it
+// execs the decoder: "$0" is the decoder, "$1" the upload, so neither path is parsed by the
+// shell. dash's ulimit: -v KiB of address space, -t CPU seconds (hard first, then the soft
+// limit below it: SIGXCPU at the soft limit, SIGKILL 5 s later), -c core size. A failed ulimit
+// is exit 126, as a failed exec is 126/127.
+std::string LimitScript(int64_t memory_bytes, int64_t cpu_seconds) {
+  return absl::StrCat("ulimit -v ", memory_bytes >> 10, " && ulimit -t ", cpu_seconds + 5,
+                      " && ulimit -S -t ", cpu_seconds,
+                      " && ulimit -c 0 || exit 126; exec \"$0\" \"$1\"");
 }
+
+// posix_spawn attributes and file actions, destroyed on scope exit.
+class SpawnSetup {
+ public:
+  SpawnSetup() {
+    ok_ = posix_spawnattr_init(&attr_) == 0;
+    ok_ = posix_spawn_file_actions_init(&actions_) == 0 && ok_;
+  }
+  ~SpawnSetup() {
+    posix_spawnattr_destroy(&attr_);
+    posix_spawn_file_actions_destroy(&actions_);
+  }
+  SpawnSetup(const SpawnSetup&) = delete;
+  SpawnSetup& operator=(const SpawnSetup&) = delete;
+
+  // Its own process group, every signal at its default and none blocked (the server ignores
+  // SIGPIPE and blocks the signals its signal thread waits for; a child must not inherit that);
+  // stdin and stderr /dev/null (HDF5 prints its error stacks there), stdout `out_fd`, every
+  // other descriptor closed (the server's listening sockets, client and Redis connections,
+  // whether or not they were opened close-on-exec).
+  int Prepare(int out_fd) {
+    if (!ok_) return ENOMEM;
+    sigset_t all, none;
+    sigfillset(&all);
+    sigemptyset(&none);
+    int error = posix_spawnattr_setflags(
+        &attr_, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+    if (error == 0) error = posix_spawnattr_setpgroup(&attr_, 0);
+    if (error == 0) error = posix_spawnattr_setsigdefault(&attr_, &all);
+    if (error == 0) error = posix_spawnattr_setsigmask(&attr_, &none);
+    if (error == 0)
+      error = posix_spawn_file_actions_addopen(&actions_, 0, "/dev/null", O_RDONLY, 0);
+    if (error == 0) error = posix_spawn_file_actions_adddup2(&actions_, out_fd, 1);
+    if (error == 0)
+      error = posix_spawn_file_actions_addopen(&actions_, 2, "/dev/null", O_WRONLY, 0);
+    if (error == 0) error = CloseTheRest();
+    return error;
+  }
+
+  const posix_spawnattr_t* attr() const { return &attr_; }
+  const posix_spawn_file_actions_t* actions() const { return &actions_; }
+
+ private:
+  int CloseTheRest() {
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 34))
+    // glibc closes them in the child with close_range, and where the kernel has none (before
+    // Linux 5.9) by walking /proc/self/fd.
+    return posix_spawn_file_actions_addclosefrom_np(&actions_, 3);
+#else
+    // Without closefrom: every descriptor open now. One another thread opens meanwhile is
+    // close-on-exec in this code base (gRPC, Redis and file descriptors all are).
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", error)) {
+      int fd = -1;
+      if (!absl::SimpleAtoi(entry.path().filename().string(), &fd) || fd < 3) continue;
+      if (int e = posix_spawn_file_actions_addclose(&actions_, fd); e != 0) return e;
+    }
+    return error ? error.value() : 0;
+#endif
+  }
+
+  bool ok_ = false;
+  posix_spawnattr_t attr_;
+  posix_spawn_file_actions_t actions_;
+};
 
 std::string SignalName(int signal) {
   const char* name = strsignal(signal);
   return absl::StrCat(signal, name != nullptr ? absl::StrCat(" (", name, ")") : "");
 }
 
-}  // namespace
+// How the reading of the child ended.
+enum class Stop { kNone, kWallTime, kCancelled, kReadError };
 
-absl::StatusOr<std::string> FindCgnsDecoder(const CgnsDecoderOptions& options) {
-  std::string path = options.executable;
-  if (path.empty()) {
-    std::error_code error;
-    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-    if (error) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "CGNS import: cannot find this binary's directory (/proc/self/exe: ", error.message(),
-          "); give the decoder with serve --cgns_decoder"));
-    }
-    path = (self.parent_path() / kDecoderName).string();
-  }
-  if (access(path.c_str(), X_OK) != 0) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "CGNS import: the decoder ", path, " is not an executable file (", strerror(errno),
-        "); build ", kDecoderName, " beside the server or give it with serve --cgns_decoder"));
-  }
-  return path;
-}
+// The running child: its pid (also its process group) and the read end of its stdout.
+struct Child {
+  pid_t pid = -1;
+  int out_fd = -1;
+};
 
-absl::StatusOr<ImportedGrid> DecodeCgnsUpload(const std::string& bytes,
-                                              const CgnsDecoderOptions& options,
-                                              MemoryBudget* budget, MemoryReservation* reservation,
-                                              const std::function<bool()>& cancelled) {
-  SG_ASSIGN_OR_RETURN(const std::string executable, FindCgnsDecoder(options));
-  TempUpload upload;
-  SG_RETURN_IF_ERROR(upload.Write(bytes));
+// Starts the decoder on `upload` under `memory_bytes` and `options`' CPU limit.
+absl::StatusOr<Child> SpawnDecoder(const std::string& executable, const std::string& upload,
+                                   int64_t memory_bytes, const CgnsDecoderOptions& options) {
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) {
     return absl::ResourceExhaustedError(absl::StrCat("CGNS import: pipe: ", strerror(errno)));
   }
-  std::string arg0 = kDecoderName, arg1 = upload.path();
-  char* const argv[] = {arg0.data(), arg1.data(), nullptr};
-  const pid_t pid = fork();
-  if (pid < 0) {
-    close(fds[0]);
-    close(fds[1]);
-    return absl::ResourceExhaustedError(absl::StrCat("CGNS import: fork: ", strerror(errno)));
-  }
-  if (pid == 0) RunChild(executable.c_str(), argv, fds[1], options);
+  SpawnSetup setup;
+  int error = setup.Prepare(fds[1]);
+  const int64_t cpu_seconds = std::max<int64_t>(1, absl::ToInt64Seconds(options.cpu_limit));
+  std::string sh = "/bin/sh", dash_c = "-c", script = LimitScript(memory_bytes, cpu_seconds);
+  std::string decoder = executable, path = upload;
+  char* const argv[] = {sh.data(),      dash_c.data(), script.data(),
+                        decoder.data(), path.data(),   nullptr};
+  pid_t pid = -1;
+  if (error == 0)
+    error = posix_spawn(&pid, sh.c_str(), setup.actions(), setup.attr(), argv, environ);
   close(fds[1]);
+  if (error != 0) {
+    close(fds[0]);
+    return absl::ResourceExhaustedError(
+        absl::StrCat("CGNS import: starting the decoder ", executable, ": ", strerror(error)));
+  }
+  return Child{pid, fds[0]};
+}
 
-  // Read until EOF, charging the budget; a child that outlives the wall limit is killed.
-  std::string output;
-  absl::Status read_status;
-  bool timed_out = false;
-  bool stopped = false;  // the call was cancelled
-  const absl::Time deadline = absl::Now() + options.wall_limit;
+// Whether the child has exited (it is not reaped: its pid and process group stay reserved).
+bool Exited(pid_t pid) {
+  siginfo_t info = {};
+  while (waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0) {
+    if (errno != EINTR) return true;  // nothing to wait for: the final waitpid reports it
+  }
+  return info.si_pid == pid;
+}
+
+// Reads the child's stdout into `*output` until EOF and then waits for its exit, charging the
+// output to `budget` through `reservation`; stops early at the wall-time deadline, on
+// cancellation or when the budget refuses (`*read_status`). Polls every 100 ms.
+Stop ReadUntilExit(const Child& child, absl::Time deadline, const std::function<bool()>& cancelled,
+                   MemoryBudget* budget, MemoryReservation* reservation, std::string* output,
+                   absl::Status* read_status) {
   std::string piece(kReadPiece, '\0');
+  bool eof = false;
   while (true) {
     const int64_t wait_ms = absl::ToInt64Milliseconds(deadline - absl::Now());
-    if (wait_ms <= 0) {
-      timed_out = true;
-      break;
+    if (wait_ms <= 0) return Stop::kWallTime;
+    if (cancelled && cancelled()) return Stop::kCancelled;
+    const int slice = static_cast<int>(std::min<int64_t>(wait_ms, 100));
+    if (eof) {  // stdout closed: wait for the exit, still bounded by the deadline
+      if (Exited(child.pid)) return Stop::kNone;
+      absl::SleepFor(absl::Milliseconds(std::min(slice, 10)));
+      continue;
     }
-    if (cancelled && cancelled()) {
-      stopped = true;
-      break;
-    }
-    pollfd p = {fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min<int64_t>(wait_ms, 1000)));
+    pollfd p = {child.out_fd, POLLIN, 0};
+    const int ready = poll(&p, 1, slice);
     if (ready < 0 && errno != EINTR) {
-      read_status = absl::InternalError(absl::StrCat("CGNS import: poll: ", strerror(errno)));
-      break;
+      *read_status = absl::InternalError(absl::StrCat("CGNS import: poll: ", strerror(errno)));
+      return Stop::kReadError;
     }
     if (ready <= 0) continue;
-    const ssize_t n = read(fds[0], piece.data(), piece.size());
+    const ssize_t n = read(child.out_fd, piece.data(), piece.size());
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-    if (n <= 0) break;  // EOF (or a read error: the exit status tells)
-    if (output.size() + n > output.capacity()) {
-      read_status = budget->Resize(
-          reservation, static_cast<int64_t>(std::max(output.size() + n, 2 * output.capacity())),
-          "the decoded CGNS file");
-      if (!read_status.ok()) break;
+    if (n <= 0) {  // EOF (or a read error: the exit status tells)
+      eof = true;
+      continue;
     }
-    output.append(piece.data(), static_cast<size_t>(n));
+    if (output->size() + n > output->capacity()) {
+      *read_status = budget->Resize(
+          reservation, static_cast<int64_t>(std::max(output->size() + n, 2 * output->capacity())),
+          "the decoded CGNS file");
+      if (!read_status->ok()) return Stop::kReadError;
+    }
+    output->append(piece.data(), static_cast<size_t>(n));
   }
-  close(fds[0]);
-  if (timed_out || stopped || !read_status.ok()) kill(pid, SIGKILL);  // our child, by its pid
+}
+
+// Kills the child's process group (the child itself when it still runs -- wall time,
+// cancellation, budget -- and after an exit anything it left running) and reaps the child:
+// its wait status, or INTERNAL when waitpid does not return it.
+absl::StatusOr<int> KillAndReap(pid_t pid) {
+  // Our child's group, by its id: the unreaped child keeps the id from being reused.
+  kill(-pid, SIGKILL);
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  pid_t reaped;
+  while ((reaped = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
   }
-  if (!read_status.ok()) return read_status;
-  if (stopped)
-    return absl::CancelledError("the call was cancelled while its CGNS file was decoded");
-  if (timed_out) {
-    return absl::InvalidArgumentError(absl::StrCat("cgns: decoding the upload took longer than ",
-                                                   absl::FormatDuration(options.wall_limit),
-                                                   "; it was stopped"));
+  if (reaped != pid) {
+    return absl::InternalError(
+        absl::StrCat("CGNS import: waiting for the decoder (pid ", pid, ") returned ", reaped,
+                     reaped < 0 ? absl::StrCat(": ", strerror(errno)) : std::string(),
+                     "; its result is unknown"));
   }
+  return status;
+}
+
+// The result of a child that ran to its end: its exit status and output judged.
+absl::StatusOr<ImportedGrid> Judge(int status, std::string output, const std::string& upload,
+                                   const std::string& executable, const CgnsDecoderOptions& options,
+                                   int64_t memory_bytes, MemoryBudget* budget,
+                                   MemoryReservation* reservation) {
   if (WIFSIGNALED(status)) {
     const int signal = WTERMSIG(status);
-    const std::string why =
-        signal == SIGXCPU || signal == SIGKILL
-            ? absl::StrCat("reached its CPU limit of ", absl::FormatDuration(options.cpu_limit))
-            : "crashed";
+    const std::string cpu = absl::FormatDuration(options.cpu_limit);
+    const std::string memory = absl::StrCat(memory_bytes >> 20, " MiB");
+    // SIGXCPU is RLIMIT_CPU's soft limit; SIGKILL, which the server did not send, is its hard
+    // limit or the kernel's out-of-memory killer.
+    const std::string why = signal == SIGXCPU ? absl::StrCat("reached its CPU limit of ", cpu)
+                            : signal == SIGKILL
+                                ? absl::StrCat("was killed at its CPU limit (", cpu,
+                                               ") or its memory limit (", memory, ")")
+                                : "crashed";
     return absl::InvalidArgumentError(absl::StrCat(
         "cgns: the decoder ", why, " (signal ", SignalName(signal),
         ") reading the upload: the file is damaged, or its content is beyond what libcgns "
-        "reads within the server's limits"));
+        "reads within the server's limits (serve --cgns_decoder_cpu_seconds, "
+        "--cgns_decoder_memory_mb)"));
   }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 2) {
-    std::string message =
-        absl::StrReplaceAll(output.substr(0, kMaxMessage), {{upload.path(), "the upload"}});
-    return absl::InvalidArgumentError(absl::StrCat("cgns: ", QuoteClientString(message)));
+    // The decoder's message names the temporary file: never shown to the client. Replaced in
+    // a prefix long enough that a name across the cut is replaced whole, then quoted (escaped
+    // and cut at kMaxMessage characters, the original length noted).
+    const std::string message = absl::StrReplaceAll(
+        absl::string_view(output).substr(0, kMaxMessage + upload.size()), {{upload, "the upload"}});
+    return absl::InvalidArgumentError(absl::StrCat(
+        "cgns: ", QuoteClientString(message, kMaxMessage),
+        output.size() > message.size() ? absl::StrCat(" (", output.size(), " bytes in all)") : ""));
   }
   if (code != 0) {
     return absl::InternalError(absl::StrCat("CGNS import: the decoder ", executable,
@@ -228,6 +308,79 @@ absl::StatusOr<ImportedGrid> DecodeCgnsUpload(const std::string& bytes,
         absl::StrCat("cgns: the decoded file: ", grid.status().message()));
   }
   return grid;
+}
+
+}  // namespace
+
+int64_t CgnsDecoderMemoryLimit(const CgnsDecoderOptions& options, int64_t budget_limit) {
+  if (options.memory_limit_bytes > 0) return options.memory_limit_bytes;
+  return std::min(kDefaultCgnsDecoderMemoryBytes,
+                  std::max(kMinCgnsDecoderMemoryBytes, budget_limit / 2));
+}
+
+absl::StatusOr<std::string> FindCgnsDecoder(const CgnsDecoderOptions& options) {
+  std::string path = options.executable;
+  if (path.empty()) {
+    std::error_code error;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (error) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "CGNS import: cannot find this binary's directory (/proc/self/exe: ", error.message(),
+          "); give the decoder with serve --cgns_decoder"));
+    }
+    path = (self.parent_path() / kDecoderName).string();
+  }
+  // Absolute, so that the shell the child starts as runs this file and does not search PATH.
+  std::error_code error;
+  if (std::filesystem::path absolute = std::filesystem::absolute(path, error); !error) {
+    path = absolute.string();
+  }
+  if (access(path.c_str(), X_OK) != 0) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "CGNS import: the decoder ", path, " is not an executable file (", strerror(errno),
+        "); build ", kDecoderName, " beside the server or give it with serve --cgns_decoder"));
+  }
+  return path;
+}
+
+absl::StatusOr<ImportedGrid> DecodeCgnsUpload(const std::string& bytes,
+                                              const CgnsDecoderOptions& options,
+                                              MemoryBudget* budget, MemoryReservation* reservation,
+                                              const std::function<bool()>& cancelled) {
+  SG_ASSIGN_OR_RETURN(const std::string executable, FindCgnsDecoder(options));
+  // The child's memory, held until it is reaped (declared before anything it outlives).
+  const int64_t memory_bytes = CgnsDecoderMemoryLimit(options, budget->limit());
+  SG_ASSIGN_OR_RETURN(
+      MemoryReservation child_memory,
+      budget->Reserve(memory_bytes, absl::StrCat("the CGNS decoder's memory limit (serve "
+                                                 "--cgns_decoder_memory_mb = ",
+                                                 memory_bytes >> 20, ")")));
+  TempUpload upload;
+  SG_RETURN_IF_ERROR(upload.Write(bytes));
+  SG_ASSIGN_OR_RETURN(const Child child,
+                      SpawnDecoder(executable, upload.path(), memory_bytes, options));
+  std::string output;
+  absl::Status read_status;
+  const Stop stop = ReadUntilExit(child, absl::Now() + options.wall_limit, cancelled, budget,
+                                  reservation, &output, &read_status);
+  close(child.out_fd);
+  SG_ASSIGN_OR_RETURN(const int status, KillAndReap(child.pid));
+  switch (stop) {
+    case Stop::kReadError:
+      return read_status;
+    case Stop::kCancelled:
+      return absl::CancelledError(
+          "the call was cancelled while its CGNS file was decoded; the decoder was killed");
+    case Stop::kWallTime:
+      return absl::InvalidArgumentError(
+          absl::StrCat("cgns: decoding the upload took longer than the wall-time limit of ",
+                       absl::FormatDuration(options.wall_limit),
+                       " (serve --cgns_decoder_timeout_seconds); the decoder was killed"));
+    case Stop::kNone:
+      break;
+  }
+  return Judge(status, std::move(output), upload.path(), executable, options, memory_bytes, budget,
+               reservation);
 }
 
 }  // namespace splinegrid::server

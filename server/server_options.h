@@ -40,7 +40,8 @@ struct ServerOptions {
   // DEADLINE_EXCEEDED, releasing what it holds; zero or negative: never.
   absl::Duration import_idle_timeout = absl::Seconds(60);
   // The child process that decodes CGNS uploads (server/cgns_decoder.h); its executable empty:
-  // splinegrid-cgns-decode beside the running binary.
+  // splinegrid-cgns-decode beside the running binary. Its memory limit is held against the
+  // memory budget while it runs (0: 1 GiB, at most half the budget).
   CgnsDecoderOptions cgns_decoder;
   // The most points one EvaluateGrid or EvaluatePoints call may ask for (OUT_OF_RANGE beyond).
   int64_t max_output_points = int64_t{1} << 30;

@@ -18,6 +18,8 @@ constexpr int64_t kMaxThreads = 1024;
 constexpr int64_t kMaxBudgetMb = int64_t{1} << 30;  // 1 PiB; << 20 stays below 2^51
 constexpr int64_t kMaxCount = int64_t{1} << 40;
 constexpr int64_t kMaxPerPrincipal = 1'000'000;
+constexpr int64_t kMaxDecoderMb = int64_t{1} << 20;  // 1 TiB of address space
+constexpr int64_t kMaxSeconds = 24 * 3600;            // a day of CPU or wall time
 
 absl::Status CheckRange(const char* flag, int64_t value, int64_t lo, int64_t hi,
                         const char* meaning = "") {
@@ -45,6 +47,17 @@ absl::Status CheckServeFlags(server::LogFormat* format) {
       CheckRange("threads", absl::GetFlag(FLAGS_threads), 0, kMaxThreads, " (0: one per core)"));
   SG_RETURN_IF_ERROR(CheckRange("memory_budget_mb", absl::GetFlag(FLAGS_memory_budget_mb), 0,
                                 kMaxBudgetMb, " MiB (0: the default)"));
+  // The CGNS decoder child (server/cgns_decoder.h): 0 or at least what it needs to start.
+  if (const int64_t mb = absl::GetFlag(FLAGS_cgns_decoder_memory_mb); mb != 0) {
+    SG_RETURN_IF_ERROR(CheckRange("cgns_decoder_memory_mb", mb,
+                                  server::kMinCgnsDecoderMemoryBytes >> 20, kMaxDecoderMb,
+                                  " MiB (or 0: the default)"));
+  }
+  SG_RETURN_IF_ERROR(CheckRange("cgns_decoder_cpu_seconds",
+                                absl::GetFlag(FLAGS_cgns_decoder_cpu_seconds), 1, kMaxSeconds));
+  SG_RETURN_IF_ERROR(CheckRange("cgns_decoder_timeout_seconds",
+                                absl::GetFlag(FLAGS_cgns_decoder_timeout_seconds), 1,
+                                kMaxSeconds));
   SG_RETURN_IF_ERROR(
       CheckRange("max_output_points", absl::GetFlag(FLAGS_max_output_points), 1, kMaxCount));
   SG_RETURN_IF_ERROR(

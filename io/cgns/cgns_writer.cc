@@ -1,7 +1,12 @@
 // WriteCgnsFile: one base, a structured zone per block, BCs with families, 1-to-1 connections.
 #include <cgnslib.h>
+#include <fcntl.h>
+#include <string.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -264,6 +269,26 @@ class Writer {
   std::map<int, int> zone_of_source_;  // source block -> 1-based zone
 };
 
+// Creates (O_EXCL, mode 0666 less the umask) an unused name "PATH.tmp-PID-N" in the directory
+// of `path` for the file to be written and renamed; the caller removes it on failure.
+absl::StatusOr<std::string> ClaimTempPath(const std::string& path) {
+  static std::atomic<int> counter{0};
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    std::string temp = absl::StrCat(path, ".tmp-", getpid(), "-", counter.fetch_add(1));
+    const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      close(fd);
+      return temp;
+    }
+    if (errno != EEXIST) {
+      return absl::PermissionDeniedError(
+          absl::StrCat("creating ", temp, " (written, then renamed to ", path, "): ",
+                       strerror(errno)));
+    }
+  }
+  return absl::AlreadyExistsError(absl::StrCat("no free temporary name beside ", path));
+}
+
 }  // namespace
 
 absl::Status WriteCgnsFile(const std::string& path, const MultiBlockGrid& grid,
@@ -276,14 +301,25 @@ absl::Status WriteCgnsFile(const std::string& path, const MultiBlockGrid& grid,
   if (cg_set_file_type(CG_FILE_HDF5) != CG_OK) {
     return absl::InternalError(absl::StrCat("cg_set_file_type: ", cg_get_error()));
   }
+  // Written to a fresh file beside `path` and renamed over it only once cg_close succeeded, so
+  // that a failed write leaves an existing file as it was (rename within a directory is atomic).
+  SG_ASSIGN_OR_RETURN(const std::string temp, ClaimTempPath(path));
   absl::Status status;
   {
-    SG_ASSIGN_OR_RETURN(CgnsFile file, CgnsFile::Open(path, CG_MODE_WRITE));
-    Writer writer(&file, grid, options, notes);
+    absl::StatusOr<CgnsFile> file = CgnsFile::Open(temp, CG_MODE_WRITE);
+    if (!file.ok()) {
+      unlink(temp.c_str());
+      return file.status();
+    }
+    Writer writer(&*file, grid, options, notes);
     status = writer.Write();
-    if (absl::Status closed = file.Close(); status.ok()) status = closed;
+    if (absl::Status closed = file->Close(); status.ok()) status = closed;
   }
-  if (!status.ok()) std::remove(path.c_str());  // no partial file left behind
+  if (status.ok() && rename(temp.c_str(), path.c_str()) != 0) {
+    status = absl::PermissionDeniedError(
+        absl::StrCat("renaming ", temp, " to ", path, ": ", strerror(errno)));
+  }
+  if (!status.ok()) unlink(temp.c_str());  // no partial file left behind
   return status;
 }
 

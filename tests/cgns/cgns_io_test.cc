@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 
 #include "absl/strings/match.h"
+#include "core/io/file_util.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -209,6 +211,39 @@ TEST(CgnsWriterTest, RefusesBlocksThatAreNotALevelOfTheSource) {
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(status.message(), HasSubstr("refinement level"));
   EXPECT_FALSE(std::filesystem::exists(dir.File("x.cgns")));  // no partial file
+}
+
+TEST(CgnsWriterTest, AFailedWriteLeavesAnExistingFileAsItWasAndNoTemporaryFile) {
+  TempDir dir("cgns-io");
+  const MultiBlockGrid grid = testing::TwoBoxes();
+  CgnsWriteOptions options;
+  options.source_extents = {grid.blocks[0].extents(), grid.blocks[1].extents()};
+  const std::string path = dir.File("keep.cgns");
+  ASSERT_TRUE(WriteCgnsFile(path, grid, options, nullptr).ok());
+  const std::string before = *ReadFileToString(path);
+  // A write that fails after the file was opened (the blocks are not level 1 of the source).
+  options.index_scale = 2;
+  const absl::Status status = WriteCgnsFile(path, grid, options, nullptr);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(*ReadFileToString(path), before);
+  absl::StatusOr<ImportedGrid> back = ReadCgnsFile(path);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(testing::MaxDifference(back->grid, grid), 0.0);
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.File(""))) {
+    EXPECT_EQ(entry.path().filename(), "keep.cgns");  // no PATH.tmp-* left behind
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+  // A successful write replaces the file (through the rename).
+  options.index_scale = 1;
+  MultiBlockGrid one;
+  one.blocks.push_back(grid.blocks[0]);
+  options.source_extents = {grid.blocks[0].extents()};
+  ASSERT_TRUE(WriteCgnsFile(path, one, options, nullptr).ok());
+  back = ReadCgnsFile(path);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->grid.blocks.size(), 1u);
 }
 
 // A base with one zone written by the mid-level library itself, for what the reader refuses.
