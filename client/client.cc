@@ -234,45 +234,49 @@ absl::StatusOr<v1::Grid> Client::ImportPlot3d(const std::string& bytes, const st
                                               const std::string& display_name,
                                               const v1::Plot3dSource& options,
                                               const ProgressFn& progress) {
-  v1::ImportGridRequest head;
-  v1::ImportHeader* header = head.mutable_header();
-  header->set_grid_id(grid_id);
-  header->set_display_name(display_name);
-  *header->mutable_plot3d() = options;
-  header->mutable_plot3d()->set_total_bytes(static_cast<int64_t>(bytes.size()));
-  v1::Grid grid;
-  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
-    auto writer = stub_->ImportGrid(context, &grid);
-    bool open = writer->Write(head);
-    v1::ImportGridRequest request;
-    for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
-      request.set_plot3d_chunk(bytes.substr(at, kUploadChunkBytes));
-      open = writer->Write(request);
-      if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
-    }
-    writer->WritesDone();
-    return writer->Finish();
-  }));
-  return grid;
+  v1::ImportHeader header;
+  header.set_grid_id(grid_id);
+  header.set_display_name(display_name);
+  *header.mutable_plot3d() = options;
+  header.mutable_plot3d()->set_total_bytes(static_cast<int64_t>(bytes.size()));
+  return UploadFile(
+      header, bytes,
+      [](v1::ImportGridRequest& request, std::string chunk) {
+        request.set_plot3d_chunk(std::move(chunk));
+      },
+      progress);
 }
 
 absl::StatusOr<v1::Grid> Client::ImportCgns(const std::string& bytes, const std::string& grid_id,
                                             const std::string& display_name,
                                             const ProgressFn& progress) {
+  v1::ImportHeader header;
+  header.set_grid_id(grid_id);
+  header.set_display_name(display_name);
+  header.mutable_cgns()->set_total_bytes(static_cast<int64_t>(bytes.size()));
+  return UploadFile(
+      header, bytes,
+      [](v1::ImportGridRequest& request, std::string chunk) {
+        request.set_cgns_chunk(std::move(chunk));
+      },
+      progress);
+}
+
+absl::StatusOr<v1::Grid> Client::UploadFile(const v1::ImportHeader& header,
+                                            const std::string& bytes, const ChunkSetter& set_chunk,
+                                            const ProgressFn& progress) {
   v1::ImportGridRequest head;
-  v1::ImportHeader* header = head.mutable_header();
-  header->set_grid_id(grid_id);
-  header->set_display_name(display_name);
-  header->mutable_cgns()->set_total_bytes(static_cast<int64_t>(bytes.size()));
+  *head.mutable_header() = header;
+  const int64_t size = static_cast<int64_t>(bytes.size());
   v1::Grid grid;
-  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
+  SG_RETURN_IF_ERROR(Call(GridId(header.grid_id()), [&](grpc::ClientContext* context, bool*) {
     auto writer = stub_->ImportGrid(context, &grid);
     bool open = writer->Write(head);
     v1::ImportGridRequest request;
-    for (int64_t at = 0; open && at < static_cast<int64_t>(bytes.size()); at += kUploadChunkBytes) {
-      request.set_cgns_chunk(bytes.substr(at, kUploadChunkBytes));
+    for (int64_t at = 0; open && at < size; at += kUploadChunkBytes) {
+      set_chunk(request, bytes.substr(at, kUploadChunkBytes));
       open = writer->Write(request);
-      if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, bytes.size()), bytes.size());
+      if (progress) progress(std::min<int64_t>(at + kUploadChunkBytes, size), size);
     }
     writer->WritesDone();
     return writer->Finish();

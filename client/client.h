@@ -276,6 +276,14 @@ class Client {
   // when there were retries).
   absl::Status Call(const std::string& grid, const Attempt& attempt) const;
 
+  // Puts one piece of a file into an upload request (its plot3d_chunk or cgns_chunk).
+  using ChunkSetter = std::function<void(v1::ImportGridRequest& request, std::string chunk)>;
+  // One ImportGrid upload of a file's `bytes`: a request holding `header` (whose grid_id routes
+  // the call and whose format message carries total_bytes), then the bytes in kUploadChunkBytes
+  // pieces placed by `set_chunk`, retried as Call says. The new grid, or the call's status.
+  absl::StatusOr<v1::Grid> UploadFile(const v1::ImportHeader& header, const std::string& bytes,
+                                      const ChunkSetter& set_chunk, const ProgressFn& progress);
+
   // The grid a request is about, for the routing header: the id of its `name`, else its
   // `grid_id` (a new grid's), else none.
   template <typename Request>

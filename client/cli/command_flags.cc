@@ -21,7 +21,8 @@ std::vector<CommandSpec> MakeCommands() {
         "log_format", "drain_notice", "shutdown_grace", "import_idle_timeout",
         "max_output_points", "max_running_long_tasks", "max_queued_long_calls_per_principal",
         "max_streams_per_principal", "tls_cert", "tls_key", "tls_client_ca", "insecure",
-        "tokens", "metrics_address", "metrics_insecure", "cgns_decoder"},
+        "tokens", "metrics_address", "metrics_insecure", "cgns_decoder",
+        "cgns_decoder_memory_mb", "cgns_decoder_cpu_seconds", "cgns_decoder_timeout_seconds"},
        {"Plaintext only on a loopback address unless --insecure; --tls_cert and --tls_key "
         "enable TLS."}},
       {"fit",
@@ -48,7 +49,7 @@ std::vector<CommandSpec> MakeCommands() {
        "fit an airfoil's coordinates locally (no server); curvature CSV with -o",
        /*client=*/false,
        {"tol", "fair", "o"},
-       {"The connection flags (--server, --json, TLS ...) are accepted and ignored."}},
+       {"Local: the connection flags (--server, --json, TLS ...) are refused, not ignored."}},
       {"get", "get NAME [--revision R | --step N] [--full]",
        "a grid's description (with --full its knots and control points)",
        /*client=*/true,
@@ -80,7 +81,7 @@ std::vector<CommandSpec> MakeCommands() {
       {"offset",
        "offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] [--points 257] "
        "[--method offsets|transfinite|elliptic] [--tol T | --kinds ... | --ctl a,b,c] "
-       "[-o OUT.{vts,x,xyz}]",
+       "[-o OUT.{vts,vtm,x,xyz,cgns}]",
        "an O-grid around an airfoil file (GenerateGrid), stored and fitted",
        /*client=*/true,
        {"name", "o", "layers", "first", "far", "points", "method", "orthogonalize",
@@ -129,10 +130,10 @@ const CommandSpec* FindCommand(absl::string_view name) {
 
 std::vector<std::string> AcceptedFlags(const CommandSpec& command) {
   std::vector<std::string> flags = command.flags;
-  // serve has transport flags of its own (--tls_cert is the server's certificate there). Every
-  // other command takes the connection flags, the local airfoil too (it ignores them), so that
-  // scripts and aliases (`alias sg='splinegrid --server=h:50051'`) may pass them to any command.
-  if (command.name != "serve") {
+  // Only the commands that talk to a server take the connection flags: serve has transport
+  // flags of its own (--tls_cert is the server's certificate there), and the local airfoil would
+  // only ignore them (`airfoil --server h:1` must not look as if it ran on h).
+  if (command.client) {
     for (const std::string& flag : ClientFlags()) {
       if (std::find(flags.begin(), flags.end(), flag) == flags.end()) flags.push_back(flag);
     }

@@ -36,8 +36,8 @@ const std::vector<std::string>& ClientFlags();
 // The command named `name`, or nullptr.
 const CommandSpec* FindCommand(absl::string_view name);
 
-// The flags `command` accepts: its own, then ClientFlags() for every command but serve (the
-// local airfoil accepts and ignores them).
+// The flags `command` accepts: its own, then ClientFlags() when it talks to a server
+// (command.client; not serve, not the local airfoil).
 std::vector<std::string> AcceptedFlags(const CommandSpec& command);
 
 }  // namespace splinegrid::cli

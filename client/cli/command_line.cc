@@ -187,9 +187,25 @@ absl::StatusOr<CommandLine> CheckCommandLine(const std::vector<std::string>& arg
   line.command = *command;
   const std::vector<std::string> accepted = AcceptedFlags(**command);
   for (const GivenFlag& flag : flags) {
-    if (!AcceptedName(flag.name, accepted)) return ForeignOrUnknownFlag(flag, **command);
+    const std::optional<std::string> name = AcceptedName(flag.name, accepted);
+    if (!name) return ForeignOrUnknownFlag(flag, **command);
+    line.given_flags.push_back(*name);
   }
   return line;
 }
+
+namespace {
+
+// The names RememberGivenFlags recorded (main.cc sets them once, before any thread starts).
+std::vector<std::string>& GivenFlagNames() {
+  static std::vector<std::string>* const names = new std::vector<std::string>();
+  return *names;
+}
+
+}  // namespace
+
+void RememberGivenFlags(const CommandLine& line) { GivenFlagNames() = line.given_flags; }
+
+bool FlagGiven(absl::string_view name) { return Contains(GivenFlagNames(), name); }
 
 }  // namespace splinegrid::cli

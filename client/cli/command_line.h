@@ -23,6 +23,8 @@ struct CommandLine {
   };
   Action action = Action::kRun;
   const CommandSpec* command = nullptr;
+  // The flags given (kRun), by the name the command reads: --noFLAG and --FLAG=false as FLAG.
+  std::vector<std::string> given_flags;
 };
 
 // Checks argv[1..] (the arguments after the program name). `help`, `help CMD`, `--help`, `-h`
@@ -32,6 +34,15 @@ struct CommandLine {
 // that take it. A flag's value given as the next argument (`--name N`) is skipped; only bool
 // flags stand alone (Abseil's rule).
 absl::StatusOr<CommandLine> CheckCommandLine(const std::vector<std::string>& args);
+
+// Records line.given_flags for FlagGiven (main.cc, once, before the command runs).
+void RememberGivenFlags(const CommandLine& line);
+
+// Whether flag `name` was written on this process's command line, in any spelling (--planar,
+// --planar=true, --noplanar), per RememberGivenFlags. For flags whose value cannot tell a
+// default from an explicit choice: `fit x.cgns --planar` (default true) is refused as a flag
+// CGNS ignores, while the default is not.
+bool FlagGiven(absl::string_view name);
 
 // Levenshtein distance of `a` and `b` (insertions, deletions, substitutions).
 int EditDistance(absl::string_view a, absl::string_view b);

@@ -22,6 +22,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "client/cli/cgns_output.h"
+#include "client/cli/command_line.h"
 #include "client/cli/eval_command.h"
 #include "client/cli/eval_output.h"
 #include "client/cli/flags.h"
@@ -153,6 +154,10 @@ absl::Status Serve(const Args& args) {
   options.memory_budget_bytes = absl::GetFlag(FLAGS_memory_budget_mb) << 20;
   options.import_idle_timeout = absl::GetFlag(FLAGS_import_idle_timeout);
   options.cgns_decoder.executable = absl::GetFlag(FLAGS_cgns_decoder);
+  options.cgns_decoder.memory_limit_bytes = absl::GetFlag(FLAGS_cgns_decoder_memory_mb) << 20;
+  options.cgns_decoder.cpu_limit = absl::Seconds(absl::GetFlag(FLAGS_cgns_decoder_cpu_seconds));
+  options.cgns_decoder.wall_limit =
+      absl::Seconds(absl::GetFlag(FLAGS_cgns_decoder_timeout_seconds));
   options.max_output_points = absl::GetFlag(FLAGS_max_output_points);
   options.shutdown_grace = absl::GetFlag(FLAGS_shutdown_grace);
   options.log_calls = absl::GetFlag(FLAGS_log_calls);
@@ -323,6 +328,14 @@ absl::Status Fit(const Args& args) {
   // A CGNS file (by extension or signature) is decoded by the server, BCs included; it is
   // stored as its zones are (--planar is about two-plane Plot3D files).
   const bool cgns = IsCgnsPath(path) || LooksLikeCgns(bytes);
+  // Plot3D read options given for a CGNS file would be ignored: refused instead (the defaults,
+  // --planar=true included, are not "given").
+  for (const char* flag : {"planar", "plot3d_layout"}) {
+    if (cgns && FlagGiven(flag)) {
+      return Usage(absl::StrCat("--", flag, " is about Plot3D files; ", path,
+                                " is CGNS (stored as its zones are): drop --", flag));
+    }
+  }
   // --plot3d_layout: the value order of 3D text and C-stream files (Fortran records show it).
   SG_ASSIGN_OR_RETURN(const v1::Plot3dLayout layout, Plot3dLayoutFlag());
   Plot3dReadOptions read_options;
@@ -459,7 +472,7 @@ absl::Status Eval(const Args& args) {
   if (IsCgnsPath(out)) {
     SG_ASSIGN_OR_RETURN(cgns, FetchCgnsOutputContext(*client, request));
   }
-  std::optional<EvalGridFacts> facts;  // VTK and Plot3D outputs (eval_output.h)
+  EvalGridFacts facts;  // VTK and Plot3D outputs (eval_output.h)
   if (!cgns) {
     SG_ASSIGN_OR_RETURN(facts, FetchEvalFacts(*client, request, eval_options));
   }
@@ -467,8 +480,7 @@ absl::Status Eval(const Args& args) {
   SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client->Evaluate(request, download.callback()));
   download.Done();
   SG_ASSIGN_OR_RETURN(const int64_t points,
-                      cgns ? WriteCgnsOutput(out, result, &*cgns)
-                           : WriteEvaluation(out, result, *facts, eval_options));
+                      WriteGridOutput(out, result, facts, eval_options, cgns ? &*cgns : nullptr));
   v1::EvaluationHeader summary;  // for --json
   summary.set_revision(result.revision);
   summary.set_total_points(points);
@@ -712,7 +724,7 @@ absl::Status Offset(const Args& args) {
       "usage: splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] "
       "[--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
       "[--profile_tol T] "
-      "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,x,xyz}]";
+      "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,vtm,x,xyz,cgns}]";
   if (args.size() != 1) return Usage(kUsage);
   const std::string& path = args[0];
   const std::string out = absl::GetFlag(FLAGS_o);
@@ -761,7 +773,10 @@ absl::Status Offset(const Args& args) {
     SG_ASSIGN_OR_RETURN(const client::EvaluatedGrid result,
                         client->Evaluate(evaluate, download.callback()));
     download.Done();
-    SG_ASSIGN_OR_RETURN(const int64_t points, WriteEvaluatedGrid(out, result));
+    // Points only, through eval's writers: no source layout (a generated grid has no file),
+    // parametric dimensions from the extents, no boundary conditions in a .cgns.
+    SG_ASSIGN_OR_RETURN(const int64_t points, WriteGridOutput(out, result, EvalGridFacts{},
+                                                              EvalOutputOptions{}, nullptr));
     absl::StrAppend(&human, "wrote ", out, ": ", points, " points (revision ", result.revision,
                     ")\n");
   }

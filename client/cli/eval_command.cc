@@ -1,17 +1,20 @@
 #include "client/cli/eval_command.h"
 
-#include <unistd.h>
+#include <stdlib.h>
 
-#include <cstdio>
+#include <cerrno>
 #include <filesystem>
 #include <map>
 #include <vector>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/flags/flag.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "client/cli/command_line.h"
 #include "client/cli/flags.h"
+#include "core/io/file_util.h"
 #include "core/io/record_file.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/archive_convert.h"
@@ -80,6 +83,12 @@ absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& 
                      ": --jacobian, --quality and --deviation are VTK fields; write "
                      ".vts, .vtm or .pvd"));
   }
+  // zlib is a storage option of VTK XML files: refused, not ignored, for Plot3D and CGNS.
+  if (FlagGiven("compress") && ext != ".vts" && ext != ".vtm" && ext != ".pvd") {
+    return absl::InvalidArgumentError(
+        absl::StrCat("-o ", out, ": ", options.compress ? "--compress" : "--nocompress",
+                     " applies to VTK files (.vts, .vtm, .pvd) only; drop it for this output"));
+  }
   if (IsSeriesPath(out) == absl::GetFlag(FLAGS_steps).empty()) {
     return absl::InvalidArgumentError(
         "a time series takes both --steps a:b and -o NAME.pvd (and only a series writes .pvd)");
@@ -102,15 +111,29 @@ absl::StatusOr<EvalGridFacts> FetchEvalFacts(client::Client& client,
   SG_ASSIGN_OR_RETURN(const v1::Grid grid, client.Get(get));
   SG_ASSIGN_OR_RETURN(EvalGridFacts facts, EvalFactsFromGrid(grid));
   if (options.deviation) {
-    const std::string path = (std::filesystem::temp_directory_path() /
-                              absl::StrCat("splinegrid-source-", getpid(), ".sgrid"))
-                                 .string();
-    absl::StatusOr<client::ArchiveSummary> exported = client.ExportGrid(request.name(), path);
-    if (!exported.ok()) return exported.status();
-    absl::StatusOr<MultiBlockGrid> source = ReadArchiveSource(path);
-    std::remove(path.c_str());
-    if (!source.ok()) return source.status();
-    facts.source = *std::move(source);
+    // The archive goes to a private directory (mkdtemp: mode 0700, an unpredictable name under
+    // $TMPDIR), so that no other user can read, replace or pre-create it; the directory and
+    // whatever ExportGrid left in it are removed on every path out of this block.
+    std::error_code error;  // the overload that does not throw for a TMPDIR that is no directory
+    const std::filesystem::path temp = std::filesystem::temp_directory_path(error);
+    if (error) {
+      return ErrnoToStatusWithMessage(
+          error.value(), "--deviation: no temporary directory (set TMPDIR to a writable one)");
+    }
+    std::string directory = (temp / "splinegrid-eval-XXXXXX").string();
+    if (mkdtemp(directory.data()) == nullptr) {
+      return ErrnoToStatusWithMessage(
+          errno, absl::StrCat("--deviation: cannot create a temporary directory '", directory,
+                              "' (set TMPDIR to a writable directory)"));
+    }
+    const absl::Cleanup remove_directory = [&directory] {
+      std::error_code ignored;
+      std::filesystem::remove_all(directory, ignored);
+    };
+    const std::string path = (std::filesystem::path(directory) / "source.sgrid").string();
+    SG_RETURN_IF_ERROR(client.ExportGrid(request.name(), path).status());
+    SG_ASSIGN_OR_RETURN(MultiBlockGrid source, ReadArchiveSource(path));
+    facts.source = std::move(source);
   }
   return facts;
 }

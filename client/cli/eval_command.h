@@ -18,8 +18,9 @@ bool IsSeriesPath(const std::string& out);
 
 // The output options of --derivs, --jacobian, --quality, --deviation and --compress; sets
 // request->derivatives when the derivatives or the Jacobian need them. INVALID_ARGUMENT, before
-// any call, for VTK fields with a file that is not VTK, --deviation other than at --level 0
-// without --box, and --steps without a .pvd -o (or a .pvd without --steps).
+// any call, for VTK fields or an explicit --compress/--nocompress with a file that is not VTK,
+// --deviation other than at --level 0 without --box, and --steps without a .pvd -o (or a .pvd
+// without --steps).
 absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& out,
                                                              v1::EvaluateGridRequest* request);
 

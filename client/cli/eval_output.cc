@@ -240,7 +240,7 @@ absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, const client::Ev
   if (ext == ".vts" || ext == ".vtm") return WriteVtk(out, ext, result, facts, options);
   if (ext == ".x" || ext == ".xyz") return WritePlot3d(out, ext, result, facts, options);
   return absl::InvalidArgumentError(
-      absl::StrCat("-o ", out, ": eval writes .vts, .vtm, .pvd, .x or .xyz here"));
+      absl::StrCat("-o ", out, ": WriteEvaluation writes .vts, .vtm, .x or .xyz"));
 }
 
 absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, const std::vector<SeriesStep>& steps,

@@ -1,6 +1,7 @@
 // Writing `splinegrid eval` results: VTK (.vts/.vtm) with optional fields, Plot3D written back
 // in the layout of the grid's source file with derivatives in a function file beside it, and
-// ParaView time series (.pvd) of deformed revisions. grid_output.h dispatches here.
+// ParaView time series (.pvd) of deformed revisions. grid_output.h dispatches here (eval and
+// offset), CGNS aside.
 #ifndef SPLINEGRID_CLIENT_CLI_EVAL_OUTPUT_H_
 #define SPLINEGRID_CLIENT_CLI_EVAL_OUTPUT_H_
 

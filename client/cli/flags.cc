@@ -69,8 +69,8 @@ ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
 ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
 ABSL_FLAG(std::string, o, "",
-          "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D); curvature: .csv; "
-          "export: the archive (.sgrid)");
+          "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D, .cgns; eval: "
+          ".pvd series); curvature: .csv; export: the archive (.sgrid)");
 ABSL_FLAG(bool, derivs, false,
           "eval: also dX/du, dX/dv[, dX/dw] (VTK point arrays; with .x/.xyz a Plot3D function "
           "file NAME.f beside it)");
@@ -146,6 +146,15 @@ ABSL_FLAG(absl::Duration, import_idle_timeout, absl::Seconds(60),
 ABSL_FLAG(std::string, cgns_decoder, "",
           "serve: the executable that decodes CGNS uploads in a child process (empty: "
           "splinegrid-cgns-decode beside this binary)");
+ABSL_FLAG(int64_t, cgns_decoder_memory_mb, 0,
+          "serve: address-space limit of a CGNS decoder child, MiB, reserved against the memory "
+          "budget while it runs (0: 1024, or half the budget when that is less; at least 64)");
+ABSL_FLAG(int64_t, cgns_decoder_cpu_seconds,
+          absl::ToInt64Seconds(splinegrid::server::CgnsDecoderOptions().cpu_limit),
+          "serve: CPU seconds a CGNS decoder child may use (SIGXCPU, then SIGKILL 5 s later)");
+ABSL_FLAG(int64_t, cgns_decoder_timeout_seconds,
+          absl::ToInt64Seconds(splinegrid::server::CgnsDecoderOptions().wall_limit),
+          "serve: wall-clock seconds a CGNS decoder child may take before it is killed");
 ABSL_FLAG(int64_t, max_output_points, int64_t{1} << 30,
           "serve: the most points one evaluation may ask for");
 ABSL_FLAG(absl::Duration, shutdown_grace, absl::Seconds(10),

@@ -1,5 +1,6 @@
-// Writing evaluated grids to files for `splinegrid eval` and `offset`: the file format follows
-// the extension of -o.
+// Where `splinegrid eval` and `offset` write an evaluated grid: the one check of -o's extension
+// and the one dispatch by it, to the CGNS writer (cgns_output.h) or to the VTK and Plot3D writers
+// (eval_output.h). A .pvd time series is eval's own (WriteSeries).
 #ifndef SPLINEGRID_CLIENT_CLI_GRID_OUTPUT_H_
 #define SPLINEGRID_CLIENT_CLI_GRID_OUTPUT_H_
 
@@ -8,18 +9,25 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "client/cli/cgns_output.h"
+#include "client/cli/eval_output.h"
 #include "client/client.h"
 
 namespace splinegrid::cli {
 
-// OK when `out` has an extension WriteEvaluatedGrid writes; INVALID_ARGUMENT naming it otherwise.
-// Checked before any call, so a bad -o fails before the work is done.
+// OK when `out` ends in an extension WriteGridOutput writes (.vts, .vtm, .x, .xyz, .cgns);
+// INVALID_ARGUMENT naming it otherwise. Checked before any call, so a bad -o fails before the
+// work is done.
 absl::Status CheckGridOutput(const std::string& out);
 
-// Writes an evaluation to `out` (VTK .vts for one block or .vtm, binary .x or text .xyz
-// Plot3D); returns the number of points written.
-absl::StatusOr<int64_t> WriteEvaluatedGrid(const std::string& out,
-                                           const client::EvaluatedGrid& result);
+// Writes `result` to `out` by its extension: .cgns with WriteCgnsOutput (boundary conditions and
+// connectivity from `cgns`, points only when it is null), the others with WriteEvaluation
+// (`facts` and `options`; empty facts: the default Plot3D layout, parametric dimensions from the
+// blocks' extents). Returns the number of points written.
+absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, const client::EvaluatedGrid& result,
+                                        const EvalGridFacts& facts,
+                                        const EvalOutputOptions& options,
+                                        const CgnsOutputContext* cgns);
 
 }  // namespace splinegrid::cli
 

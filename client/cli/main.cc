@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
       break;
   }
 
+  splinegrid::cli::RememberGivenFlags(*line);  // FlagGiven: explicit flags vs defaults
   std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   using Command = absl::Status (*)(const splinegrid::cli::Args&);
   const std::map<std::string, Command> commands = {

@@ -82,14 +82,21 @@ TEST(CommandLineCheck, RefusesAFlagOfAnotherCommandNamingItsOwner) {
   EXPECT_EQ(line.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(line.status().message(),
               HasSubstr("--rotate is not a flag of list; it belongs to deform"));
-  // A connection flag given to serve: the group is named. The local airfoil accepts them (and
-  // ignores them), so that scripts may pass --server to every command.
+  // A connection flag given to serve or to the local airfoil (which would only ignore it): the
+  // group is named.
   const auto serve = Check("serve --server localhost:1");
   ASSERT_FALSE(serve.ok());
   EXPECT_THAT(serve.status().message(),
               HasSubstr("--server is not a flag of serve; it belongs to the commands that "
                         "talk to a server"));
-  EXPECT_TRUE(Check("airfoil a.dat --server localhost:1 --json").ok());
+  for (const char* line : {"airfoil a.dat --server localhost:1", "airfoil a.dat --json",
+                           "airfoil a.dat --tls_ca=ca.pem"}) {
+    const auto airfoil = Check(line);
+    ASSERT_FALSE(airfoil.ok()) << line;
+    EXPECT_THAT(airfoil.status().message(), HasSubstr("is not a flag of airfoil; it belongs to "
+                                                      "the commands that talk to a server"))
+        << line;
+  }
 }
 
 TEST(CommandLineCheck, SuggestsTheClosestFlagOfTheCommand) {
@@ -155,7 +162,7 @@ TEST(CommandHelp, ListsTheCommandsFlagsWithHelpAndDefaults) {
   EXPECT_THAT(fit, HasSubstr("--server VALUE  (default: \"localhost:50051\")"));
   EXPECT_THAT(fit, Not(HasSubstr("--rotate")));
   const std::string airfoil = CommandHelp(*FindCommand("airfoil"));
-  EXPECT_THAT(airfoil, Not(HasSubstr("--server VALUE")));  // accepted, ignored, not listed
+  EXPECT_THAT(airfoil, Not(HasSubstr("--server VALUE")));  // local: refused, not listed
   const std::string overview = OverviewHelp("9.9.9");
   EXPECT_THAT(overview, HasSubstr("splinegrid 9.9.9"));
   for (const CommandSpec& command : Commands()) EXPECT_THAT(overview, HasSubstr(command.name));

@@ -173,5 +173,21 @@ TEST(CliConventions, EveryReadmeCommandLineParses) {
   std::filesystem::remove_all(scratch);
 }
 
+// The local airfoil talks to no server: a connection flag would be ignored, so it is refused.
+TEST(CliConventions, TheLocalAirfoilRefusesConnectionFlags) {
+  const std::string profile =
+      absl::StrCat(SPLINEGRID_SOURCE_DIR, "/../shared/data/airfoils/rae2822.dat");
+  for (const char* flag : {"--server=127.0.0.1:1", "--json", "--timeout=3s", "--token=t"}) {
+    const Result airfoil = Both(absl::StrCat("airfoil ", profile, " ", flag, " 2>&1"));
+    EXPECT_EQ(airfoil.exit_code, 2) << flag << "\n" << airfoil.out;
+    EXPECT_THAT(airfoil.out, HasSubstr("is not a flag of airfoil; it belongs to the commands "
+                                       "that talk to a server"))
+        << flag;
+  }
+  const Result local = Both(absl::StrCat("airfoil ", profile, " 2>&1"));
+  EXPECT_EQ(local.exit_code, 0) << local.out;
+  EXPECT_THAT(Stdout("help airfoil").out, Not(HasSubstr("--server VALUE")));
+}
+
 }  // namespace
 }  // namespace splinegrid::testing

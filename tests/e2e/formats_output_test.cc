@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "core/io/file_util.h"
@@ -262,6 +263,90 @@ TEST_F(FormatsOutputTest, DeformStepsBecomeAParaViewTimeSeries) {
   EXPECT_EQ(Cli("eval pitch --steps=7:9 --level=1 -o none.pvd").exit_code, 1);
   EXPECT_EQ(Cli("eval pitch --steps=3:1 --level=1 -o bad.pvd").exit_code, 2);
   EXPECT_EQ(Cli("eval pitch --level=1 -o nosteps.pvd").exit_code, 2);
+}
+
+// A flag the output or the input would ignore is refused (exit 2, naming it), not dropped:
+// zlib for a file that is not VTK, Plot3D read options for a CGNS file. Defaults never count.
+TEST_F(FormatsOutputTest, FlagsTheOutputOrInputWouldIgnoreAreRefused) {
+  ASSERT_NO_FATAL_FAILURE(Fit(SharedDataPath("grids/n0012_113-33.p2dfmt"), "naca", "--kinds"));
+  for (const std::string line : {"--nocompress -o a.x", "--compress -o a.xyz",
+                                 "--nocompress -o a.cgns", "--compress=false -o a.x"}) {
+    const Result eval = Cli(absl::StrCat("eval naca --level=0 ", line));
+    EXPECT_EQ(eval.exit_code, 2) << line << "\n" << eval.out;
+    EXPECT_THAT(eval.out, HasSubstr(absl::StrContains(line, "no") || absl::StrContains(line, "false")
+                                        ? "--nocompress applies to VTK files (.vts, .vtm, .pvd)"
+                                        : "--compress applies to VTK files (.vts, .vtm, .pvd)"))
+        << line;
+    EXPECT_FALSE(std::filesystem::exists(Path(line.substr(line.find("-o ") + 3)))) << line;
+  }
+  // VTK takes it, and Plot3D without it is fine.
+  EXPECT_EQ(Cli("eval naca --level=0 --nocompress -o a.vts").exit_code, 0);
+  EXPECT_EQ(Cli("eval naca --level=0 --compress -o a.vtm").exit_code, 0);
+  EXPECT_EQ(Cli("eval naca --level=0 -o a.x").exit_code, 0);
+
+  // CGNS (Debian's plot3d_to_cgns): --planar (default true), --noplanar and --plot3d_layout
+  // given are refused before any upload; the same fit without them stores the grid.
+  ASSERT_NO_FATAL_FAILURE(MakeCStreamFile("-d", "ffd.x"));  // writes ffd.cgns first
+  for (const std::string flag : {"--planar", "--noplanar", "--planar=true", "--plot3d_layout=planes"}) {
+    const Result fit = Cli(absl::StrCat("fit ffd.cgns --name=ffd --tol=1e-6 ", flag));
+    EXPECT_EQ(fit.exit_code, 2) << flag << "\n" << fit.out;
+    EXPECT_THAT(fit.out, HasSubstr("is about Plot3D files; ffd.cgns is CGNS")) << flag;
+  }
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/ffd")));
+  const Result cgns = Cli("fit ffd.cgns --name=ffd --tol=1e-6");
+  EXPECT_EQ(cgns.exit_code, 0) << cgns.out;
+  // A Plot3D file keeps its flags.
+  EXPECT_EQ(Cli("fit ffd.x --name=ffd-p --tol=1e-6 --planar --plot3d_layout=whole").exit_code, 0);
+}
+
+// eval --deviation exports the source to a private mkdtemp directory under $TMPDIR and removes
+// it: nothing is left there after the run, and a TMPDIR that is no directory is a clear error.
+TEST_F(FormatsOutputTest, DeviationLeavesNoTemporaryFiles) {
+  ASSERT_NO_FATAL_FAILURE(Fit(SharedDataPath("grids/n0012_113-33.p2dfmt"), "naca", "--kinds"));
+  std::filesystem::create_directories(Path("tmp"));
+  const std::string eval = absl::StrCat(kBinary, " eval naca --level=0 --deviation --server=127.0.0.1:",
+                                        port_);
+  const Result ok = Shell(absl::StrCat("TMPDIR=", Path("tmp"), " ", eval, " -o d.vts"));
+  ASSERT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_THAT(VtkRead("d.vts"), HasSubstr("point:deviation/1/0/"));
+  EXPECT_TRUE(std::filesystem::is_empty(Path("tmp")));
+  // A failure after the export (the output directory does not exist): removed as well.
+  const Result failed = Shell(absl::StrCat("TMPDIR=", Path("tmp"), " ", eval, " -o no/such/d.vts"));
+  EXPECT_EQ(failed.exit_code, 1) << failed.out;
+  EXPECT_TRUE(std::filesystem::is_empty(Path("tmp")));
+  ASSERT_TRUE(WriteFileAtomically(Path("not-a-dir"), "x").ok());
+  const Result bad = Shell(absl::StrCat("TMPDIR=", Path("not-a-dir"), " ", eval, " -o e.vts"));
+  EXPECT_EQ(bad.exit_code, 1) << bad.out;
+  EXPECT_THAT(bad.out, HasSubstr("--deviation: "));
+  EXPECT_THAT(bad.out, HasSubstr("set TMPDIR"));
+  EXPECT_FALSE(std::filesystem::exists(Path("e.vts")));
+}
+
+// offset -o goes through eval's writers: the same extensions (.vtm and .cgns too), checked
+// before the grid is generated, and no derivative fields in a points-only file.
+TEST_F(FormatsOutputTest, OffsetWritesThroughTheEvalWriters) {
+  const std::string profile = SharedDataPath("airfoils/rae2822.dat");
+  const std::string generate = absl::StrCat(
+      "offset ", profile, " --layers=8 --first=1e-3 --far=5 --points=65 --allow_folds ");
+  const Result bad = Cli(absl::StrCat(generate, "--name=bad -o og.vtk"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_THAT(bad.out, HasSubstr("-o og.vtk: the extension must be .vts, .vtm, .x, .xyz or .cgns"));
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/bad")));
+  int n = 0;
+  for (const std::string out : {"og.vts", "og.vtm", "og.xyz", "og.cgns"}) {
+    const Result offset = Cli(absl::StrCat(generate, "--name=og", n++, " -o ", out));
+    EXPECT_EQ(offset.exit_code, 3) << out << "\n" << offset.out;  // the clamped seam folds
+    EXPECT_THAT(offset.out, HasSubstr(absl::StrCat("wrote ", out, ": 585 points (revision 1)")))
+        << out;
+  }
+  const std::string read = VtkRead("og.vts og.vtm");
+  EXPECT_THAT(read, HasSubstr("og.vts - points=585 cells=512"));
+  EXPECT_THAT(read, HasSubstr("og.vtm block_0 points=585"));
+  EXPECT_THAT(read, ::testing::Not(HasSubstr("dX_")));
+  absl::StatusOr<MultiBlockGrid> xyz = ReadPlot3dFile(Path("og.xyz"));
+  ASSERT_TRUE(xyz.ok()) << xyz.status();
+  EXPECT_EQ(xyz->blocks[0].extents(), (Extents{65, 9, 1}));
+  EXPECT_GT(std::filesystem::file_size(Path("og.cgns")), 0u);
 }
 
 }  // namespace
