@@ -185,13 +185,19 @@ std::vector<std::string> ReadmeCommandLines() {
   std::vector<std::string> lines;
   const std::regex span(R"((?:build/)?\bsplinegrid ([a-z]+)((?: [^`\n#&]*)?))");
   for (const char* file : {"/README.md", "/python/README.md", "/deploy/README.md",
-                           "/docker/README.md"}) {
+                           "/docker/README.md", "/docs/formats.md", "/docs/c-api.md",
+                           "/docs/operations.md"}) {
     std::ifstream in(std::string(SPLINEGRID_SOURCE_DIR) + file);
     std::stringstream text;
     text << in.rdbuf();
     const std::string all = text.str();
     for (std::sregex_iterator it(all.begin(), all.end(), span), end; it != end; ++it) {
       if (FindCommand((*it)[1].str()) == nullptr) continue;  // prose: "splinegrid is a ..."
+      // A terminal transcript ("$ build/splinegrid list --rotate 10") shows a refused command
+      // next to its error on purpose.
+      const size_t newline = all.rfind('\n', static_cast<size_t>(it->position(0)));
+      const size_t line_start = newline == std::string::npos ? 0 : newline + 1;
+      if (all.compare(line_start, 2, "$ ") == 0) continue;
       lines.push_back((*it)[1].str() + (*it)[2].str());
     }
   }

@@ -120,7 +120,8 @@ TEST(CliConventions, AMistypedFlagOrCommandGetsASuggestion) {
 std::vector<std::vector<std::string>> ReadmeCommandLines() {
   std::vector<std::vector<std::string>> lines;
   for (const char* file : {"/README.md", "/python/README.md", "/deploy/README.md",
-                           "/docker/README.md"}) {
+                           "/docker/README.md", "/docs/formats.md", "/docs/c-api.md",
+                           "/docs/operations.md"}) {
     for (absl::string_view line : absl::StrSplit(ReadFile(SPLINEGRID_SOURCE_DIR + std::string(file)), '\n')) {
       line = absl::StripAsciiWhitespace(line);
       if (!absl::ConsumePrefix(&line, "build/splinegrid ")) continue;
