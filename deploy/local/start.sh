@@ -57,7 +57,7 @@ show_logs=()
 [[ -n $NGINX && -x $NGINX ]] || { echo "start.sh: nginx not found (apt-get install nginx-light)" >&2; exit 2; }
 if [[ $STORE == redis ]]; then
   [[ -n $REDIS_SERVER && -x $REDIS_SERVER ]] || { echo "start.sh: redis-server not found (apt-get install redis-server)" >&2; exit 2; }
-  help=$("$SPLINEGRID" --helpfull 2>&1 || true)   # --helpfull exits 1
+  help=$("$SPLINEGRID" help serve 2>&1 || true)
   if ! grep -q -- '--store ' <<<"$help"; then
     echo "start.sh: $SPLINEGRID has no --store flag (too old a build); rebuild it, or STORE=memory to check the plumbing" >&2
     exit 2
