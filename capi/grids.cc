@@ -54,6 +54,20 @@ sg_status sg_import_plot3d(sg_client* c, const char* path, const char* grid_id, 
   });
 }
 
+sg_status sg_import_cgns(sg_client* c, const char* path, const char* grid_id, char* id,
+                         size_t id_size) {
+  if (c == nullptr) return SG_INVALID_ARGUMENT;
+  return Guard(StateOf(c), [&]() -> absl::Status {
+    SG_RETURN_IF_ERROR(RequireString(path, "path"));
+    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
+    SG_ASSIGN_OR_RETURN(const std::string bytes, splinegrid::ReadFileToString(path));
+    SG_ASSIGN_OR_RETURN(const v1::Grid grid,
+                        connected->ImportCgns(bytes, grid_id == nullptr ? "" : grid_id,
+                                              BaseName(path)));
+    return splinegrid::capi::CopyOut(client::GridId(grid.name()), id, id_size, "id");
+  });
+}
+
 sg_status sg_import_points(sg_client* c, const char* grid_id, int32_t spatial_dim,
                            const int32_t extents[3], const double* points, int64_t count, char* id,
                            size_t id_size) {

@@ -166,6 +166,12 @@ SG_API void sg_close(sg_client* client);
  * OUT_OF_RANGE naming `id` if it does not fit, the grid is still stored) unless `id` is NULL. */
 SG_API sg_status sg_import_plot3d(sg_client* client, const char* path, const char* grid_id,
                                   int32_t planar_view, char* id, size_t id_size);
+/* Imports a CGNS file (structured zones; the server decodes it in a sandboxed child process) as
+ * a new grid: its boundary conditions become the default boundary kinds of later fits.
+ * `grid_id`, `id`, `id_size` as for sg_import_plot3d. INVALID_ARGUMENT ("cgns: ...") for a file
+ * the decoder cannot read. */
+SG_API sg_status sg_import_cgns(sg_client* client, const char* path, const char* grid_id,
+                                char* id, size_t id_size);
 /* Imports one block of points as a new grid: extents[3] points per direction (1 for unused
  * ones), `spatial_dim` (2 or 3) coordinates each, `count` values in `points` (must equal
  * ni * nj * nk * spatial_dim). `grid_id`, `id`, `id_size` as for sg_import_plot3d. */

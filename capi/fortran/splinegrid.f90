@@ -69,7 +69,7 @@ module splinegrid
   end type sg_revision_info
 
   public :: sg_connect, sg_close, sg_last_error, sg_status_name, sg_version
-  public :: sg_import_plot3d, sg_import_points, sg_fit, sg_grid_info_get, sg_block_extents
+  public :: sg_import_plot3d, sg_import_cgns, sg_import_points, sg_fit, sg_grid_info_get, sg_block_extents
   public :: sg_delete, sg_deform_rigid, sg_deform_points, sg_evaluate
   public :: sg_watch_open, sg_watch_next, sg_watch_cancel, sg_watch_close
 
@@ -130,6 +130,15 @@ module splinegrid
       integer(c_size_t), value :: id_size
       integer(c_int) :: status
     end function c_sg_import_plot3d
+    function c_sg_import_cgns(client, path, grid_id, id, id_size) &
+        bind(c, name="sg_import_cgns") result(status)
+      import :: c_ptr, c_char, c_size_t, c_int
+      type(c_ptr), value :: client
+      character(kind=c_char), dimension(*), intent(in) :: path, grid_id
+      type(c_ptr), value :: id
+      integer(c_size_t), value :: id_size
+      integer(c_int) :: status
+    end function c_sg_import_cgns
     function c_sg_import_points(client, grid_id, spatial_dim, extents, points, count, id, &
         id_size) bind(c, name="sg_import_points") result(status)
       import :: c_ptr, c_char, c_int32_t, c_int64_t, c_size_t, c_int
@@ -357,6 +366,23 @@ contains
         c_loc(buffer), int(size(buffer), c_size_t))
     if (present(id)) call copy_id(buffer, id)
   end function sg_import_plot3d
+
+  ! Imports a CGNS file as a new grid (its boundary conditions become the default boundary kinds
+  ! of later fits); grid_id and id as for sg_import_plot3d.
+  integer(c_int) function sg_import_cgns(client, path, grid_id, id) result(status)
+    type(sg_client), intent(in) :: client
+    character(*), intent(in) :: path
+    character(*), intent(in), optional :: grid_id
+    character(*), intent(out), optional :: id
+    character(kind=c_char), allocatable, target :: buffer(:)
+    character(:), allocatable :: wanted
+    wanted = ""
+    if (present(grid_id)) wanted = grid_id
+    allocate(buffer(1024))
+    status = c_sg_import_cgns(client%handle, c_string(path), c_string(wanted), c_loc(buffer), &
+        int(size(buffer), c_size_t))
+    if (present(id)) call copy_id(buffer, id)
+  end function sg_import_cgns
 
   integer(c_int) function import_points(client, grid_id, spatial_dim, extents, points, count, &
       id) result(status)

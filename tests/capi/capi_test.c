@@ -297,9 +297,28 @@ static void Airfoil(sg_client* client, const char* grid_file) {
   CHECK_OK(client, sg_delete(client, "c-naca"));
 }
 
+/* A CGNS file (written by Debian's plot3d_to_cgns): imported, fitted by its kinds; a Plot3D file
+ * given as CGNS is the decoder's INVALID_ARGUMENT. */
+static void Cgns(sg_client* client, const char* cgns_file, const char* plot3d_file) {
+  CHECK(sg_import_cgns(NULL, cgns_file, "c-cgns", NULL, 0) == SG_INVALID_ARGUMENT);
+  CHECK_ERROR(client, sg_import_cgns(client, NULL, "c-cgns", NULL, 0), SG_INVALID_ARGUMENT,
+              "path: NULL");
+  CHECK_ERROR(client, sg_import_cgns(client, "/nonexistent/grid.cgns", "c-cgns", NULL, 0),
+              SG_NOT_FOUND, "/nonexistent/grid.cgns");
+  CHECK_ERROR(client, sg_import_cgns(client, plot3d_file, "c-cgns", NULL, 0),
+              SG_INVALID_ARGUMENT, "cgns");
+  char id[64];
+  CHECK_OK(client, sg_import_cgns(client, cgns_file, "c-cgns", id, sizeof id));
+  CHECK(strcmp(id, "c-cgns") == 0);
+  sg_fit_result fit;
+  CHECK_OK(client, sg_fit(client, "c-cgns", 1e-3, &fit));
+  CHECK(fit.revision == 1);
+  CHECK_OK(client, sg_delete(client, "c-cgns"));
+}
+
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    fprintf(stderr, "usage: capi_test HOST:PORT CLOSED_HOST:PORT GRID_FILE\n");
+  if (argc != 5) {
+    fprintf(stderr, "usage: capi_test HOST:PORT CLOSED_HOST:PORT GRID_FILE CGNS_FILE\n");
     return 2;
   }
   CHECK(strcmp(sg_version(), SPLINEGRID_EXPECTED_VERSION) == 0);
@@ -313,6 +332,7 @@ int main(int argc, char** argv) {
   if (failures == 0) {
     Points(client);
     Airfoil(client, argv[3]);
+    Cgns(client, argv[4], argv[3]);
 
     /* A truncated copy of a message still reports the full length. */
     CHECK(sg_fit(client, "nothing", 1e-3, NULL) == SG_NOT_FOUND);
