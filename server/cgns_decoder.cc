@@ -6,6 +6,7 @@
 #include <spawn.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -74,12 +75,26 @@ class TempUpload {
 // The limits, set by the shell the child starts as (posix_spawn cannot set them), before it
 // execs the decoder: "$0" is the decoder, "$1" the upload, so neither path is parsed by the
 // shell. dash's ulimit: -v KiB of address space, -t CPU seconds (hard first, then the soft
-// limit below it: SIGXCPU at the soft limit, SIGKILL 5 s later), -c core size. A failed ulimit
-// is exit 126, as a failed exec is 126/127.
+// limit below it: SIGXCPU at the soft limit, SIGKILL 5 s later), -c core size. The limits are
+// at most the server's own hard limits (systemd LimitAS=/LimitCPU=, a container's --ulimit),
+// which an unprivileged process cannot raise. A failed ulimit is exit kLimitsFailed, apart from
+// a failed exec's 126/127.
+constexpr int kLimitsFailed = 125;
+
+// `wanted`, or the server's hard limit of `resource` when that is lower.
+int64_t WithinHardLimit(int resource, int64_t wanted) {
+  rlimit limit;
+  if (getrlimit(resource, &limit) != 0 || limit.rlim_max == RLIM_INFINITY) return wanted;
+  return std::min<int64_t>(wanted, static_cast<int64_t>(limit.rlim_max));
+}
+
 std::string LimitScript(int64_t memory_bytes, int64_t cpu_seconds) {
-  return absl::StrCat("ulimit -v ", memory_bytes >> 10, " && ulimit -t ", cpu_seconds + 5,
-                      " && ulimit -S -t ", cpu_seconds,
-                      " && ulimit -c 0 || exit 126; exec \"$0\" \"$1\"");
+  const int64_t memory_kib = WithinHardLimit(RLIMIT_AS, memory_bytes) >> 10;
+  const int64_t cpu_hard = WithinHardLimit(RLIMIT_CPU, cpu_seconds + 5);
+  const int64_t cpu_soft = std::min(cpu_seconds, cpu_hard);
+  return absl::StrCat("ulimit -v ", memory_kib, " && ulimit -t ", cpu_hard, " && ulimit -S -t ",
+                      cpu_soft, " && ulimit -c 0 || exit ", kLimitsFailed,
+                      "; exec \"$0\" \"$1\"");
 }
 
 // posix_spawn attributes and file actions, destroyed on scope exit.
@@ -111,9 +126,11 @@ class SpawnSetup {
     if (error == 0) error = posix_spawnattr_setpgroup(&attr_, 0);
     if (error == 0) error = posix_spawnattr_setsigdefault(&attr_, &all);
     if (error == 0) error = posix_spawnattr_setsigmask(&attr_, &none);
+    // The pipe goes to 1 first: were its write end descriptor 0 or 2, opening /dev/null there
+    // first would replace it.
+    if (error == 0) error = posix_spawn_file_actions_adddup2(&actions_, out_fd, 1);
     if (error == 0)
       error = posix_spawn_file_actions_addopen(&actions_, 0, "/dev/null", O_RDONLY, 0);
-    if (error == 0) error = posix_spawn_file_actions_adddup2(&actions_, out_fd, 1);
     if (error == 0)
       error = posix_spawn_file_actions_addopen(&actions_, 2, "/dev/null", O_WRONLY, 0);
     if (error == 0) error = CloseTheRest();
@@ -281,13 +298,18 @@ absl::StatusOr<ImportedGrid> Judge(int status, std::string output, const std::st
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 2) {
     // The decoder's message names the temporary file: never shown to the client. Replaced in
-    // a prefix long enough that a name across the cut is replaced whole, then quoted (escaped
-    // and cut at kMaxMessage characters, the original length noted).
-    const std::string message = absl::StrReplaceAll(
-        absl::string_view(output).substr(0, kMaxMessage + upload.size()), {{upload, "the upload"}});
-    return absl::InvalidArgumentError(absl::StrCat(
-        "cgns: ", QuoteClientString(message, kMaxMessage),
-        output.size() > message.size() ? absl::StrCat(" (", output.size(), " bytes in all)") : ""));
+    // the whole output (already charged to the budget), so no cut can leave a part of the name,
+    // then quoted (escaped, and cut at kMaxMessage characters with the length noted).
+    const std::string message = absl::StrReplaceAll(output, {{upload, "the upload"}});
+    return absl::InvalidArgumentError(
+        absl::StrCat("cgns: ", QuoteClientString(message, kMaxMessage)));
+  }
+  if (code == kLimitsFailed) {
+    return absl::InternalError(absl::StrCat(
+        "CGNS import: the decoder's resource limits could not be set (memory ", memory_bytes >> 20,
+        " MiB, CPU ", absl::FormatDuration(options.cpu_limit),
+        "): check the server's own limits (ulimit -a) against serve --cgns_decoder_memory_mb "
+        "and --cgns_decoder_cpu_seconds"));
   }
   if (code != 0) {
     return absl::InternalError(absl::StrCat("CGNS import: the decoder ", executable,
@@ -365,6 +387,7 @@ absl::StatusOr<ImportedGrid> DecodeCgnsUpload(const std::string& bytes,
                                   reservation, &output, &read_status);
   close(child.out_fd);
   SG_ASSIGN_OR_RETURN(const int status, KillAndReap(child.pid));
+  child_memory = MemoryReservation();  // the child is gone: its allowance goes back now
   switch (stop) {
     case Stop::kReadError:
       return read_status;

@@ -1,6 +1,7 @@
 // WriteCgnsFile: one base, a structured zone per block, BCs with families, 1-to-1 connections.
 #include <cgnslib.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -8,10 +9,12 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <set>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/file_util.h"
 #include "core/util/status_macros.h"
 #include "io/cgns/cgns_file.h"
 #include "io/cgns/cgns_io.h"
@@ -281,9 +284,8 @@ absl::StatusOr<std::string> ClaimTempPath(const std::string& path) {
       return temp;
     }
     if (errno != EEXIST) {
-      return absl::PermissionDeniedError(
-          absl::StrCat("creating ", temp, " (written, then renamed to ", path, "): ",
-                       strerror(errno)));
+      return ErrnoToStatusWithMessage(
+          errno, absl::StrCat("creating ", temp, " (written, then renamed to ", path, ")"));
     }
   }
   return absl::AlreadyExistsError(absl::StrCat("no free temporary name beside ", path));
@@ -303,7 +305,17 @@ absl::Status WriteCgnsFile(const std::string& path, const MultiBlockGrid& grid,
   }
   // Written to a fresh file beside `path` and renamed over it only once cg_close succeeded, so
   // that a failed write leaves an existing file as it was (rename within a directory is atomic).
-  SG_ASSIGN_OR_RETURN(const std::string temp, ClaimTempPath(path));
+  // A symbolic link is followed (the file it names is replaced, beside itself), and an existing
+  // file keeps its permission bits. (A file with several hard links is replaced by a new one.)
+  std::string target = path;
+  std::error_code link_error;
+  if (std::filesystem::is_symlink(path, link_error)) {
+    const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, link_error);
+    if (!link_error) target = resolved.string();
+  }
+  struct stat existing;
+  const bool exists = stat(target.c_str(), &existing) == 0;
+  SG_ASSIGN_OR_RETURN(const std::string temp, ClaimTempPath(target));
   absl::Status status;
   {
     absl::StatusOr<CgnsFile> file = CgnsFile::Open(temp, CG_MODE_WRITE);
@@ -315,9 +327,11 @@ absl::Status WriteCgnsFile(const std::string& path, const MultiBlockGrid& grid,
     status = writer.Write();
     if (absl::Status closed = file->Close(); status.ok()) status = closed;
   }
-  if (status.ok() && rename(temp.c_str(), path.c_str()) != 0) {
-    status = absl::PermissionDeniedError(
-        absl::StrCat("renaming ", temp, " to ", path, ": ", strerror(errno)));
+  if (status.ok() && exists && chmod(temp.c_str(), existing.st_mode & 07777) != 0) {
+    status = ErrnoToStatusWithMessage(errno, absl::StrCat("keeping the mode of ", target));
+  }
+  if (status.ok() && rename(temp.c_str(), target.c_str()) != 0) {
+    status = ErrnoToStatusWithMessage(errno, absl::StrCat("renaming ", temp, " to ", target));
   }
   if (!status.ok()) unlink(temp.c_str());  // no partial file left behind
   return status;

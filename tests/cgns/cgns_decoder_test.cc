@@ -48,6 +48,10 @@ case $(cat "$D/mode") in
   long) i=0
         while [ $i -lt 100 ]; do printf '%s: bad node %s in zone %s. ' "$1" $i $i; i=$((i+1)); done
         exit 2 ;;
+  packed) printf 'xxxxxxxxxxxxxx'
+        i=0
+        while [ $i -lt 80 ]; do printf '%s' "$1"; i=$((i+1)); done
+        exit 2 ;;
 esac
 exit 3
 )";
@@ -194,11 +198,21 @@ TEST(CgnsDecoderTest, ALongMessageIsCutAndDoesNotNameTheTemporaryFile) {
   const std::string message(imported.status().message());
   EXPECT_THAT(message, HasSubstr("cgns: "));
   EXPECT_THAT(message, HasSubstr("the upload: bad node 0 in zone 0."));
-  EXPECT_THAT(message, HasSubstr("bytes in all)"));  // cut, with the length noted
+  EXPECT_THAT(message, HasSubstr(" bytes)"));  // cut, with the length noted
   EXPECT_LT(message.size(), 2100u);
   ASSERT_FALSE(server.upload().empty());
   EXPECT_THAT(message, Not(HasSubstr(server.upload())));
   EXPECT_THAT(message, Not(HasSubstr("splinegrid-cgns-")));  // not even a part of its name
+  server.ExpectCleanedUp();
+
+  // The name back to back past the cut: replacing shortens the text, which must not pull a
+  // part of a later name under the cut (the review's case: 14 characters, then the name 80 times).
+  server.Mode("packed");
+  imported = server.Import();
+  EXPECT_EQ(imported.status().code(), absl::StatusCode::kInvalidArgument) << imported.status();
+  EXPECT_THAT(imported.status().message(), HasSubstr("the uploadthe upload"));
+  EXPECT_THAT(imported.status().message(), Not(HasSubstr("splinegrid-cgns-")));
+  EXPECT_THAT(imported.status().message(), Not(HasSubstr("/tmp/")));
   server.ExpectCleanedUp();
 }
 

@@ -246,6 +246,32 @@ TEST(CgnsWriterTest, AFailedWriteLeavesAnExistingFileAsItWasAndNoTemporaryFile) 
   EXPECT_EQ(back->grid.blocks.size(), 1u);
 }
 
+// Writing through a symbolic link replaces the file it names (the link stays) and an existing
+// file keeps its permission bits.
+TEST(CgnsWriterTest, AWriteThroughALinkReplacesItsTargetAndKeepsTheMode) {
+  TempDir dir("cgns-io");
+  const MultiBlockGrid grid = testing::TwoBoxes();
+  CgnsWriteOptions options;
+  options.source_extents = {grid.blocks[0].extents(), grid.blocks[1].extents()};
+  std::filesystem::create_directories(dir.File("real"));
+  const std::string target = dir.File("real/grid.cgns");
+  ASSERT_TRUE(WriteCgnsFile(target, grid, options, nullptr).ok());
+  std::filesystem::permissions(target, std::filesystem::perms::owner_read |
+                                           std::filesystem::perms::owner_write);
+  const std::string link = dir.File("link.cgns");
+  std::filesystem::create_symlink(target, link);
+  MultiBlockGrid one;
+  one.blocks.push_back(grid.blocks[0]);
+  options.source_extents = {grid.blocks[0].extents()};
+  ASSERT_TRUE(WriteCgnsFile(link, one, options, nullptr).ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  absl::StatusOr<ImportedGrid> back = ReadCgnsFile(target);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->grid.blocks.size(), 1u);
+  EXPECT_EQ(std::filesystem::status(target).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+}
+
 // A base with one zone written by the mid-level library itself, for what the reader refuses.
 void WriteOneZone(const std::string& path, bool unstructured, bool rind) {
   int fn = 0, base = 0, zone = 0, coord = 0;
