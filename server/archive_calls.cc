@@ -1,17 +1,17 @@
 // ExportGrid and ImportArchive: a grid with its source points and revisions as archive records
 // (store/grid_archive.h), so a user can move grids between servers and keep them with a case.
 #include <deque>
-#include <mutex>
 #include <optional>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
-#include "server/idle_watchdog.h"
 #include "server/service.h"
 #include "server/store/grid_archive.h"
+#include "server/upload_reactor.h"
 
 namespace splinegrid::server {
 namespace {
@@ -119,79 +119,16 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
 // Assembles the records as they arrive (memory charged as data comes, not as the header
 // announces), then stores the grid on the pool: nothing is stored unless the whole archive
 // arrived and checks out.
-class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>> {
+class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
  public:
   ImportArchiveReactor(ServiceState* state, grpc::CallbackServerContext* context,
                        v1::Grid* response)
-      : state_(state),
-        context_(context),
-        response_(response),
-        log_("ImportArchive", "", state->options) {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
-    if (!caller.ok()) {
-      End(caller.status());
-      return;
-    }
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) {
-      End(slot.status());
-      return;
-    }
-    stream_ = *std::move(slot);
-    idle_.Start(state_->options.import_idle_timeout, [this] { OnIdle(); });
-    SG_HAPPENS_BEFORE(this);
-    StartRead(&message_);
-  }
-
-  void OnReadDone(bool ok) override {
-    SG_HAPPENS_AFTER(this);
-    if (!ok) {  // the client closed its side: everything has arrived
-      idle_.Stop();  // from here on the call is the pool's
-      if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
-      // Reads also end when the client cancels or the shutdown's grace runs out: then nothing
-      // is stored and the status says why.
-      if (context_->IsCancelled()) {
-        End(WhyCallEnded(*state_, context_));
-        return;
-      }
-      if (absl::Status status =
-              state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
-          !status.ok()) {
-        End(status);
-      }
-      return;
-    }
-    idle_.Touch();
-    std::lock_guard<std::mutex> lock(mu_);
-    if (ended_) return;  // the idle timeout ended the call meanwhile
-    if (absl::Status status = Accept(); !status.ok()) {
-      ended_ = true;
-      End(status);
-      return;
-    }
-    SG_HAPPENS_BEFORE(this);
-    StartRead(&message_);
-  }
-
-  void OnDone() override {
-    SG_HAPPENS_AFTER(this);
-    idle_.Stop();
-    delete this;
+      : UploadReactor(state, context, "ImportArchive"), response_(response) {
+    Start();
   }
 
  private:
-  // On the watchdog's thread: nothing arrived for import_idle_timeout (a read is pending).
-  void OnIdle() {
-    std::lock_guard<std::mutex> lock(mu_);
-    if (ended_) return;
-    ended_ = true;
-    End(IdleTimeoutError("ImportArchive", state_->options.import_idle_timeout));
-  }
-
-  absl::Status Accept() {
-    if (!message_.status.ok()) return message_.status;
-    const v1::ImportArchiveRequest& message = message_.message;
+  absl::Status Accept(const v1::ImportArchiveRequest& message) override {
     if (!assembler_) {
       const std::string& id = message.grid_id();
       if (!id.empty() && !IsValidGridId(id)) {
@@ -211,41 +148,21 @@ class ImportArchiveReactor : public grpc::ServerReadReactor<Decoded<v1::ImportAr
     return absl::OkStatus();
   }
 
-  void Complete() {
-    SG_HAPPENS_AFTER(this);
-    const absl::Status status = [&]() -> absl::Status {
-      if (!assembler_) return absl::InvalidArgumentError("the archive is empty: no records came");
-      SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
-                          assembler_->Finish(/*check_counts=*/true));
-      grid->owner = caller_.owner();  // the importer's, not the exporter's
-      log_.set_grid(absl::StrCat("grids/", grid->id));
-      SG_RETURN_IF_ERROR(state_->store->Create(grid));
-      return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
-    }();
-    assembler_.reset();
-    End(status);
+  absl::Status Complete() override {
+    if (!assembler_) return absl::InvalidArgumentError("the archive is empty: no records came");
+    // The assembled records are released before the call ends, stored or not.
+    absl::Cleanup release = [this] { assembler_.reset(); };
+    SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
+                        assembler_->Finish(/*check_counts=*/true));
+    grid->owner = caller_.owner();  // the importer's, not the exporter's
+    log_.set_grid(absl::StrCat("grids/", grid->id));
+    SG_RETURN_IF_ERROR(state_->store->Create(grid));
+    return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }
 
-  void End(const absl::Status& status) {
-    stream_.Release();  // the call is over for its principal once its status goes out
-    log_.Finish(status);
-    SG_HAPPENS_BEFORE(this);
-    Finish(ToGrpcStatus(status));
-  }
-
-  ServiceState* state_;
-  grpc::CallbackServerContext* context_;
   v1::Grid* response_;
-  CallLog log_;
-  Caller caller_;
-  // This call's place among its principal's open streams.
-  StreamSlot stream_;
-  Decoded<v1::ImportArchiveRequest> message_;
   std::optional<GridAssembler> assembler_;
   int64_t records_ = 0;
-  IdleWatch idle_;      // ends the call when nothing arrives for import_idle_timeout
-  std::mutex mu_;       // orders the reads' Finish/StartRead against the idle watch's Finish
-  bool ended_ = false;  // guarded by mu_: Finish was called from OnReadDone or OnIdle
 };
 
 }  // namespace

@@ -4,7 +4,6 @@
 // Memory is allocated and charged to the budget as data arrive, never from the header's
 // announced sizes; a stream that sends nothing for --import_idle_timeout is ended.
 #include <algorithm>
-#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -18,90 +17,20 @@
 #include "proto/convert/plot3d_format_convert.h"
 #include "server/cgns_decoder.h"
 #include "server/grid_encoding.h"
-#include "server/happens_before.h"
-#include "server/idle_watchdog.h"
 #include "server/service.h"
+#include "server/upload_reactor.h"
 
 namespace splinegrid::server {
 namespace {
 
-class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridRequest>> {
+class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
  public:
   ImportReactor(ServiceState* state, grpc::CallbackServerContext* context, v1::Grid* response)
-      : state_(state),
-        context_(context),
-        response_(response),
-        log_("ImportGrid", "", state->options) {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kWrite, &log_);
-    if (!caller.ok()) {
-      Fail(caller.status());
-      return;
-    }
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) {
-      Fail(slot.status());
-      return;
-    }
-    stream_ = *std::move(slot);
-    idle_.Start(state_->options.import_idle_timeout, [this] { OnIdle(); });
-    SG_HAPPENS_BEFORE(this);
-    StartRead(&message_);
-  }
-
-  void OnReadDone(bool ok) override {
-    SG_HAPPENS_AFTER(this);
-    if (!ok) {  // the client closed its side: everything has arrived
-      idle_.Stop();  // from here on the call is the pool's
-      if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
-      // Reads also end when the client cancels or the shutdown's grace runs out: then nothing
-      // is stored and the status says why.
-      if (context_->IsCancelled()) {
-        Fail(WhyCallEnded(*state_, context_));
-        return;
-      }
-      if (absl::Status status =
-              state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Complete(); });
-          !status.ok()) {
-        Fail(status);
-      }
-      return;
-    }
-    idle_.Touch();
-    std::lock_guard<std::mutex> lock(mu_);
-    if (ended_) return;  // the idle timeout ended the call meanwhile
-    if (absl::Status status = message_.status.ok() ? Accept(message_.message) : message_.status;
-        !status.ok()) {
-      ended_ = true;
-      Fail(status);
-      return;
-    }
-    SG_HAPPENS_BEFORE(this);
-    StartRead(&message_);
-  }
-
-  void OnDone() override {
-    SG_HAPPENS_AFTER(this);
-    idle_.Stop();
-    delete this;
+      : UploadReactor(state, context, "ImportGrid"), response_(response) {
+    Start();
   }
 
  private:
-  void Fail(const absl::Status& status) {
-    stream_.Release();  // the call is over for its principal once its status goes out
-    log_.Finish(status);
-    SG_HAPPENS_BEFORE(this);
-    Finish(ToGrpcStatus(status));
-  }
-
-  // On the watchdog's thread: nothing arrived for import_idle_timeout (a read is pending).
-  void OnIdle() {
-    std::lock_guard<std::mutex> lock(mu_);
-    if (ended_) return;
-    ended_ = true;
-    Fail(IdleTimeoutError("ImportGrid", state_->options.import_idle_timeout));
-  }
-
   // Makes room for `more` elements in `into` (growing by doubling, capped at `limit` elements:
   // at most twice what arrived, never more than announced), charging the growth first. While
   // the elements move both buffers exist, so both are charged until the old one is freed.
@@ -122,7 +51,7 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
                                  what);  // a release
   }
 
-  absl::Status Accept(const v1::ImportGridRequest& message) {
+  absl::Status Accept(const v1::ImportGridRequest& message) override {
     if (!have_header_) {
       if (message.part_case() != v1::ImportGridRequest::kHeader) {
         return absl::InvalidArgumentError("the first message of ImportGrid must be the header");
@@ -191,7 +120,7 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     }
     coords_.resize(extents_.size());  // empty: they grow as points arrive (AcceptPoints)
     header_.mutable_points()->clear_blocks();  // kept in extents_
-    message_.message = v1::ImportGridRequest();  // drops the header's capacity
+    ReleaseMessage();  // drops the header's capacity
     return absl::OkStatus();
   }
 
@@ -343,22 +272,9 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }
 
-  void Complete() {
-    const absl::Status status = Store();
-    stream_.Release();  // the call is over for its principal once its status goes out
-    log_.Finish(status);
-    SG_HAPPENS_BEFORE(this);
-    Finish(ToGrpcStatus(status));
-  }
+  absl::Status Complete() override { return Store(); }
 
-  ServiceState* state_;
-  grpc::CallbackServerContext* context_;
   v1::Grid* response_;
-  CallLog log_;
-  Caller caller_;
-  // This call's place among its principal's open streams.
-  StreamSlot stream_;
-  Decoded<v1::ImportGridRequest> message_;
   bool have_header_ = false;
   v1::ImportHeader header_;
   MemoryReservation upload_;       // what arrived (capacity), charged as it grows
@@ -368,9 +284,6 @@ class ImportReactor : public grpc::ServerReadReactor<Decoded<v1::ImportGridReque
   std::vector<Extents> extents_;              // points source: the header's blocks
   std::vector<std::vector<double>> coords_;   // and their coordinates so far
   std::vector<StatedConnection> connections_;  // CGNS source: the file's 1-to-1 connections
-  IdleWatch idle_;  // ends the call when nothing arrives for import_idle_timeout
-  std::mutex mu_;   // orders the reads' Finish/StartRead against the idle watch's Finish
-  bool ended_ = false;  // guarded by mu_: Finish was called from OnReadDone or OnIdle
 };
 
 }  // namespace
