@@ -189,7 +189,10 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const
     }
   }
   std::sort(files.begin(), files.end());
-  for (const auto& [number, path] : files) {
+  for (const auto& file : files) {
+    // Named, not a structured binding: clang 14 (.ci/tsan, .ci/fuzz) cannot capture those.
+    const int64_t number = file.first;
+    const fs::path& path = file.second;
     absl::Status loaded = [&]() -> absl::Status {
       SG_ASSIGN_OR_RETURN(RecordReader reader, RecordReader::Open(path.string()));
       std::string payload;

@@ -33,8 +33,10 @@ class Gate {
  public:
   std::function<void()> Task() {
     return [this] {
+      // The future first: once started_ is set the test may open the gate and destroy it.
+      std::future<void> opened = opened_.get_future();
       started_.set_value();
-      opened_.get_future().wait();
+      opened.wait();
     };
   }
   void WaitStarted() { started_.get_future().wait(); }
