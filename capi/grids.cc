@@ -1,6 +1,7 @@
 // splinegrid.h: importing, fitting, describing and deleting grids.
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -38,34 +39,46 @@ std::string BaseName(const std::string& path) {
 
 }  // namespace
 
-extern "C" {
+namespace {
 
-sg_status sg_import_plot3d(sg_client* c, const char* path, const char* grid_id, int32_t planar_view,
-                           char* id, size_t id_size) {
+// The body of the file imports: reads `path` and uploads it with `upload` (the client, the
+// file's bytes, the wanted id), then copies the new grid's id out.
+sg_status ImportFile(
+    sg_client* c, const char* path, const char* grid_id, char* id, size_t id_size,
+    const std::function<absl::StatusOr<v1::Grid>(client::Client&, const std::string&,
+                                                 const std::string&)>& upload) {
   if (c == nullptr) return SG_INVALID_ARGUMENT;
   return Guard(StateOf(c), [&]() -> absl::Status {
     SG_RETURN_IF_ERROR(RequireString(path, "path"));
     SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
     SG_ASSIGN_OR_RETURN(const std::string bytes, splinegrid::ReadFileToString(path));
     SG_ASSIGN_OR_RETURN(const v1::Grid grid,
-                        connected->ImportPlot3d(bytes, grid_id == nullptr ? "" : grid_id,
-                                                BaseName(path), planar_view != 0));
+                        upload(*connected, bytes, grid_id == nullptr ? "" : grid_id));
     return splinegrid::capi::CopyOut(client::GridId(grid.name()), id, id_size, "id");
   });
 }
 
+}  // namespace
+
+extern "C" {
+
+sg_status sg_import_plot3d(sg_client* c, const char* path, const char* grid_id, int32_t planar_view,
+                           char* id, size_t id_size) {
+  return ImportFile(c, path, grid_id, id, id_size,
+                    [&](client::Client& connected, const std::string& bytes,
+                        const std::string& wanted) {
+                      return connected.ImportPlot3d(bytes, wanted, BaseName(path),
+                                                    planar_view != 0);
+                    });
+}
+
 sg_status sg_import_cgns(sg_client* c, const char* path, const char* grid_id, char* id,
                          size_t id_size) {
-  if (c == nullptr) return SG_INVALID_ARGUMENT;
-  return Guard(StateOf(c), [&]() -> absl::Status {
-    SG_RETURN_IF_ERROR(RequireString(path, "path"));
-    SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
-    SG_ASSIGN_OR_RETURN(const std::string bytes, splinegrid::ReadFileToString(path));
-    SG_ASSIGN_OR_RETURN(const v1::Grid grid,
-                        connected->ImportCgns(bytes, grid_id == nullptr ? "" : grid_id,
-                                              BaseName(path)));
-    return splinegrid::capi::CopyOut(client::GridId(grid.name()), id, id_size, "id");
-  });
+  return ImportFile(c, path, grid_id, id, id_size,
+                    [&](client::Client& connected, const std::string& bytes,
+                        const std::string& wanted) {
+                      return connected.ImportCgns(bytes, wanted, BaseName(path));
+                    });
 }
 
 sg_status sg_import_points(sg_client* c, const char* grid_id, int32_t spatial_dim,
