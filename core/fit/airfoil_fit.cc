@@ -37,6 +37,10 @@ constexpr int kScreenCorrections = 3;
 constexpr double kScreenMargin = 1.5;
 // Removal passes over the knots (each pass tries every knot once).
 constexpr int kRemovalPasses = 3;
+// A merge of neighbouring knots a < b tries one knot at a + w (b - a) for these w, in order.
+// Measured on dense_profile_test's 12 fits: the midpoint alone saved 0-2 controls per fit, the
+// thirds 0-1 more (the 30P30N main element at 2e-4 chord: 23, 22, 21), for ~40% more time.
+constexpr double kMergePositions[] = {0.5, 1.0 / 3.0, 2.0 / 3.0};
 // Fairing search: lambda = weight 10^-e for e = 0 .. kFairingDecades, then bisections of the
 // last decade on a log scale (a factor 10^(1/16) = 1.15), as the adaptive engine does.
 constexpr int kFairingDecades = 14;
@@ -259,7 +263,8 @@ struct Placement {
 
 // Steps 3 and 4 from the knots `interior` and parameters `params`: insertion until every
 // distance is within `target` and the curve has no cusp (`cusp` gives the parameter of one),
-// at most `cap` controls; then removal. Knot vectors are screened (kScreenCorrections).
+// at most `cap` controls; then removal and merges. Knot vectors are screened
+// (kScreenCorrections).
 absl::StatusOr<Placement> PlaceKnots(
     ProfileFitter& fitter, std::vector<double> interior, const std::vector<double>& params,
     double target, int cap, bool remove,
@@ -299,29 +304,55 @@ absl::StatusOr<Placement> PlaceKnots(
     ++out.inserted;
     SG_ASSIGN_OR_RETURN(out.fitted, screen(out.interior, out.fitted.params));
   }
+  // Removal and merges keep a trial knot vector when its fit meets the target without a cusp.
+  auto simple = [](const std::vector<double>& knots, double t) {
+    return std::count(knots.begin(), knots.end(), t) == 1;
+  };
+  auto keep_if_met = [&](std::vector<double> trial) -> absl::StatusOr<bool> {
+    if (!fitter.WellPosed(trial, out.fitted.params)) return false;
+    absl::StatusOr<Fitted> fit = screen(trial, out.fitted.params);
+    if (fit.status().code() == absl::StatusCode::kCancelled) return fit.status();
+    if (!fit.ok() || !(fit->max() <= target) || cusp(*fit)) return false;
+    out.interior = std::move(trial);
+    out.fitted = *std::move(fit);
+    return true;
+  };
   for (int pass = 0; remove && out.stop.empty() && pass < kRemovalPasses; ++pass) {
     // Candidates: the simple knots, smallest third-derivative jump |J_q| first.
     const std::vector<double> jump = JumpMagnitudes(out.fitted.curve);
     std::vector<std::pair<double, double>> candidates;  // (|J_q|, knot)
     for (size_t q = 0, i = 0; i < out.interior.size(); ++i) {
-      if (std::count(out.interior.begin(), out.interior.end(), out.interior[i]) > 1) continue;
-      candidates.push_back({jump[q++], out.interior[i]});
+      if (simple(out.interior, out.interior[i])) candidates.push_back({jump[q++], out.interior[i]});
     }
     std::sort(candidates.begin(), candidates.end());
     int removed = 0;
     for (const auto& [jump, knot] : candidates) {
       std::vector<double> trial = out.interior;
       trial.erase(std::find(trial.begin(), trial.end(), knot));
-      if (!fitter.WellPosed(trial, out.fitted.params)) continue;
-      absl::StatusOr<Fitted> fit = screen(trial, out.fitted.params);
-      if (fit.status().code() == absl::StatusCode::kCancelled) return fit.status();
-      if (!fit.ok() || !(fit->max() <= target) || cusp(*fit)) continue;
-      out.interior = std::move(trial);
-      out.fitted = *std::move(fit);
-      ++removed;
+      SG_ASSIGN_OR_RETURN(const bool kept, keep_if_met(std::move(trial)));
+      removed += kept;
     }
     out.removed += removed;
     if (removed == 0) break;
+  }
+  // Merges: two neighbouring simple knots replaced by one between them (kMergePositions), until
+  // a sweep keeps none.
+  for (bool merged = remove && out.stop.empty(); merged;) {
+    merged = false;
+    for (size_t i = 0; i + 1 < out.interior.size(); ++i) {
+      const double a = out.interior[i], b = out.interior[i + 1];
+      if (!simple(out.interior, a) || !simple(out.interior, b)) continue;
+      for (double w : kMergePositions) {
+        std::vector<double> trial = out.interior;
+        trial.erase(trial.begin() + i, trial.begin() + i + 2);
+        trial.insert(trial.begin() + i, a + w * (b - a));
+        SG_ASSIGN_OR_RETURN(const bool kept, keep_if_met(std::move(trial)));
+        if (kept) {
+          ++out.removed, merged = true;
+          break;
+        }
+      }
+    }
   }
   return out;
 }

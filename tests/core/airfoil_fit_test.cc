@@ -266,9 +266,13 @@ TEST(AirfoilFitTest, FairingKeepsToleranceAndDoesNotRoughen) {
       EXPECT_LE(fit->curvature.spurious(), fit->unfaired_curvature.spurious()) << what;
     }
   }
-  // With room left by the knots, fairing acts: NACA 0012 (measured lambda 2.7e-4).
+  // With room left by the knots, fairing acts: NACA 0012 with the knots of insertion alone
+  // (with removal and merges its 11 controls are fairer unfaired than the 14 of insertion faired:
+  // sum of squared curvature differences 566 against 570, and no lambda lowers it further).
+  // Measured lambda 2.7e-4.
   AirfoilFitOptions options;
   options.fairing_headroom = 0.7;
+  options.remove_knots = false;
   absl::StatusOr<AirfoilFit> faired = FitAirfoil(Shared("naca0012"), options);
   ASSERT_TRUE(faired.ok()) << faired.status();
   EXPECT_GT(faired->fairing_weight, 1e-5);

@@ -2,12 +2,14 @@
 // (the real tool), constructed variants of every byte order, precision, iblank, block count,
 // dimension and layout, Fortran planes records, and malformed streams.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <system_error>
 #include <limits>
 #include <string>
 #include <vector>
@@ -240,7 +242,11 @@ class CgnsToPlot3dTest : public testing::Test {
       GTEST_FAIL() << "cgns_to_plot3d / plot3d_to_cgns missing: install cgns-convert "
                       "(.ci/setup)";
     }
-    dir_ = std::filesystem::path(testing::TempDir()) / "plot3d_stream_test";
+    // A directory of its own: ctest runs the tests of this fixture as parallel processes.
+    dir_ = std::filesystem::path(testing::TempDir()) /
+           absl::StrCat("plot3d_stream_test_",
+                        testing::UnitTest::GetInstance()->current_test_info()->name(), "_",
+                        getpid());
     std::filesystem::create_directories(dir_);
     source_ = SharedDataPath("surfaces/ffd_box_6x2x6.fmt");
     absl::StatusOr<MultiBlockGrid> grid = ReadPlot3dFile(source_);
@@ -249,6 +255,11 @@ class CgnsToPlot3dTest : public testing::Test {
     cgns_ = (dir_ / "ffd.cgns").string();
     ASSERT_EQ(RunShell(absl::StrCat("plot3d_to_cgns -f -d ", source_, " ", cgns_, " >/dev/null")),
               0);
+  }
+
+  void TearDown() override {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
   }
 
   // cgns_to_plot3d `options` of the CGNS file; the Plot3D file's path.
