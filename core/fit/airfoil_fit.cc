@@ -41,6 +41,10 @@ constexpr int kRemovalPasses = 3;
 // Measured on dense_profile_test's 12 fits: the midpoint alone saved 0-2 controls per fit, the
 // thirds 0-1 more (the 30P30N main element at 2e-4 chord: 23, 22, 21), for ~40% more time.
 constexpr double kMergePositions[] = {0.5, 1.0 / 3.0, 2.0 / 3.0};
+// Coarse to fine (CoarseStart): outlines of at least kCoarseStride * kCoarsePoints points place
+// their knots on every kCoarseStride-th point first.
+constexpr int kCoarseStride = 4;
+constexpr int kCoarsePoints = 500;
 // Fairing search: lambda = weight 10^-e for e = 0 .. kFairingDecades, then bisections of the
 // last decade on a log scale (a factor 10^(1/16) = 1.15), as the adaptive engine does.
 constexpr int kFairingDecades = 14;
@@ -357,6 +361,100 @@ absl::StatusOr<Placement> PlaceKnots(
   return out;
 }
 
+// Where knot placement starts: interior knots and a parameter per data point, and what the
+// coarser placements that led there did.
+struct Start {
+  std::vector<double> interior;
+  std::vector<double> params;
+  int inserted = 0;
+  int removed = 0;
+  int fits = 0;  // least-squares solves
+};
+
+// PlaceKnots from `start`; when that runs out of splits or controls, again from `scratch` with
+// parameter correction restricted to regular feet. When Hoschek's correction crowded the feet of
+// a dense outline into a bend of an early, too coarse fit (profile_fitter.h, "Focal points"),
+// spans were left without data and looped; the restriction (|kappa| d <= kMaxFocalRatio) avoids
+// that. The second placement is kept when it meets the target, and `fitter` then stays
+// restricted; else the first stands, with its reason.
+absl::StatusOr<Placement> Place(ProfileFitter& fitter, const Start& start, const Start& scratch,
+                                double target, int cap, bool remove,
+                                const std::function<std::optional<double>(const Fitted&)>& cusp) {
+  SG_ASSIGN_OR_RETURN(Placement placed, PlaceKnots(fitter, start.interior, start.params, target,
+                                                   cap, remove, cusp));
+  placed.inserted += start.inserted;
+  placed.removed += start.removed;
+  if (placed.stop.empty()) return placed;
+  fitter.set_max_focal_ratio(kMaxFocalRatio);
+  SG_ASSIGN_OR_RETURN(Placement regular, PlaceKnots(fitter, scratch.interior, scratch.params,
+                                                    target, cap, remove, cusp));
+  if (regular.stop.empty()) return regular;
+  fitter.set_max_focal_ratio(std::numeric_limits<double>::infinity());
+  return placed;
+}
+
+// Coarse to fine (file comment, step 3): the knots and parameters that placement ends with on
+// every kCoarseStride-th point (the anchors kept), itself started coarse to fine, with the
+// parameters carried to the points in between linearly in chord length; `initial` when the
+// outline has fewer than kCoarseStride * kCoarsePoints points or the coarse placement fails.
+// `fit_data`, `data` and `features` as ProfileFitter takes them; `cusp_at(fitter, fit)` is the
+// cusp test of a fit by `fitter`.
+absl::StatusOr<Start> CoarseStart(
+    const std::vector<double>& fit_data, const std::vector<double>& data,
+    const std::vector<int>& features, Start initial, double target, int cap,
+    const AirfoilFitOptions& options,
+    const std::function<std::optional<double>(const ProfileFitter&, const Fitted&)>& cusp_at) {
+  const int m = static_cast<int>(initial.params.size());
+  if (m < kCoarseStride * kCoarsePoints) return initial;
+  std::vector<int> keep;  // data indices of the coarse outline, ascending, anchors included
+  for (int i = 0; i < m; i += kCoarseStride) keep.push_back(i);
+  keep.push_back(m - 1);
+  keep.insert(keep.end(), features.begin(), features.end());
+  std::sort(keep.begin(), keep.end());
+  keep.erase(std::unique(keep.begin(), keep.end()), keep.end());
+  const int n = static_cast<int>(keep.size());
+  std::vector<double> coarse_fit_data(2 * n), coarse_data(2 * n);
+  Start coarse{initial.interior, std::vector<double>(n)};
+  for (int j = 0; j < n; ++j) {
+    for (int c = 0; c < 2; ++c) {
+      coarse_fit_data[2 * j + c] = fit_data[2 * keep[j] + c];
+      coarse_data[2 * j + c] = data[2 * keep[j] + c];
+    }
+    coarse.params[j] = initial.params[keep[j]];
+  }
+  std::vector<int> coarse_features;
+  for (int r : features) {
+    coarse_features.push_back(
+        static_cast<int>(std::lower_bound(keep.begin(), keep.end(), r) - keep.begin()));
+  }
+  SG_ASSIGN_OR_RETURN(const Start start,
+                      CoarseStart(coarse_fit_data, coarse_data, coarse_features, coarse, target,
+                                  std::min(cap, n), options, cusp_at));
+  ProfileFitter fitter(std::move(coarse_fit_data), std::move(coarse_data), options.order,
+                       coarse_features, options.max_parameter_corrections, options.cancel);
+  SG_ASSIGN_OR_RETURN(
+      const Placement placed,
+      Place(fitter, start, coarse, target, std::min(cap, n), options.remove_knots,
+            [&](const Fitted& fit) { return cusp_at(fitter, fit); }));
+  if (!placed.stop.empty()) {
+    initial.fits += fitter.fits() + start.fits;
+    return initial;
+  }
+  Start out{placed.interior, std::vector<double>(m), placed.inserted, placed.removed,
+            fitter.fits() + start.fits};
+  for (int j = 0; j + 1 < n; ++j) {
+    const int a = keep[j], b = keep[j + 1];
+    const double ua = placed.fitted.params[j], ub = placed.fitted.params[j + 1];
+    std::vector<double> arc(b - a + 1, 0.0);
+    for (int i = a + 1; i <= b; ++i) {
+      arc[i - a] = arc[i - a - 1] + std::hypot(fit_data[2 * i] - fit_data[2 * i - 2],
+                                               fit_data[2 * i + 1] - fit_data[2 * i - 1]);
+    }
+    for (int i = a; i <= b; ++i) out.params[i] = ua + (ub - ua) * arc[i - a] / arc.back();
+  }
+  return out;
+}
+
 }  // namespace
 
 int64_t ProfileCurvature::spurious() const {
@@ -459,32 +557,21 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
     CountSpurious(result.reference_curvature, result.reference_curvature);
     curvature_limit = kCurvatureGuard * result.reference_curvature.total.max_abs_curvature;
   }
-  auto cusp = [&](const Fitted& fit) -> std::optional<double> {
-    const auto [kappa, u] = CurvaturePeak(fit, anchors, level);
+  auto cusp_at = [&](const ProfileFitter& by, const Fitted& fit) -> std::optional<double> {
+    const auto [kappa, u] = CurvaturePeak(fit, by.anchors(), level);
     if (kappa > curvature_limit) return u;
     return std::nullopt;
   };
+  auto cusp = [&](const Fitted& fit) { return cusp_at(fitter, fit); };
 
-  // Steps 3 and 4, then the unfaired fit converged.
+  // Steps 3 and 4 (coarse to fine), then the unfaired fit converged.
   const bool fair_to_tolerance = options.fairing.mode == FairingMode::kToTolerance;
   const double target = tolerance * (fair_to_tolerance ? options.fairing_headroom : 1.0);
-  SG_ASSIGN_OR_RETURN(Placement placed, PlaceKnots(fitter, interior, params, target, cap,
-                                                   options.remove_knots, cusp));
-  if (!placed.stop.empty()) {
-    // The placement ran out of splits or controls. When Hoschek's correction crowded the feet
-    // of a dense outline into a bend of an early, too coarse fit (profile_fitter.h, "Focal
-    // points"), spans were left without data and looped; placing again with the correction
-    // restricted to regular feet (|kappa| d <= kMaxFocalRatio) avoids that. The second
-    // placement is kept when it meets the target; else the first stands, with its reason.
-    fitter.set_max_focal_ratio(kMaxFocalRatio);
-    SG_ASSIGN_OR_RETURN(Placement regular, PlaceKnots(fitter, interior, params, target, cap,
-                                                      options.remove_knots, cusp));
-    if (regular.stop.empty()) {
-      placed = std::move(regular);
-    } else {
-      fitter.set_max_focal_ratio(std::numeric_limits<double>::infinity());
-    }
-  }
+  const Start scratch{interior, params};
+  SG_ASSIGN_OR_RETURN(const Start start, CoarseStart(fit_data, data, result.features, scratch,
+                                                     target, cap, options, cusp_at));
+  SG_ASSIGN_OR_RETURN(Placement placed,
+                      Place(fitter, start, scratch, target, cap, options.remove_knots, cusp));
   result.knots_inserted = placed.inserted;
   result.knots_removed = placed.removed;
   interior = std::move(placed.interior);
@@ -531,7 +618,7 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
       static_cast<int>(std::max_element(result.distances.begin(), result.distances.end()) -
                        result.distances.begin());
   result.max_deviation = result.distances[result.worst_point];
-  result.fits = fitter.fits();
+  result.fits = fitter.fits() + start.fits;
   const double peak = result.curvature.total.max_abs_curvature;
   result.met = result.max_deviation <= tolerance && peak <= curvature_limit;
   if (!result.met) {

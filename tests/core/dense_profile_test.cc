@@ -167,7 +167,7 @@ Measured FitAndCheck(const StructuredBlock& data, double tolerance, double chord
       << what;
   const Measured out{data.extent(0), fit->num_control_points, fit->max_deviation / chord, ms};
   std::cout << what << ": " << out.points << " points, " << out.controls << " controls, "
-            << fit->features.size() << " features, "
+            << fit->features.size() << " features, " << fit->fits << " fits, "
             << out.deviation << " chords, " << ms << " ms\n";
   return out;
 }
@@ -211,23 +211,20 @@ TEST(DenseProfileTest, Naca0012At20000Points) {
 }
 
 TEST(DenseProfileTest, Sc20714At16000Points) {
-  CheckDenseAgainstQuarter({"sc20714", 16000, 1e-4});  // measured 15 and 17
-  // Before merges (airfoil_fit.h, step 4): 15 against 13, over the bound of 14.
+  CheckDenseAgainstQuarter({"sc20714", 16000, 1e-4});  // measured 18 and 18
+  // Before merges and coarse-to-fine placement (airfoil_fit.h): 15 against 13, over the bound.
   CheckDenseAgainstQuarter({"sc20714", 16000, 2e-4});  // measured 13 and 13
 }
 
 // The 30P30N main element in the file's units (chord about 830): tolerances relative to it,
 // two cove corners kept as features.
 TEST(DenseProfileTest, HighLiftMainElementAt12000Points) {
-  CheckDenseAgainstQuarter({"30p30n/30p30n_main", 12228, 2e-4});  // measured 21 and 21
+  // Before coarse-to-fine placement (airfoil_fit.h, step 3) 1e-4 needed 26 controls against 23:
+  // the quarter's knots, with its parameters carried over, fit the dense outline within 0.082 of
+  // the 0.083 tolerance, but greedy insertion on all points did not find them.
+  CheckDenseAgainstQuarter({"30p30n/30p30n_main", 12228, 1e-4});  // measured 23 and 23
+  CheckDenseAgainstQuarter({"30p30n/30p30n_main", 12228, 2e-4});  // measured 19 and 19
   CheckDenseAgainstQuarter({"30p30n/30p30n_main", 12228, 5e-4});  // measured 18 and 18
-  // Known gap (issue 13, point 4): at 1e-4 chord the dense outline fits with 26 controls and
-  // its quarter with 23 (bound 25; before merges 28 and 24); both meet the tolerance without a
-  // cusp. Both placements insert 24 knots; removal and merges take 7 from the dense one and 11
-  // from the quarter.
-  const StructuredBlock coarse = Shared("30p30n/30p30n_main");
-  const double chord = Chord(coarse);
-  FitAndCheck(Densify(coarse, 12228, 13), 1e-4 * chord, chord, "30p30n main at 1e-4, dense");
 }
 
 }  // namespace
