@@ -66,11 +66,11 @@ BoundaryKind GeometricKind(const StructuredBlock& block, const Face& face,
                                                                   : BoundaryKind::kOuter;
 }
 
-// A wall segment of a planar block: two neighbouring points of a wall face that both carry the
-// wall kind.
+// A wall segment: two neighbouring points, along one direction of a wall face, that both carry
+// the wall kind, seen from one end (`from`) towards the other (`to`).
 struct WallSegment {
-  const double* a;
-  const double* b;
+  const double* from;
+  const double* to;
 };
 
 // Position of a point of `block`.
@@ -78,49 +78,97 @@ const double* At(const StructuredBlock& block, const Extents& x) {
   return block.Point(x[0], x[1], x[2]);
 }
 
-// Whether a solid lies behind the face at `contact` (a point at an end of an unmatched run of a
-// face of a planar block): some wall segment that starts at (a point coincident with) `contact`
-// leaves it on the side of the face away from the block's interior, i.e. its unit direction w
-// has w . n_in < -kBehind, with n_in the unit direction from the face into the block there.
-// (A channel inlet between two walls fails this: its walls run along the block's side.)
-bool SolidBehind(const double* contact, const double* inward, int dim,
-                 std::span<const WallSegment> walls, double coincide) {
-  constexpr double kBehind = 0.1;  // cos 84 degrees: the wall turns away by > 6 degrees
-  double n2 = 0.0;
-  for (int c = 0; c < dim; ++c) n2 += (inward[c] - contact[c]) * (inward[c] - contact[c]);
-  if (!(n2 > 0.0)) return false;
-  for (const WallSegment& w : walls) {
-    for (const auto& [from, to] : {std::pair{w.a, w.b}, std::pair{w.b, w.a}}) {
+// The wall segments of a grid, found by their starting point: sorted by a projection of `from`
+// on a direction no grid plane is likely to be normal to, so that the segments starting at one
+// point are a short range of the order.
+class WallSegments {
+ public:
+  WallSegments(int dim, double coincide) : dim_(dim), coincide_(coincide) {}
+
+  void Add(const double* a, const double* b) {
+    segments_.push_back({a, b});
+    segments_.push_back({b, a});
+  }
+  void Sort() {
+    std::sort(segments_.begin(), segments_.end(), [&](const WallSegment& x, const WallSegment& y) {
+      return Key(x.from) < Key(y.from);
+    });
+  }
+  bool empty() const { return segments_.empty(); }
+
+  // Whether a solid lies behind a face at `contact` (a point at an end of an unmatched run of a
+  // face line; `inward` its neighbour into the block): some wall segment that starts at (a point
+  // coincident with) `contact` leaves it on the side of the face away from the block's interior,
+  // i.e. its unit direction w has w . n_in < -kBehind, with n_in the unit direction from the face
+  // into the block there. (A channel inlet between two walls fails this: its walls run along
+  // the block's side.)
+  bool SolidBehind(const double* contact, const double* inward) const {
+    constexpr double kBehind = 0.1;  // cos 84 degrees: the wall turns away by > 6 degrees
+    double n2 = 0.0;
+    for (int c = 0; c < dim_; ++c) n2 += (inward[c] - contact[c]) * (inward[c] - contact[c]);
+    if (!(n2 > 0.0)) return false;
+    const double key = Key(contact), reach = 2.0 * coincide_;  // |kProjection| < 2
+    auto it = std::lower_bound(segments_.begin(), segments_.end(), key - reach,
+                               [&](const WallSegment& w, double k) { return Key(w.from) < k; });
+    for (; it != segments_.end() && Key(it->from) <= key + reach; ++it) {
       double gap2 = 0.0, dot = 0.0, l2 = 0.0;
-      for (int c = 0; c < dim; ++c) {
-        gap2 += (from[c] - contact[c]) * (from[c] - contact[c]);
-        dot += (to[c] - from[c]) * (inward[c] - contact[c]);
-        l2 += (to[c] - from[c]) * (to[c] - from[c]);
+      for (int c = 0; c < dim_; ++c) {
+        gap2 += (it->from[c] - contact[c]) * (it->from[c] - contact[c]);
+        dot += (it->to[c] - it->from[c]) * (inward[c] - contact[c]);
+        l2 += (it->to[c] - it->from[c]) * (it->to[c] - it->from[c]);
       }
-      if (gap2 <= coincide * coincide && l2 > 0.0 && dot < -kBehind * std::sqrt(l2 * n2)) {
+      if (gap2 <= coincide_ * coincide_ && l2 > 0.0 && dot < -kBehind * std::sqrt(l2 * n2)) {
         return true;
       }
     }
+    return false;
   }
-  return false;
+
+ private:
+  static constexpr double kProjection[3] = {1.0, 0.6180339887498949, 0.4142135623730950};
+  double Key(const double* p) const {
+    double key = 0.0;
+    for (int c = 0; c < dim_; ++c) key += kProjection[c] * p[c];
+    return key;
+  }
+
+  int dim_;
+  double coincide_;
+  std::vector<WallSegment> segments_;
+};
+
+// Whether the wall-base pass looks at `block`: planar blocks (one point in k) and volume blocks.
+bool HasSolidFaces(const StructuredBlock& block) {
+  const int active = ActiveDirections(block.extents());
+  return (block.extent(2) == 1 && active == 2) || active == 3;
 }
 
-// Second pass of ClassifyBoundaries for planar blocks (one point in k): a run of unmatched
-// points of a face classified outer by clustering is a wall when a solid lies behind the face at
-// both ends of the run (SolidBehind), as at the blunt base of a nozzle lip or a thick trailing
-// edge: the run then joins two walls of one solid across the side of the face away from the
-// flow. The clustering test misses such bases when the grid is not clustered towards them.
-// Overridden faces are left as given. Cost: O(boundary points x wall segments) for the run ends.
+// The in-face directions of `face` (those with more than one point).
+std::vector<int> FaceDirections(const StructuredBlock& block, const Face& face) {
+  std::vector<int> directions;
+  for (int e = 0; e < 3; ++e) {
+    if (e != face.normal && block.extent(e) > 1) directions.push_back(e);
+  }
+  return directions;
+}
+
+// Second pass of ClassifyBoundaries for planar and volume blocks: along every grid line of a face
+// classified outer by clustering, a run of unmatched points is a wall when a solid lies behind
+// the face at both ends of the run (WallSegments::SolidBehind), as at the blunt base of a nozzle
+// lip or a thick trailing edge: the run then joins two walls of one solid across the side of the
+// face away from the flow. A point is wall when a run along either direction of the face says
+// so (on the base of a 3D lip the lines across the base end on the lip's walls, those along the
+// span on the side planes); the face is a wall when all its unmatched points are. The clustering
+// test misses such bases when the grid is not clustered towards them. Overridden faces are left
+// as given. Cost: O(wall points log wall points) to sort the segments, O(log) per run end.
 void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindOverride> overrides,
                            const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
   constexpr uint8_t kWallBit = static_cast<uint8_t>(BoundaryKind::kWall);
   constexpr uint8_t kOuterBit = static_cast<uint8_t>(BoundaryKind::kOuter);
-  std::vector<WallSegment> walls;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   int dim = 0;
-  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
-    const StructuredBlock& block = grid.blocks[b];
-    if (block.extent(2) != 1) continue;
+  for (const StructuredBlock& block : grid.blocks) {
+    if (!HasSolidFaces(block)) continue;
     dim = std::max(dim, block.spatial_dim());
     for (int64_t p = 0; p < block.num_points(); ++p) {
       for (int c = 0; c < block.spatial_dim(); ++c) {
@@ -128,29 +176,34 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
         hi[c] = std::max(hi[c], block.coords()[block.spatial_dim() * p + c]);
       }
     }
+  }
+  double diagonal2 = 0.0;
+  for (int c = 0; c < dim; ++c) diagonal2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  WallSegments walls(dim, 1e-9 * std::sqrt(diagonal2));
+  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
+    const StructuredBlock& block = grid.blocks[b];
+    if (!HasSolidFaces(block)) continue;
     const std::vector<Face> faces = BlockFaces(block, b);
     for (size_t f = 0; f < faces.size(); ++f) {
       if (kinds.face_kinds[b][f] != BoundaryKind::kWall) continue;
-      const int e = 1 - faces[f].normal;  // the face's own direction
-      Extents x = {0, 0, 0};
-      x[faces[f].normal] = faces[f].upper ? block.extent(faces[f].normal) - 1 : 0;
-      for (int r = 0; r + 1 < block.extent(e); ++r) {
-        Extents y = x;
-        x[e] = r, y[e] = r + 1;
-        if ((kinds.point_kinds[b][block.Index(x[0], x[1], 0)] & kWallBit) &&
-            (kinds.point_kinds[b][block.Index(y[0], y[1], 0)] & kWallBit)) {
-          walls.push_back({At(block, x), At(block, y)});
-        }
+      for (int e : FaceDirections(block, faces[f])) {
+        ForEachFacePoint(block, faces[f], [&](const Extents& x) {
+          if (x[e] + 1 >= block.extent(e)) return;
+          Extents y = x;
+          ++y[e];
+          if ((kinds.point_kinds[b][block.Index(x[0], x[1], x[2])] & kWallBit) &&
+              (kinds.point_kinds[b][block.Index(y[0], y[1], y[2])] & kWallBit)) {
+            walls.Add(At(block, x), At(block, y));
+          }
+        });
       }
     }
   }
   if (walls.empty()) return;
-  double diagonal2 = 0.0;
-  for (int c = 0; c < dim; ++c) diagonal2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-  const double coincide = 1e-9 * std::sqrt(diagonal2);
+  walls.Sort();
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
     const StructuredBlock& block = grid.blocks[b];
-    if (block.extent(2) != 1 || ActiveDirections(block.extents()) != 2) continue;
+    if (!HasSolidFaces(block)) continue;
     const std::vector<Face> faces = BlockFaces(block, b);
     for (size_t f = 0; f < faces.size(); ++f) {
       const Face& face = faces[f];
@@ -158,51 +211,57 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
           std::any_of(overrides.begin(), overrides.end(),
                       [&](const FaceKindOverride& o) { return o.face == face; });
       if (overridden || kinds.face_kinds[b][f] != BoundaryKind::kOuter) continue;
-      const int d = face.normal, e = 1 - d, n = block.extent(e);
-      auto point = [&](int r) {
-        Extents x = {0, 0, 0};
-        x[d] = face.upper ? block.extent(d) - 1 : 0;
-        x[e] = r;
-        return x;
-      };
-      auto inward = [&](int r) {
-        Extents x = point(r);
+      const int d = face.normal;
+      const std::vector<int> directions = FaceDirections(block, face);
+      auto index = [&](const Extents& x) { return block.Index(x[0], x[1], x[2]); };
+      auto unmatched = [&](const Extents& x) { return !(matched[b][index(x)] & FaceBit(face)); };
+      auto inward = [&](Extents x) {
         x[d] += face.upper ? -1 : 1;
         return At(block, x);
       };
-      auto unmatched = [&](int r) {
-        const Extents x = point(r);
-        return !(matched[b][block.Index(x[0], x[1], 0)] & FaceBit(face));
+      // Points of the face strictly inside it: they carry no other face's kind.
+      auto inside = [&](const Extents& x) {
+        return std::all_of(directions.begin(), directions.end(),
+                           [&](int e) { return x[e] > 0 && x[e] + 1 < block.extent(e); });
       };
-      bool all_runs = true, any_run = false;
-      for (int r0 = 0; r0 < n;) {
-        if (!unmatched(r0)) {
-          ++r0;
-          continue;
-        }
-        int r1 = r0;
-        while (r1 + 1 < n && unmatched(r1 + 1)) ++r1;
-        any_run = true;
-        // The contact points: the matched neighbours of the run, or its own ends at corners.
-        const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
-        const bool base =
-            SolidBehind(At(block, point(c0)), inward(c0), block.spatial_dim(), walls, coincide) &&
-            SolidBehind(At(block, point(c1)), inward(c1), block.spatial_dim(), walls, coincide);
-        if (base) {
-          for (int r = c0; r <= c1; ++r) {
-            const Extents x = point(r);
-            uint8_t& k = kinds.point_kinds[b][block.Index(x[0], x[1], 0)];
-            // The run and its contact points become wall: the outer kind they carry is this
-            // face's, except at a block corner, which keeps the other face's kind.
-            if (r > 0 && r + 1 < n) k &= static_cast<uint8_t>(~kOuterBit);
-            k |= kWallBit;
+      std::vector<uint8_t> base(block.num_points(), 0);  // points found on a base
+      for (int e : directions) {
+        const int n = block.extent(e);
+        ForEachFacePoint(block, face, [&](const Extents& start) {
+          if (start[e] != 0) return;  // one line per start point
+          auto point = [&](int r) {
+            Extents x = start;
+            x[e] = r;
+            return x;
+          };
+          for (int r0 = 0; r0 < n;) {
+            if (!unmatched(point(r0))) {
+              ++r0;
+              continue;
+            }
+            int r1 = r0;
+            while (r1 + 1 < n && unmatched(point(r1 + 1))) ++r1;
+            // The contact points: the matched neighbours of the run, or its own ends at edges.
+            const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
+            if (walls.SolidBehind(At(block, point(c0)), inward(point(c0))) &&
+                walls.SolidBehind(At(block, point(c1)), inward(point(c1)))) {
+              for (int r = c0; r <= c1; ++r) base[index(point(r))] = 1;
+            }
+            r0 = r1 + 1;
           }
-        } else {
-          all_runs = false;
-        }
-        r0 = r1 + 1;
+        });
       }
-      if (any_run && all_runs) kinds.face_kinds[b][f] = BoundaryKind::kWall;
+      bool any_unmatched = false, all_base = true;
+      ForEachFacePoint(block, face, [&](const Extents& x) {
+        if (unmatched(x)) any_unmatched = true, all_base = all_base && base[index(x)];
+        if (!base[index(x)]) return;
+        uint8_t& k = kinds.point_kinds[b][index(x)];
+        // The base and its contact points become wall: the outer kind they carry is this
+        // face's, except on the face's edges, which keep the other faces' kinds.
+        if (inside(x)) k &= static_cast<uint8_t>(~kOuterBit);
+        k |= kWallBit;
+      });
+      if (any_unmatched && all_base) kinds.face_kinds[b][f] = BoundaryKind::kWall;
     }
   }
 }

@@ -55,12 +55,14 @@ struct BoundaryKinds {
 // Classifies every boundary point of `grid`: matched points are interface; a face's other
 // points are wall when the grid clusters towards the face (first spacing below
 // wall_spacing_ratio times the block's median spacing in that direction), else outer; an
-// override sets a face's kind. Then, in planar blocks, a run of unmatched points of an outer face
-// (not overridden) becomes wall when a solid lies behind the face at both ends of the run: a
-// wall that meets the run's end point leaves it on the side of the face away from the block's
-// interior. That is a blunt base (a nozzle lip, a thick trailing edge) joining two walls of one
-// solid, which the clustering test misses when the grid is not clustered towards it; an inlet
-// between two walls (the walls run along the block) and a far field stay outer. Errors:
+// override sets a face's kind. Then, in planar and volume blocks, a run of unmatched points
+// along a grid line of an outer face (not overridden) becomes wall when a solid lies behind the
+// face at both ends of the run: a wall that meets the run's end point leaves it on the side of
+// the face away from the block's interior. That is a blunt base (a nozzle lip, a thick trailing
+// edge, in 2D or across the span in 3D) joining two walls of one solid, which the clustering
+// test misses when the grid is not clustered towards it; an inlet between two walls (the walls
+// run along the block) and a far field stay outer; a face all of whose unmatched points are on
+// such runs is a wall face. Errors:
 // INVALID_ARGUMENT for an override naming a block or face that does not exist.
 absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
                                                  const Connectivity& connectivity,

@@ -1,7 +1,8 @@
 // ClassifyBoundaries on a blunt base between two walls (issue 13, point 5): three blocks around
 // a thick lip, whose base is one block's imin face with no clustering towards it, classify the
 // base as wall automatically; the inflow face between a wall and the far field, the far field
-// and the interfaces keep their kinds; an explicit override still wins.
+// and the interfaces keep their kinds; an explicit override still wins. The same in 3D: the lip
+// grid extruded along z into volume blocks.
 #include <algorithm>
 #include <vector>
 
@@ -58,8 +59,21 @@ BoundaryKinds Classify(const MultiBlockGrid& grid, size_t matches,
   return kinds.ok() ? *std::move(kinds) : BoundaryKinds{};
 }
 
-uint8_t KindAt(const MultiBlockGrid& grid, const BoundaryKinds& kinds, int b, int i, int j) {
-  return kinds.point_kinds[b][grid.blocks[b].Index(i, j, 0)];
+uint8_t KindAt(const MultiBlockGrid& grid, const BoundaryKinds& kinds, int b, int i, int j,
+               int k = 0) {
+  return kinds.point_kinds[b][grid.blocks[b].Index(i, j, k)];
+}
+
+// Every planar block of `grid` extruded along z over [0, 1] with `nk` points.
+MultiBlockGrid Extruded(const MultiBlockGrid& grid, int nk) {
+  MultiBlockGrid out;
+  for (const StructuredBlock& b : grid.blocks) {
+    out.blocks.push_back(SpaceBlock(b.extent(0), b.extent(1), nk, [&](int i, int j, int k) {
+      const double* p = b.Point(i, j, 0);
+      return std::array{p[0], p[1], k / (nk - 1.0)};
+    }));
+  }
+  return out;
 }
 
 TEST(WallBaseTest, BluntBaseBetweenTwoWallsIsWall) {
@@ -108,6 +122,50 @@ TEST(WallBaseTest, OverrideWinsAndAChannelInletStaysOuter) {
   const BoundaryKinds inlet = Classify(channel, 0);
   EXPECT_THAT(inlet.face_kinds[0], ElementsAre(BoundaryKind::kOuter, BoundaryKind::kOuter,
                                                BoundaryKind::kWall, BoundaryKind::kWall));
+}
+
+// The lip extruded: the base (block 2's imin face between the two interfaces) is a wall across
+// the span; along the span its lines end on the side planes kmin and kmax, which stay outer and
+// keep that kind on their edges with the base.
+TEST(WallBaseTest, BluntBaseOfAVolumeGridIsWall) {
+  constexpr int kNk = 5;
+  const MultiBlockGrid grid = Extruded(LipGrid(), kNk);
+  const BoundaryKinds kinds = Classify(grid, 2);
+  const int base0 = kNj - 1, base1 = base0 + kBase - 1;
+  EXPECT_THAT(kinds.face_kinds[2],
+              ElementsAre(BoundaryKind::kWall, BoundaryKind::kOuter, BoundaryKind::kOuter,
+                          BoundaryKind::kOuter, BoundaryKind::kOuter, BoundaryKind::kOuter));
+  for (int k = 0; k < kNk; ++k) {
+    const uint8_t side = k == 0 || k == kNk - 1 ? kOuter : 0;
+    for (int j = base0 + 1; j < base1; ++j) {
+      EXPECT_EQ(KindAt(grid, kinds, 2, 0, j, k), kWall | side) << j << " " << k;
+    }
+    EXPECT_EQ(KindAt(grid, kinds, 2, 0, base0, k), kInterface | kWall | side) << k;
+    EXPECT_EQ(KindAt(grid, kinds, 2, 0, 3, k), kInterface | side) << k;
+    EXPECT_EQ(KindAt(grid, kinds, 2, kNi - 1, base0 + 3, k), kOuter) << k;  // outflow
+  }
+  for (int b : {0, 1}) {
+    // i=max is matched (its face kind applies to no point).
+    EXPECT_EQ(kinds.face_kinds[b][0], BoundaryKind::kOuter) << b;
+    EXPECT_EQ(kinds.face_kinds[b][2], BoundaryKind::kWall) << b;
+    for (int f : {3, 4, 5}) EXPECT_EQ(kinds.face_kinds[b][f], BoundaryKind::kOuter) << b << f;
+    EXPECT_EQ(KindAt(grid, kinds, b, 0, 5, 2), kOuter) << b;  // inflow
+    EXPECT_EQ(KindAt(grid, kinds, b, 4, 0, 2), kWall) << b;
+  }
+}
+
+TEST(WallBaseTest, InletOfAVolumeChannelStaysOuter) {
+  const std::vector<double> t = GeometricSpacing(kNj, 1e-3, 2.0);
+  std::vector<double> y = t;
+  for (int j = static_cast<int>(t.size()) - 2; j >= 0; --j) y.push_back(2.0 * t.back() - t[j]);
+  MultiBlockGrid channel;
+  channel.blocks.push_back(PlanarBlock(kNi, static_cast<int>(y.size()), [&](int i, int j) {
+    return std::array{i / (kNi - 1.0), y[j]};
+  }));
+  const BoundaryKinds inlet = Classify(Extruded(channel, 4), 0);
+  EXPECT_THAT(inlet.face_kinds[0],
+              ElementsAre(BoundaryKind::kOuter, BoundaryKind::kOuter, BoundaryKind::kWall,
+                          BoundaryKind::kWall, BoundaryKind::kOuter, BoundaryKind::kOuter));
 }
 
 }  // namespace
