@@ -432,26 +432,34 @@ absl::StatusOr<Start> CoarseStart(
                                   std::min(cap, n), options, cusp_at));
   ProfileFitter fitter(std::move(coarse_fit_data), std::move(coarse_data), options.order,
                        coarse_features, options.max_parameter_corrections, options.cancel);
-  SG_ASSIGN_OR_RETURN(
-      const Placement placed,
+  // Every 4th point can leave a segment between close anchors with too few points for its
+  // controls: then, and whenever the coarse placement fails, the outline starts from scratch.
+  if (!fitter.WellPosed(coarse.interior, coarse.params)) return initial;
+  absl::StatusOr<Placement> placed =
       Place(fitter, start, coarse, target, std::min(cap, n), options.remove_knots,
-            [&](const Fitted& fit) { return cusp_at(fitter, fit); }));
-  if (!placed.stop.empty()) {
+            [&](const Fitted& fit) { return cusp_at(fitter, fit); });
+  if (placed.status().code() == absl::StatusCode::kCancelled) return placed.status();
+  if (!placed.ok() || !placed->stop.empty()) {
     initial.fits += fitter.fits() + start.fits;
     return initial;
   }
-  Start out{placed.interior, std::vector<double>(m), placed.inserted, placed.removed,
+  Start out{placed->interior, std::vector<double>(m), placed->inserted, placed->removed,
             fitter.fits() + start.fits};
   for (int j = 0; j + 1 < n; ++j) {
     const int a = keep[j], b = keep[j + 1];
-    const double ua = placed.fitted.params[j], ub = placed.fitted.params[j + 1];
+    const double ua = placed->fitted.params[j], ub = placed->fitted.params[j + 1];
     std::vector<double> arc(b - a + 1, 0.0);
     for (int i = a + 1; i <= b; ++i) {
       arc[i - a] = arc[i - a - 1] + std::hypot(fit_data[2 * i] - fit_data[2 * i - 2],
                                                fit_data[2 * i + 1] - fit_data[2 * i - 1]);
     }
-    for (int i = a; i <= b; ++i) out.params[i] = ua + (ub - ua) * arc[i - a] / arc.back();
+    for (int i = a; i < b; ++i) {
+      // Coincident kept points (a merged sharp trailing edge): spaced by index instead.
+      const double share = arc.back() > 0.0 ? arc[i - a] / arc.back() : (i - a) / double(b - a);
+      out.params[i] = ua + (ub - ua) * share;
+    }
   }
+  out.params[m - 1] = placed->fitted.params[n - 1];
   return out;
 }
 

@@ -160,7 +160,8 @@ std::vector<int> FaceDirections(const StructuredBlock& block, const Face& face) 
 // so (on the base of a 3D lip the lines across the base end on the lip's walls, those along the
 // span on the side planes); the face is a wall when all its unmatched points are. The clustering
 // test misses such bases when the grid is not clustered towards them. Overridden faces are left
-// as given. Cost: O(wall points log wall points) to sort the segments, O(log) per run end.
+// as given. Cost: O(wall points log wall points) to sort the segments, O(log) per run end, and
+// O(points) per outer face.
 void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindOverride> overrides,
                            const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
   constexpr uint8_t kWallBit = static_cast<uint8_t>(BoundaryKind::kWall);
@@ -219,12 +220,34 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
         x[d] += face.upper ? -1 : 1;
         return At(block, x);
       };
-      // Points of the face strictly inside it: they carry no other face's kind.
-      auto inside = [&](const Extents& x) {
-        return std::all_of(directions.begin(), directions.end(),
-                           [&](int e) { return x[e] > 0 && x[e] + 1 < block.extent(e); });
+      // Whether another face of the block through x gives x the outer kind (an unmatched point
+      // of an outer face): that kind stays when x becomes wall.
+      auto outer_elsewhere = [&](const Extents& x) {
+        for (int e : directions) {
+          for (const bool upper : {false, true}) {
+            if (x[e] != (upper ? block.extent(e) - 1 : 0)) continue;
+            const Face other{b, e, upper};
+            const size_t g = static_cast<size_t>(
+                std::find(faces.begin(), faces.end(), other) - faces.begin());
+            if (g < faces.size() && kinds.face_kinds[b][g] == BoundaryKind::kOuter &&
+                !(matched[b][index(x)] & FaceBit(other))) {
+              return true;
+            }
+          }
+        }
+        return false;
       };
-      std::vector<uint8_t> base(block.num_points(), 0);  // points found on a base
+      // Points found on a base, by their place on the face (the directions' indices).
+      auto slot = [&](const Extents& x) {
+        int64_t s = 0;
+        for (auto it = directions.rbegin(); it != directions.rend(); ++it) {
+          s = s * block.extent(*it) + x[*it];
+        }
+        return s;
+      };
+      int64_t face_points = 1;
+      for (int e : directions) face_points *= block.extent(e);
+      std::vector<uint8_t> base(face_points, 0);
       for (int e : directions) {
         const int n = block.extent(e);
         ForEachFacePoint(block, face, [&](const Extents& start) {
@@ -245,7 +268,7 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
             const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
             if (walls.SolidBehind(At(block, point(c0)), inward(point(c0))) &&
                 walls.SolidBehind(At(block, point(c1)), inward(point(c1)))) {
-              for (int r = c0; r <= c1; ++r) base[index(point(r))] = 1;
+              for (int r = c0; r <= c1; ++r) base[slot(point(r))] = 1;
             }
             r0 = r1 + 1;
           }
@@ -253,12 +276,12 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
       }
       bool any_unmatched = false, all_base = true;
       ForEachFacePoint(block, face, [&](const Extents& x) {
-        if (unmatched(x)) any_unmatched = true, all_base = all_base && base[index(x)];
-        if (!base[index(x)]) return;
+        if (unmatched(x)) any_unmatched = true, all_base = all_base && base[slot(x)];
+        if (!base[slot(x)]) return;
         uint8_t& k = kinds.point_kinds[b][index(x)];
         // The base and its contact points become wall: the outer kind they carry is this
-        // face's, except on the face's edges, which keep the other faces' kinds.
-        if (inside(x)) k &= static_cast<uint8_t>(~kOuterBit);
+        // face's unless another outer face of the block passes through them.
+        if (!outer_elsewhere(x)) k &= static_cast<uint8_t>(~kOuterBit);
         k |= kWallBit;
       });
       if (any_unmatched && all_base) kinds.face_kinds[b][f] = BoundaryKind::kWall;

@@ -150,7 +150,9 @@ TEST(CgnsServerTest, CGridConditionsAreDefaultKindsAndRoundTripThroughEvalAtALev
   EXPECT_EQ(kinds[0].face(), v1::BLOCK_FACE_J_MIN);
   EXPECT_EQ(kinds[0].kind(), v1::BOUNDARY_KIND_OUTER);
   for (const v1::FaceKind& k : kinds) {
-    if (k.face() == v1::BLOCK_FACE_J_MIN) EXPECT_EQ(k.kind(), v1::BOUNDARY_KIND_OUTER);
+    if (k.face() == v1::BLOCK_FACE_J_MIN) {
+      EXPECT_EQ(k.kind(), v1::BOUNDARY_KIND_OUTER);
+    }
   }
 
   // eval --level 1 -o: the same conditions and the wake cut at twice the indices.

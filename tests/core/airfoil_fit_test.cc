@@ -250,6 +250,26 @@ TEST(AirfoilFitTest, FeaturePointsKeptLeadingEdgeSmooth) {
   ExpectWithinTolerance(*fit, naca, kTolerance, "naca0012, features at 20 degrees");
 }
 
+// Coarse to fine (airfoil_fit.h, step 3) keeps every 4th point and the anchors: a feature at
+// point 3 leaves the segment before it with no coarse point inside, too few for its controls.
+// The fit must then start from scratch, not fail. A 90-degree kink where a straight tab of 4
+// points meets a 2,400-point ellipse.
+TEST(AirfoilFitTest, DenseOutlineWithAFeatureNearItsEnd) {
+  std::vector<double> xy = {1.15, 0.0, 1.10, 0.0, 1.05, 0.0};
+  constexpr int kEllipse = 2400;
+  for (int q = 0; q < kEllipse; ++q) {
+    const double t = 2.0 * std::numbers::pi * q / kEllipse;
+    xy.push_back(0.5 + 0.5 * std::cos(t));
+    xy.push_back(0.06 * std::sin(t));
+  }
+  const StructuredBlock block = Outline(xy);
+  absl::StatusOr<AirfoilFit> fit = FitAirfoil(block, {});
+  ASSERT_TRUE(fit.ok()) << fit.status();
+  EXPECT_THAT(fit->features, ::testing::ElementsAre(3));
+  EXPECT_TRUE(fit->met) << fit->unmet_reason;
+  EXPECT_LE(fit->max_deviation, kTolerance);
+}
+
 TEST(AirfoilFitTest, FairingKeepsToleranceAndDoesNotRoughen) {
   for (const std::string name : {"rae2822", "naca0012", "sc20714"}) {
     for (const double headroom : {1.0, 0.7}) {
