@@ -27,18 +27,13 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
         context_(context),
         request_(request),
         log_("ExportGrid", request->name(), state->options) {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
-    if (!caller.ok()) {
-      End(caller.status());
+    absl::StatusOr<AdmittedStream> admitted = AdmitStream(*state_, context, Role::kRead, &log_);
+    if (!admitted.ok()) {
+      End(admitted.status());
       return;
     }
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) {
-      End(slot.status());
-      return;
-    }
-    stream_ = *std::move(slot);
+    caller_ = std::move(admitted->caller);
+    stream_ = std::move(admitted->slot);
     if (absl::Status status =
             state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { Prepare(); });
         !status.ok()) {

@@ -39,18 +39,13 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
         request_(request),
         cancel_(CallCancelCheck(context)),
         log_("EvaluateGrid", request->name(), state->options) {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context, Role::kRead, &log_);
-    if (!caller.ok()) {
-      Fail(caller.status());
+    absl::StatusOr<AdmittedStream> admitted = AdmitStream(*state_, context, Role::kRead, &log_);
+    if (!admitted.ok()) {
+      Fail(admitted.status());
       return;
     }
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) {
-      Fail(slot.status());
-      return;
-    }
-    stream_ = *std::move(slot);
+    caller_ = std::move(admitted->caller);
+    stream_ = std::move(admitted->slot);
     if (absl::Status status =
             state_->pool.TrySubmit(caller_.principal, WorkKind::kCheap, [this] { Start(); });
         !status.ok()) {

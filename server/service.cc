@@ -100,6 +100,14 @@ absl::StatusOr<Caller> AdmitCall(const ServiceState& state, grpc::CallbackServer
   return caller;
 }
 
+absl::StatusOr<AdmittedStream> AdmitStream(ServiceState& state,
+                                           grpc::CallbackServerContext* context, Role needed,
+                                           CallLog* log) {
+  SG_ASSIGN_OR_RETURN(Caller caller, AdmitCall(state, context, needed, log));
+  SG_ASSIGN_OR_RETURN(StreamSlot slot, state.streams.Open(caller.principal));
+  return AdmittedStream{std::move(caller), std::move(slot)};
+}
+
 grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerContext* context,
                                                        CallLog log, Role needed, WorkKind kind,
                                                        Work work) {

@@ -46,6 +46,17 @@ struct ServiceState {
 absl::StatusOr<Caller> AdmitCall(const ServiceState& state, grpc::CallbackServerContext* context,
                                  Role needed, CallLog* log);
 
+// A streaming call admitted by AdmitCall and holding one of its caller's stream slots.
+struct AdmittedStream {
+  Caller caller;
+  StreamSlot slot;
+};
+
+// AdmitCall, then a stream slot of the caller (RESOURCE_EXHAUSTED when all are open).
+absl::StatusOr<AdmittedStream> AdmitStream(ServiceState& state,
+                                           grpc::CallbackServerContext* context, Role needed,
+                                           CallLog* log);
+
 // absl::Status -> grpc::Status (the codes are the same numbers).
 grpc::Status ToGrpcStatus(const absl::Status& status);
 

@@ -69,18 +69,14 @@ class UploadReactor : public grpc::ServerReadReactor<Decoded<Request>> {
 
   // Admits the call and starts reading (the last statement of the subclass's constructor).
   void Start() {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context_, Role::kWrite, &log_);
-    if (!caller.ok()) {
-      End(caller.status());
+    absl::StatusOr<AdmittedStream> admitted =
+        AdmitStream(*state_, context_, Role::kWrite, &log_);
+    if (!admitted.ok()) {
+      End(admitted.status());
       return;
     }
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) {
-      End(slot.status());
-      return;
-    }
-    stream_ = *std::move(slot);
+    caller_ = std::move(admitted->caller);
+    stream_ = std::move(admitted->slot);
     idle_.Start(state_->options.import_idle_timeout, [this] { OnIdle(); });
     SG_HAPPENS_BEFORE(this);
     this->StartRead(&message_);

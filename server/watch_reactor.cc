@@ -26,6 +26,7 @@
 #include <mutex>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
 #include "server/service.h"
@@ -91,12 +92,10 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
 
  private:
   absl::Status Subscribe() {
-    absl::StatusOr<Caller> caller = AdmitCall(*state_, context_, Role::kRead, &log_);
-    if (!caller.ok()) return caller.status();
-    caller_ = *std::move(caller);
-    absl::StatusOr<StreamSlot> slot = state_->streams.Open(caller_.principal);
-    if (!slot.ok()) return slot.status();
-    stream_ = *std::move(slot);
+    SG_ASSIGN_OR_RETURN(AdmittedStream admitted,
+                        AdmitStream(*state_, context_, Role::kRead, &log_));
+    caller_ = std::move(admitted.caller);
+    stream_ = std::move(admitted.slot);
     absl::StatusOr<std::string> id = ParseGridName(request_->name(), "name");
     if (!id.ok()) return id.status();
     id_ = *std::move(id);

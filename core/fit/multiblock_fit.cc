@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <numeric>
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
@@ -10,6 +9,7 @@
 #include "core/fit/adaptive_engine.h"
 #include "core/fit/segment_model.h"
 #include "core/util/status_macros.h"
+#include "core/util/union_find.h"
 
 namespace splinegrid {
 namespace {
@@ -17,38 +17,31 @@ namespace {
 // Refinement level of the wall curvature samples: three samples between grid points.
 constexpr int kCurvatureLevel = 2;
 
-// Union-find over (block, control index) pairs.
-class ControlSets {
+// Union-find over (block, control index) pairs: a control's id is its block's offset plus its
+// index, so the first block in order owns a shared boundary (UnionFind keeps the smaller id).
+class ControlSets : public UnionFind {
  public:
-  explicit ControlSets(const std::vector<FittedBlock>& blocks) {
-    offsets_.push_back(0);
-    for (const FittedBlock& b : blocks)
-      offsets_.push_back(offsets_.back() + b.spline.num_control_points());
-    parent_.resize(offsets_.back());
-    std::iota(parent_.begin(), parent_.end(), 0);
-  }
+  explicit ControlSets(const std::vector<FittedBlock>& blocks) : ControlSets(Offsets(blocks)) {}
   int64_t Id(int b, int64_t c) const { return offsets_[b] + c; }
-  int64_t Find(int64_t x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  // The smaller id becomes the representative: the first block in order owns a boundary.
-  void Union(int64_t x, int64_t y) {
-    x = Find(x);
-    y = Find(y);
-    if (x != y) parent_[std::max(x, y)] = std::min(x, y);
-  }
   std::pair<int, int64_t> Locate(int64_t id) const {
     const int b = static_cast<int>(std::upper_bound(offsets_.begin(), offsets_.end(), id) -
                                    offsets_.begin()) -
                   1;
     return {b, id - offsets_[b]};
   }
-  int64_t size() const { return offsets_.back(); }
 
  private:
+  explicit ControlSets(std::vector<int64_t> offsets)
+      : UnionFind(offsets.back()), offsets_(std::move(offsets)) {}
+  // 0, then the running totals of the blocks' controls.
+  static std::vector<int64_t> Offsets(const std::vector<FittedBlock>& blocks) {
+    std::vector<int64_t> offsets = {0};
+    for (const FittedBlock& b : blocks) {
+      offsets.push_back(offsets.back() + b.spline.num_control_points());
+    }
+    return offsets;
+  }
   std::vector<int64_t> offsets_;
-  std::vector<int64_t> parent_;
 };
 
 // The control index box of pole p in a spline with `n` controls per direction: every control
@@ -133,7 +126,7 @@ double CopySharedControls(const SegmentModel& model, const Connectivity& connect
   for (const FittedBlock& b : blocks) extents.push_back(b.spline.control_extents());
   ControlSets sets(blocks);
   for (const auto& [x, y] : model.MatchedControls(connectivity, extents)) {
-    sets.Union(sets.Id(x.first, x.second), sets.Id(y.first, y.second));
+    sets.Join(sets.Id(x.first, x.second), sets.Id(y.first, y.second));
   }
   for (const Pole& p : poles) {
     const Extents& n = extents[p.block];
@@ -141,7 +134,7 @@ double CopySharedControls(const SegmentModel& model, const Connectivity& connect
     ForEachPoleLine(p, grid.blocks[p.block], n, [&](const Extents& at) {
       const int64_t first = at[0] + int64_t{n[0]} * (at[1] + int64_t{n[1]} * at[2]);
       for (int a = 1; a < n[p.d]; ++a) {
-        sets.Union(sets.Id(p.block, first), sets.Id(p.block, first + a * stride));
+        sets.Join(sets.Id(p.block, first), sets.Id(p.block, first + a * stride));
       }
     });
   }

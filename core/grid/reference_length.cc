@@ -5,11 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/util/union_find.h"
 
 namespace splinegrid {
 namespace {
@@ -24,24 +24,6 @@ double Distance2(const Point3& p, const Point3& q) {
   for (int c = 0; c < 3; ++c) d2 += (p[c] - q[c]) * (p[c] - q[c]);
   return d2;
 }
-
-// Disjoint sets with path halving.
-class UnionFind {
- public:
-  explicit UnionFind(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int Find(int x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  void Join(int a, int b) {
-    a = Find(a);
-    b = Find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<int> parent_;
-};
 
 // A wall's diameter and the two points that span it.
 struct Diameter {
@@ -199,7 +181,7 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
           const auto it = cells.find({key[0] + dx, key[1] + dy, key[2] + dz});
           if (it == cells.end()) continue;
           for (int q : it->second) {
-            if (Distance2(points[p], points[q]) <= eps * eps) walls.Join(static_cast<int>(p), q);
+            if (Distance2(points[p], points[q]) <= eps * eps) walls.Join(static_cast<int64_t>(p), q);
           }
         }
       }
@@ -209,7 +191,7 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
   std::map<int, std::vector<Point3>> members;
   std::map<int, int> first_block;
   for (size_t p = 0; p < points.size(); ++p) {
-    const int root = walls.Find(static_cast<int>(p));
+    const int root = static_cast<int>(walls.Find(static_cast<int64_t>(p)));
     members[root].push_back(points[p]);
     first_block.try_emplace(root, point_block[p]);
   }

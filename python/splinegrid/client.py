@@ -101,23 +101,7 @@ from splinegrid.v1 import grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
-__all__ = [
-    "GRID_ROUTING_HEADER",
-    "SERVICE",
-    "ArchiveSummary",
-    "BoundaryPoints",
-    "Client",
-    "EvaluatedBlock",
-    "EvaluatedGrid",
-    "EvaluatedPoints",
-    "FullGrid",
-    "RetryPolicy",
-    "RevisionWatch",
-    "SplineArrays",
-    "SplinegridError",
-    "WallCurvatureLine",
-    "grid_name",
-]
+__all__ = ["Client"]  # the package (splinegrid/__init__.py) exports the rest from their modules
 
 
 UPLOAD_CHUNK_BYTES = 1 << 20  # Plot3D bytes or point coordinates per upload message
