@@ -37,10 +37,12 @@ constexpr int kScreenCorrections = 3;
 constexpr double kScreenMargin = 1.5;
 // Removal passes over the knots (each pass tries every knot once).
 constexpr int kRemovalPasses = 3;
-// A merge of neighbouring knots a < b tries one knot at a + w (b - a) for these w, in order.
-// Measured on dense_profile_test's 12 fits: the midpoint alone saved 0-2 controls per fit, the
-// thirds 0-1 more (the 30P30N main element at 2e-4 chord: 23, 22, 21), for ~40% more time.
-constexpr double kMergePositions[] = {0.5, 1.0 / 3.0, 2.0 / 3.0};
+// Merges (MergeCandidates) replace two or three neighbouring knots by one fewer: a pair a < b by
+// one knot at a + f (b - a) for f = 1/2, 1/3, 2/3; a triple a < b < c by the midpoints of its
+// pairs (knot averaging), else by [a, c]'s thirds. Measured on dense_profile_test's 15 fits:
+// the pair midpoint alone saved 0-2 controls per fit, the pair thirds 0-1 more (the 30P30N
+// main element at 2e-4 chord: 23, 22, 21), the triples 0-1 more (NACA 0012 at 20,000 points
+// and 1e-4: 17 -> 16, where 5,000 points resampled need 15), each for ~15-40% more time.
 // Coarse to fine (CoarseStart): outlines of at least kCoarseStride * kCoarsePoints points place
 // their knots on every kCoarseStride-th point first.
 constexpr int kCoarseStride = 4;
@@ -62,6 +64,17 @@ constexpr double kCurvatureGuard = 2.0;
 // radius of curvature. Measured on dense_profile_test's cases with the restriction always on:
 // 0.5 fitted all of them, 4 still left a densified RAE 2822 with a cusp.
 constexpr double kMaxFocalRatio = 0.5;
+
+// Candidate knots to replace the neighbouring knots `window` (2 or 3 of them) by one fewer,
+// best first (the merge rule above).
+std::vector<std::vector<double>> MergeCandidates(std::span<const double> window) {
+  if (window.size() == 2) {
+    const double a = window[0], b = window[1];
+    return {{a + (b - a) / 2.0}, {a + (b - a) / 3.0}, {a + 2.0 * (b - a) / 3.0}};
+  }
+  const double a = window[0], b = window[1], c = window[2];
+  return {{(a + b) / 2.0, (b + c) / 2.0}, {a + (c - a) / 3.0, a + 2.0 * (c - a) / 3.0}};
+}
 
 // |J_q| of `curve` at its simple interior knots, in knot order: the scaled jumps of the third
 // derivative (fairing.h, ScaledDerivativeJumps) of both coordinates.
@@ -339,21 +352,26 @@ absl::StatusOr<Placement> PlaceKnots(
     out.removed += removed;
     if (removed == 0) break;
   }
-  // Merges: two neighbouring simple knots replaced by one between them (kMergePositions), until
-  // a sweep keeps none.
-  for (bool merged = remove && out.stop.empty(); merged;) {
-    merged = false;
-    for (size_t i = 0; i + 1 < out.interior.size(); ++i) {
-      const double a = out.interior[i], b = out.interior[i + 1];
-      if (!simple(out.interior, a) || !simple(out.interior, b)) continue;
-      for (double w : kMergePositions) {
-        std::vector<double> trial = out.interior;
-        trial.erase(trial.begin() + i, trial.begin() + i + 2);
-        trial.insert(trial.begin() + i, a + w * (b - a));
-        SG_ASSIGN_OR_RETURN(const bool kept, keep_if_met(std::move(trial)));
-        if (kept) {
-          ++out.removed, merged = true;
-          break;
+  // Merges: neighbouring simple knots replaced by one fewer (MergeCandidates), pairs until a
+  // sweep keeps none, then triples likewise.
+  for (int width : {2, 3}) {
+    for (bool merged = remove && out.stop.empty(); merged;) {
+      merged = false;
+      for (size_t i = 0; i + width <= out.interior.size(); ++i) {
+        const std::span<const double> window(out.interior.data() + i, width);
+        if (!std::all_of(window.begin(), window.end(),
+                         [&](double t) { return simple(out.interior, t); })) {
+          continue;
+        }
+        for (const std::vector<double>& fewer : MergeCandidates(window)) {
+          std::vector<double> trial = out.interior;
+          trial.erase(trial.begin() + i, trial.begin() + i + width);
+          trial.insert(trial.begin() + i, fewer.begin(), fewer.end());
+          SG_ASSIGN_OR_RETURN(const bool kept, keep_if_met(std::move(trial)));
+          if (kept) {
+            ++out.removed, merged = true;
+            break;
+          }
         }
       }
     }
