@@ -201,6 +201,10 @@ class GridStore {
     return Get(id);
   }
 
+  // Whether Get and GetHolding answer from this process's memory (a lookup, no I/O), so that a
+  // handler may call them on a gRPC thread instead of the worker pool.
+  virtual bool ReadsAreLocal() const { return false; }
+
   // Publishes `revision` (its number is assigned here: latest + 1) as the grid's newest, drops
   // deformed revisions beyond the retention limit, tells the grid's watchers and returns the new
   // snapshot; NOT_FOUND if the grid was deleted meanwhile, ABORTED if `expected_latest` is not 0

@@ -1,5 +1,10 @@
 // Service benchmarks over loopback TCP. The server runs in a child process pinned to CPU 0
 // (one server core: the worker pool has one thread), the client in this process on CPU 1.
+// Beside the service runs a raw gRPC baseline (raw_baseline_server: the smallest callback
+// service, gRPC's defaults) started the same way; its benchmarks run first, and the service's
+// report `vs_raw`, their rate as a fraction of the baseline's in the same run.
+//   BM_RawUnary              the baseline's unary call (24-byte reply), 16 in flight
+//   BM_RawStream             the baseline's server stream of prebuilt 256 KiB messages
 //   BM_EvaluateGridStream    payload bytes/s of EvaluateGrid for a volume of >= 50M points
 //   BM_EvaluatePointsUnary   one-point EvaluatePoints calls with 16 in flight: calls/s, p50/p99
 //   BM_FitThroughApi         FitGrid latency for every shared grid, tolerances by boundary kind
@@ -26,6 +31,7 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -33,6 +39,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bench/grid_samples.h"
+#include "bench/service/raw_baseline.grpc.pb.h"
 #include "benchmark/benchmark.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
@@ -63,26 +70,34 @@ int FreePort() {
   return ntohs(addr.sin_port);
 }
 
-// The real `splinegrid serve` in a child process pinned to CPU 0 (exec'd, not just forked: gRPC
-// does not survive fork), on a free loopback port, with one worker thread.
+// A server binary in a child process pinned to CPU 0 (exec'd, not just forked: gRPC does not
+// survive fork), on a free loopback port; this process moves to CPU 1. By default the real
+// `splinegrid serve` with one worker thread.
 class ServerProcess {
  public:
-  ServerProcess() : port_(FreePort()) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the benchmark
-      PinToCpu(0);
-      const std::string binary = SPLINEGRID_BINARY_DIR "/splinegrid";
-      const std::string address = absl::StrCat("--address=127.0.0.1:", port_);
-      execl(binary.c_str(), binary.c_str(), "serve", address.c_str(), "--threads=1",
-            "--log_calls=false", "--max_output_points=2147483648", static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    PinToCpu(1);
+  ServerProcess()
+      : ServerProcess("splinegrid", {"serve", "--threads=1", "--log_calls=false",
+                                     "--max_output_points=2147483648"}) {
     auto client = client::Client::Connect(target());
     for (int i = 0; i < 200 && !client->Health().ok(); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(25));
     }
+  }
+  // `binary` (in the build directory) with `args` and --address=127.0.0.1:PORT.
+  ServerProcess(const std::string& binary, std::vector<std::string> args) : port_(FreePort()) {
+    args.push_back(absl::StrCat("--address=127.0.0.1:", port_));
+    pid_ = fork();
+    if (pid_ == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the benchmark
+      PinToCpu(0);
+      const std::string path = absl::StrCat(SPLINEGRID_BINARY_DIR, "/", binary);
+      std::vector<char*> argv = {const_cast<char*>(path.c_str())};
+      for (std::string& arg : args) argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(path.c_str(), argv.data());
+      _exit(127);
+    }
+    PinToCpu(1);
   }
   ~ServerProcess() {
     kill(pid_, SIGKILL);
@@ -104,6 +119,47 @@ class ServerProcess {
   pid_t pid_ = -1;
 };
 
+// The raw baseline's rates in this run (0 until its benchmark ran).
+struct Baseline {
+  double unary_calls_per_s = 0.0;
+  double stream_bytes_per_s = 0.0;
+};
+Baseline& RawBaselineRates() {
+  static Baseline baseline;
+  return baseline;
+}
+
+// The raw baseline server (bench/service/raw_baseline_server) and a stub on one channel with
+// the settings of client::Client::Connect.
+struct RawServer {
+  ServerProcess process{"bench/raw_baseline_server", {}};
+  std::shared_ptr<grpc::Channel> channel;
+  std::unique_ptr<RawBaseline::Stub> stub;
+  RawServer() {
+    grpc::ChannelArguments args;
+    args.SetMaxReceiveMessageSize(8 << 20);
+    channel = grpc::CreateCustomChannel(process.target(), grpc::InsecureChannelCredentials(), args);
+    channel->WaitForConnected(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    stub = RawBaseline::NewStub(channel);
+  }
+};
+RawServer& SharedRawServer() {
+  static RawServer* server = new RawServer();
+  return *server;
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
+  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
+}
+
+double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 ServerProcess& SharedServer() {
   static ServerProcess* server = new ServerProcess();
   return *server;
@@ -117,6 +173,117 @@ void BM_IdleServerMemory(benchmark::State& state) {
   state.counters["resident_MiB"] = server.ResidentMiB();
 }
 BENCHMARK(BM_IdleServerMemory)->Iterations(1);
+
+// Unary calls, kUnaryInFlight at a time (callback API): `start(done)` issues one call and runs
+// done(ok) when it ends. Sets items/s, p50_us and p99_us; returns calls per second (0 when a
+// call failed).
+constexpr int kUnaryInFlight = 16;
+double RunUnaryCalls(benchmark::State& state, int64_t calls,
+                     const std::function<void(std::function<void(bool)>)>& start) {
+  std::vector<double> latencies;
+  latencies.reserve(calls);
+  std::mutex mu;
+  std::condition_variable done_cv;
+  int64_t started = 0, finished = 0;
+  std::atomic<int64_t> failures{0};
+  std::function<void()> launch = [&] {
+    const auto begin = std::chrono::steady_clock::now();
+    start([&, begin](bool ok) {
+      const double us = MicrosecondsSince(begin);
+      if (!ok) ++failures;
+      bool more;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        latencies.push_back(us);
+        ++finished;
+        more = started < calls;
+        if (more) ++started;
+      }
+      if (more) {
+        launch();
+      } else {
+        done_cv.notify_all();
+      }
+    });
+  };
+  double seconds = 0.0;
+  for (auto _ : state) {
+    const auto begin = std::chrono::steady_clock::now();
+    const int64_t first = std::min<int64_t>(kUnaryInFlight, calls);
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      started = first;
+      finished = 0;
+      latencies.clear();
+    }
+    for (int64_t i = 0; i < first; ++i) launch();
+    std::unique_lock<std::mutex> lock(mu);
+    done_cv.wait(lock, [&] { return finished == calls; });
+    seconds = MicrosecondsSince(begin) * 1e-6;
+  }
+  if (failures > 0) {
+    state.SkipWithError("some calls failed");
+    return 0.0;
+  }
+  std::sort(latencies.begin(), latencies.end());
+  state.SetItemsProcessed(calls);
+  state.counters["p50_us"] = latencies[latencies.size() / 2];
+  state.counters["p99_us"] = latencies[latencies.size() * 99 / 100];
+  return static_cast<double>(calls) / seconds;
+}
+
+// The baseline's unary call: request and reply shaped like a one-point EvaluatePoints.
+void BM_RawUnary(benchmark::State& state) {
+  RawServer& raw = SharedRawServer();
+  UnaryRequest request;
+  request.set_name("grids/m6");
+  request.add_blocks(1);
+  for (double p : {0.3, 0.7, 0.0}) request.add_parameters(p);
+  struct Call {
+    grpc::ClientContext context;
+    UnaryReply reply;
+  };
+  RawBaselineRates().unary_calls_per_s =
+      RunUnaryCalls(state, state.range(0), [&](std::function<void(bool)> done) {
+        auto* call = new Call();
+        raw.stub->async()->Unary(&call->context, &request, &call->reply,
+                                 [call, done = std::move(done)](grpc::Status status) {
+                                   const bool ok = status.ok() && call->reply.values_size() == 3;
+                                   delete call;
+                                   done(ok);
+                                 });
+      });
+}
+BENCHMARK(BM_RawUnary)
+    ->Arg(200000)
+    ->ArgName("calls")
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+// The baseline's server stream: as many payload bytes as BM_EvaluateGridStream's double
+// evaluation (370^3 points x 3 doubles), in messages of EvaluateGrid's chunk size (256 KiB).
+constexpr int64_t kStreamPoints = int64_t{370} * 370 * 370;
+void BM_RawStream(benchmark::State& state) {
+  RawServer& raw = SharedRawServer();
+  StreamRequest request;
+  request.set_total_bytes(kStreamPoints * 3 * 8);
+  request.set_chunk_bytes(256 << 10);
+  int64_t bytes = 0;
+  double seconds = 0.0;
+  for (auto _ : state) {
+    const auto begin = std::chrono::steady_clock::now();
+    grpc::ClientContext context;
+    std::unique_ptr<grpc::ClientReader<StreamChunk>> reader = raw.stub->Stream(&context, request);
+    StreamChunk chunk;
+    while (reader->Read(&chunk)) bytes += 8 * int64_t{chunk.values_size()};
+    if (!reader->Finish().ok()) return state.SkipWithError("Stream failed");
+    seconds += MicrosecondsSince(begin) * 1e-6;
+  }
+  state.SetBytesProcessed(bytes);
+  RawBaselineRates().stream_bytes_per_s = static_cast<double>(bytes) / seconds;
+}
+BENCHMARK(BM_RawStream)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 // A 64^3 volume fitted with 24^3 control points, evaluated at 370^3 = 50.65M points.
 void BM_EvaluateGridStream(benchmark::State& state) {
@@ -136,12 +303,14 @@ void BM_EvaluateGridStream(benchmark::State& state) {
   }
   v1::EvaluateGridRequest request;
   request.set_name("grids/volume");
-  request.mutable_counts()->set_i(370);
+  request.mutable_counts()->set_i(370);  // kStreamPoints
   request.mutable_counts()->set_j(370);
   request.mutable_counts()->set_k(370);
   request.set_precision(single ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
   int64_t bytes = 0, points = 0;
+  double seconds = 0.0;
   for (auto _ : state) {
+    const auto begin = std::chrono::steady_clock::now();
     grpc::ClientContext context;
     auto reader = client->stub().EvaluateGrid(&context, request);
     v1::EvaluateGridResponse message;
@@ -153,9 +322,14 @@ void BM_EvaluateGridStream(benchmark::State& state) {
       bytes += message.chunk().values_size() * 8 + message.chunk().float_values_size() * 4;
     }
     if (!reader->Finish().ok()) return state.SkipWithError("EvaluateGrid failed");
+    seconds += MicrosecondsSince(begin) * 1e-6;
   }
   state.SetBytesProcessed(bytes);
   state.SetItemsProcessed(points);
+  if (RawBaselineRates().stream_bytes_per_s > 0.0) {
+    state.counters["vs_raw"] =
+        static_cast<double>(bytes) / seconds / RawBaselineRates().stream_bytes_per_s;
+  }
 }
 BENCHMARK(BM_EvaluateGridStream)
     ->Arg(0)
@@ -167,7 +341,6 @@ BENCHMARK(BM_EvaluateGridStream)
 
 // One-point EvaluatePoints calls, 16 in flight (callback API), latencies recorded per call.
 void BM_EvaluatePointsUnary(benchmark::State& state) {
-  constexpr int kInFlight = 16;
   auto client = client::Client::Connect(SharedServer().target());
   static bool imported = false;
   if (!imported) {
@@ -186,57 +359,21 @@ void BM_EvaluatePointsUnary(benchmark::State& state) {
   request.add_parameters(0.3);
   request.add_parameters(0.7);
   request.add_parameters(0.0);
-  const int64_t calls = state.range(0);
-  std::vector<double> latencies;
-  latencies.reserve(calls);
-  std::mutex mu;
-  std::condition_variable done_cv;
-  int64_t started = 0, finished = 0;
-  std::atomic<int64_t> failures{0};
   struct Call {
     grpc::ClientContext context;
     v1::EvaluatePointsResponse response;
-    std::chrono::steady_clock::time_point start;
   };
-  std::function<void()> launch = [&] {
+  const double rate = RunUnaryCalls(state, state.range(0), [&](std::function<void(bool)> done) {
     auto* call = new Call();
-    call->start = std::chrono::steady_clock::now();
-    client->stub().async()->EvaluatePoints(
-        &call->context, &request, &call->response, [&, call](grpc::Status status) {
-          const double us = std::chrono::duration<double, std::micro>(
-                                std::chrono::steady_clock::now() - call->start)
-                                .count();
-          delete call;
-          if (!status.ok()) ++failures;
-          bool more;
-          {
-            std::lock_guard<std::mutex> lock(mu);
-            latencies.push_back(us);
-            ++finished;
-            more = started < calls;
-            if (more) ++started;
-          }
-          if (more) {
-            launch();
-          } else {
-            done_cv.notify_all();
-          }
-        });
-  };
-  for (auto _ : state) {
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      started = std::min<int64_t>(kInFlight, calls);
-    }
-    for (int i = 0; i < std::min<int64_t>(kInFlight, calls); ++i) launch();
-    std::unique_lock<std::mutex> lock(mu);
-    done_cv.wait(lock, [&] { return finished == calls; });
+    client->stub().async()->EvaluatePoints(&call->context, &request, &call->response,
+                                           [call, done = std::move(done)](grpc::Status status) {
+                                             delete call;
+                                             done(status.ok());
+                                           });
+  });
+  if (RawBaselineRates().unary_calls_per_s > 0.0) {
+    state.counters["vs_raw"] = rate / RawBaselineRates().unary_calls_per_s;
   }
-  if (failures > 0) return state.SkipWithError("some calls failed");
-  std::sort(latencies.begin(), latencies.end());
-  state.SetItemsProcessed(calls);
-  state.counters["p50_us"] = latencies[latencies.size() / 2];
-  state.counters["p99_us"] = latencies[latencies.size() * 99 / 100];
 }
 BENCHMARK(BM_EvaluatePointsUnary)
     ->Arg(200000)
@@ -297,18 +434,6 @@ int64_t ImportPitchGrid(client::Client& client, const std::string& id, std::stri
     return 0;
   }
   return fit->revision();
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
-  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
-}
-
-double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 v1::DeformGridRequest PitchRequest(const std::string& id, int64_t reference, double degrees) {

@@ -43,6 +43,7 @@ class MemoryStore final : public GridStore {
 
   absl::Status Create(std::shared_ptr<const StoredGrid> grid) override;
   absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) override;
+  bool ReadsAreLocal() const override { return true; }  // the dir: log is only written
   absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
       const std::string& id, GridRevision revision, int64_t expected_latest = 0) override;
   absl::Status Delete(const std::string& id, const DeleteCheck& check = nullptr) override;
