@@ -52,25 +52,24 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
   // up to the grid's creation, so a kept one for the same shape decides (a grid deleted and made
   // again under the same id builds once on the cheap lane); reference 0 (the latest) is long.
   const absl::StatusOr<std::string> grid_id = ParseGridName(request->name(), "name");
-  const WorkKind kind =
-      grid_id.ok() && request->reference_revision() > 0 &&
-              state_->deformers.HasAny(
-                  DeformerShapeKey(*grid_id, request->reference_revision(), *request))
-          ? WorkKind::kCheap
-          : WorkKind::kLong;
+  const WorkKind kind = grid_id.ok() && request->reference_revision() > 0 &&
+                                state_->deformers.HasAny(DeformerShapeKey(
+                                    *grid_id, request->reference_revision(), *request))
+                            ? WorkKind::kCheap
+                            : WorkKind::kLong;
   return RunOnPool(
       context, log, Role::kWrite, kind,
       [this, request, response, cancel](const Caller&) -> absl::Status {
         const auto start = std::chrono::steady_clock::now();
         SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
         // The base is checked again, atomically, when the revision is added.
-        SG_ASSIGN_OR_RETURN(
-            const std::shared_ptr<const StoredGrid> grid,
-            state_->store->GetHolding(id, {request->base_revision(), request->reference_revision()}));
-        if (request->base_revision() < 0 || request->reference_revision() < 0) {
-          return absl::InvalidArgumentError(absl::StrCat(
-              "base_revision = ", request->base_revision(), " and reference_revision = ",
-              request->reference_revision(), " must not be negative"));
+        SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                            state_->store->GetHolding(
+                                id, {request->base_revision(), request->reference_revision()}));
+        // The base is compared with the latest, not looked up: a stale one is ABORTED.
+        if (request->base_revision() < 0) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("base_revision = ", request->base_revision(), " is negative"));
         }
         if (request->check_level() < 0 || request->check_level() > kMaxCheckLevel) {
           return absl::InvalidArgumentError(absl::StrCat("check_level = ", request->check_level(),
@@ -92,7 +91,8 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
                                                  " is stale; the latest revision is ", latest));
         }
         SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> reference,
-                            grid->FindRevision(request->reference_revision()));
+                            grid->ResolveRevision(request->reference_revision(), std::nullopt,
+                                                  "reference_revision"));
         SG_ASSIGN_OR_RETURN(
             const std::shared_ptr<const Deformer> deformer,
             state_->deformers.Get(

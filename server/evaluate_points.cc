@@ -64,7 +64,7 @@ grpc::ServerUnaryReactor* SplineGridService::EvaluatePoints(
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
                         state_->store->GetHolding(id, {request->revision()}));
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> rev,
-                        grid->FindRevision(request->revision(), OptionalStep(*request)));
+                        grid->ResolveRevision(request->revision(), OptionalStep(*request)));
     SG_ASSIGN_OR_RETURN(const int64_t n,
                         CheckRequest(*request, *rev, state_->options.max_output_points));
     const int s = rev->blocks.front().fitted.spline.spatial_dim();

@@ -96,12 +96,8 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   absl::StatusOr<std::unique_ptr<v1::EvaluateGridResponse>> Plan() {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
     SG_ASSIGN_OR_RETURN(grid_, state_->store->GetHolding(id, {request_->revision()}));
-    if (request_->revision() < 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("revision = ", request_->revision(), " is negative"));
-    }
     SG_ASSIGN_OR_RETURN(revision_,
-                        grid_->FindRevision(request_->revision(), OptionalStep(*request_)));
+                        grid_->ResolveRevision(request_->revision(), OptionalStep(*request_)));
     SG_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(*request_));
     const int num_blocks = static_cast<int>(revision_->blocks.size());
     std::vector<int> blocks(request_->blocks().begin(), request_->blocks().end());
@@ -149,13 +145,13 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
           (int64_t{(*extents)[0]} + (*extents)[1] + (*extents)[2]) * int64_t{sizeof(double)};
     }
     // Reserved before the parameters are sampled: a small request may ask for 2^30 of them.
-    SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(
-                                     work_bytes + param_bytes + int64_t{kMaxReady + 4} * kChunkBytes,
-                                     "the evaluation"));
+    SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(work_bytes + param_bytes +
+                                                            int64_t{kMaxReady + 4} * kChunkBytes,
+                                                        "the evaluation"));
     for (BlockPlan& block : plan_) {
-      SG_ASSIGN_OR_RETURN(block.params,
-                          SampleParameters(revision_->blocks[block.block].fitted.distribution,
-                                           resolution));
+      SG_ASSIGN_OR_RETURN(
+          block.params,
+          SampleParameters(revision_->blocks[block.block].fitted.distribution, resolution));
     }
     h->set_revision(revision_->number);
     h->set_spatial_dim(s);

@@ -91,12 +91,8 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
       [this, request, response, cancel](const Caller&) -> absl::Status {
         SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
         SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-        if (request->revision() < 0) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("revision = ", request->revision(), " is negative"));
-        }
         SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
-                            grid->FindRevision(request->revision()));
+                            grid->ResolveRevision(request->revision()));
         GridFitOptions options = parent->fit_options;
         if (request->has_fairing()) {
           SG_ASSIGN_OR_RETURN(options.fairing, ParseFairing(request->fairing(), "fairing"));

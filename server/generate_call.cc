@@ -52,12 +52,8 @@ absl::StatusOr<GridFitOptions> GeneratedFitOptions(const v1::GenerateGridRequest
 absl::StatusOr<ProfileSource> StoredWallProfile(GridStore& store, const v1::StoredWall& wall) {
   SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(wall.name(), "stored_wall.name"));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, store.Get(id));
-  if (wall.revision() < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("stored_wall.revision = ", wall.revision(), " is negative"));
-  }
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> revision,
-                      grid->FindRevision(wall.revision()));
+                      grid->ResolveRevision(wall.revision(), std::nullopt, "stored_wall.revision"));
   const int num_blocks = static_cast<int>(revision->blocks.size());
   const int b = wall.block();
   if (b < 0 || b >= num_blocks) {
@@ -144,9 +140,9 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
   const auto start = std::chrono::steady_clock::now();
   const std::string& id = request.grid_id();
   if (!id.empty() && !IsValidGridId(id)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "grid_id = ", QuoteClientString(id),
-        " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("grid_id = ", QuoteClientString(id),
+                     " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
   }
   if (request.display_name().size() > 1024) {
     return absl::InvalidArgumentError("display_name is longer than 1024 bytes");

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "proto/convert/plot3d_format_convert.h"
 #include "proto/convert/source_boundaries_convert.h"
@@ -84,17 +85,11 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   for (const auto& r : grid.revisions) {
     EncodeRevisionInfo(RevisionSummary::Of(*r), out->add_revisions());
   }
-  if (grid.revisions.empty()) {
-    if (revision != 0) {
-      return absl::NotFoundError(absl::StrCat("grids/", grid.id, " has no revision ", revision,
-                                              " (it has not been fitted yet)"));
-    }
-    return absl::OkStatus();
-  }
+  if (grid.revisions.empty() && revision == 0) return absl::OkStatus();  // not fitted yet
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> found,
+                      grid.ResolveRevision(revision));
   out->set_latest_revision(grid.revisions.back()->number);
-  absl::StatusOr<std::shared_ptr<const GridRevision>> found = grid.FindRevision(revision);
-  if (!found.ok()) return found.status();
-  const GridRevision& rev = **found;
+  const GridRevision& rev = *found;
   const int num_blocks = static_cast<int>(rev.blocks.size());
   for (int b : blocks) {
     if (b < 0 || b >= num_blocks) {

@@ -40,7 +40,23 @@ bool DroppedSome(const StoredGrid& grid) {
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(int64_t number) const {
+absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
+    int64_t number, std::optional<int64_t> step, const char* field) const {
+  if (number < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(field, " = ", number, " is negative"));
+  }
+  if (step) {
+    if (number != 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, " = ", number, " and step = ", *step, " are both given; give one"));
+    }
+    for (auto it = revisions.rbegin(); it != revisions.rend(); ++it) {
+      if ((*it)->origin == RevisionOrigin::kDeform && (*it)->step == *step) return *it;
+    }
+    return absl::NotFoundError(absl::StrCat(
+        "grids/", id, " has no revision of step ", *step,
+        DroppedSome(*this) ? " (older deformed revisions were dropped by retention)" : ""));
+  }
   if (revisions.empty()) {
     return absl::FailedPreconditionError(
         absl::StrCat("grids/", id, " has no revision yet; call FitGrid first"));
@@ -51,7 +67,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(int
       [](const std::shared_ptr<const GridRevision>& r, int64_t n) { return r->number < n; });
   if (it != revisions.end() && (*it)->number == number) return *it;
   const int64_t latest = revisions.back()->number;
-  if (number > 0 && number < latest) {
+  if (number < latest) {
     return absl::NotFoundError(absl::StrCat(
         "grids/", id, " revision ", number,
         " was dropped by retention: a grid keeps its fitted and faired revisions and only its "
@@ -60,21 +76,6 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(int
   }
   return absl::NotFoundError(
       absl::StrCat("grids/", id, " has no revision ", number, " (latest is ", latest, ")"));
-}
-
-absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::FindRevision(
-    int64_t number, std::optional<int64_t> step) const {
-  if (!step) return FindRevision(number);
-  if (number != 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("revision = ", number, " and step = ", *step, " are both given; give one"));
-  }
-  for (auto it = revisions.rbegin(); it != revisions.rend(); ++it) {
-    if ((*it)->origin == RevisionOrigin::kDeform && (*it)->step == *step) return *it;
-  }
-  return absl::NotFoundError(absl::StrCat(
-      "grids/", id, " has no revision of step ", *step,
-      DroppedSome(*this) ? " (older deformed revisions were dropped by retention)" : ""));
 }
 
 bool GridSubscription::Next(RevisionSummary* revision, End* end) {

@@ -103,13 +103,14 @@ struct StoredGrid {
   std::shared_ptr<const SourcePoints> source;
   std::vector<std::shared_ptr<const GridRevision>> revisions;  // ascending numbers
 
-  // The revision `number` (0: the latest), or NOT_FOUND (saying so when retention dropped it:
-  // a missing number below the latest) / FAILED_PRECONDITION (none yet).
-  absl::StatusOr<std::shared_ptr<const GridRevision>> FindRevision(int64_t number) const;
-  // The revision `number`, or with `step` the latest deformed revision of that time step
-  // (INVALID_ARGUMENT if both are given; NOT_FOUND if no revision has the step).
-  absl::StatusOr<std::shared_ptr<const GridRevision>> FindRevision(
-      int64_t number, std::optional<int64_t> step) const;
+  // The revision `number` of the request's field `field` (0: the latest), or with `step` the
+  // latest deformed revision of that time step. Every handler resolves revisions here, so the
+  // errors are the same for every call: INVALID_ARGUMENT naming the field for a negative number
+  // or for both a number and a step; NOT_FOUND for a number or step the grid does not have
+  // (saying so when retention dropped it); FAILED_PRECONDITION when it has no revision yet.
+  absl::StatusOr<std::shared_ptr<const GridRevision>> ResolveRevision(
+      int64_t number, std::optional<int64_t> step = std::nullopt,
+      const char* field = "revision") const;
 };
 
 // The receiving end of a GridSubscription (implemented by the WatchGrid reactor).

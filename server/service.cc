@@ -152,15 +152,11 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
   auto work = [this, request, response](const Caller&) -> absl::Status {
     SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request->name(), "name"));
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
-    if (request->revision() < 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("revision = ", request->revision(), " is negative"));
-    }
     const std::vector<int> blocks(request->blocks().begin(), request->blocks().end());
     int64_t revision = request->revision();
     if (request->has_step()) {
       SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> found,
-                          grid->FindRevision(revision, OptionalStep(*request)));
+                          grid->ResolveRevision(revision, OptionalStep(*request)));
       revision = found->number;
     }
     return EncodeGrid(*grid, revision, request->view(), blocks, response);

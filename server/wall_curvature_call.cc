@@ -20,12 +20,8 @@ absl::Status WallCurvature(const StoredGrid& grid, const v1::GetWallCurvatureReq
     return absl::InvalidArgumentError(
         absl::StrCat("refinement_level = ", level, " is outside [0, ", kMaxCurvatureLevel, "]"));
   }
-  if (request.revision() < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("revision = ", request.revision(), " is negative"));
-  }
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> revision,
-                      grid.FindRevision(request.revision()));
+                      grid.ResolveRevision(request.revision()));
   const int num_blocks = static_cast<int>(revision->blocks.size());
   std::vector<bool> wanted(num_blocks, request.blocks().empty());
   for (int b : request.blocks()) {

@@ -184,7 +184,7 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::GetHolding(
             snapshots_.Recent(id, options_.cached_read_window)) {
       const StoredGrid& grid = *cached->snapshot;
       if (std::all_of(numbers.begin(), numbers.end(),
-                      [&](int64_t n) { return grid.FindRevision(n).ok(); })) {
+                      [&](int64_t n) { return grid.ResolveRevision(n).ok(); })) {
         return std::move(cached->snapshot);
       }
     }

@@ -534,7 +534,7 @@ TEST_F(RedisStoreTest, RetentionDropsOldDeformedRevisionsAndNumbersAreNeverReuse
   EXPECT_THAT(Numbers(*a_->Get("g").value()), ElementsAre(1, 3, 4));
   const auto on_b = b_->Get("g").value();
   EXPECT_THAT(Numbers(*on_b), ElementsAre(1, 3, 4));
-  EXPECT_THAT(on_b->FindRevision(2).status(),
+  EXPECT_THAT(on_b->ResolveRevision(2).status(),
               StatusIs(absl::StatusCode::kNotFound, "dropped by retention"));
   ASSERT_TRUE(b_->AddRevision("g", MakeRevision(RevisionOrigin::kFair, 1)).ok());  // 5
   EXPECT_EQ(Deform(*a_, "g"), 6);

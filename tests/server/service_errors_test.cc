@@ -224,6 +224,54 @@ TEST_F(ServiceErrorsTest, BadEvaluationsAreRejected) {
               StatusIs(absl::StatusCode::kInvalidArgument, "blocks[0] = 2"));
 }
 
+// Every call that names a revision resolves it in one place (StoredGrid::ResolveRevision): a
+// negative one is INVALID_ARGUMENT naming the field, an absent one NOT_FOUND, in every call.
+TEST_F(ServiceErrorsTest, RevisionsResolveAlikeInEveryCall) {
+  std::vector<std::pair<std::string, absl::Status>> negative, absent;
+  for (int64_t revision : {-1, 9}) {
+    auto& out = revision < 0 ? negative : absent;
+    v1::EvaluateGridRequest grid;
+    grid.set_name("naca");
+    grid.set_revision(revision);
+    out.emplace_back("EvaluateGrid", client_->Evaluate(grid).status());
+    v1::EvaluatePointsRequest points;
+    points.set_name("naca");
+    points.set_revision(revision);
+    points.add_blocks(0);
+    for (int c = 0; c < 3; ++c) points.add_parameters(0.5);
+    out.emplace_back("EvaluatePoints", client_->EvaluatePoints(points).status());
+    out.emplace_back("GetGrid", client_->Get("naca", revision).status());
+    out.emplace_back("FairGrid", client_->Fair("naca", revision).status());
+    out.emplace_back("GetWallCurvature", client_->WallCurvature("naca", revision, 0).status());
+    v1::DeformGridRequest deform;
+    deform.set_name("naca");
+    deform.set_reference_revision(revision);
+    deform.mutable_rigid()->set_angle_degrees(1.0);
+    out.emplace_back("DeformGrid", client_->Deform(deform).status());
+    v1::GenerateGridRequest generate;
+    generate.set_grid_id("generated");
+    generate.mutable_stored_wall()->set_name("grids/naca");
+    generate.mutable_stored_wall()->set_revision(revision);
+    out.emplace_back("GenerateGrid", client_->Generate(generate).status());
+  }
+  for (const auto& [call, status] : negative) {
+    const std::string field = call == "DeformGrid"     ? "reference_revision = -1"
+                              : call == "GenerateGrid" ? "stored_wall.revision = -1"
+                                                       : "revision = -1";
+    EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument, field + " is negative"))
+        << call;
+  }
+  for (const auto& [call, status] : absent) {
+    EXPECT_THAT(status, StatusIs(absl::StatusCode::kNotFound, "has no revision 9")) << call;
+  }
+  v1::DeformGridRequest stale_base;
+  stale_base.set_name("naca");
+  stale_base.set_base_revision(-2);
+  stale_base.mutable_rigid()->set_angle_degrees(1.0);
+  EXPECT_THAT(client_->Deform(stale_base).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "base_revision = -2 is negative"));
+}
+
 TEST_F(ServiceErrorsTest, UnfittedGridHasNoRevisionToEvaluate) {
   ImportShared("surfaces/even_sphere.fmt", "raw");
   v1::EvaluateGridRequest request;
