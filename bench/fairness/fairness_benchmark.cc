@@ -48,6 +48,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "bench/latency.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
 #include "tests/core/test_data.h"
@@ -77,13 +78,6 @@ constexpr char kAirfoil[] = "airfoils/naca0012.dat";
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
-  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
 }
 
 // A `splinegrid serve` on a free loopback port, with 2 workers and `flags`; stopped (SIGTERM)

@@ -39,6 +39,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bench/grid_samples.h"
+#include "bench/latency.h"
 #include "bench/service/raw_baseline.grpc.pb.h"
 #include "benchmark/benchmark.h"
 #include "client/client.h"
@@ -146,18 +147,6 @@ struct RawServer {
 RawServer& SharedRawServer() {
   static RawServer* server = new RawServer();
   return *server;
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
-  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
-}
-
-double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 ServerProcess& SharedServer() {

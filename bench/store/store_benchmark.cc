@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "bench/latency.h"
 #include "benchmark/benchmark.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
@@ -254,18 +255,6 @@ std::unique_ptr<client::Client> Connect(int target, std::string* error) {
   }
   if (port == 0) return nullptr;
   return client::Client::Connect(Address(port));
-}
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * values.size()));
-  return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
-}
-
-double MicrosecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 // Results of earlier benchmarks of this run, for the ratios ("deform/0/p50" ...).
