@@ -75,17 +75,6 @@ void SegmentIncrements(const RowSoA<S>& a, int64_t a_offset, const RowSoA<S>& b,
   }
 }
 
-// The same for interleaved points (rows of different k-planes, read once each).
-template <int S, Parametrization P>
-void SegmentIncrements(const double* __restrict a, const double* __restrict b, int64_t count,
-                       double* __restrict out) {
-  for (int64_t i = 0; i < count; ++i) {
-    double d2 = 0.0;
-    for (int c = 0; c < S; ++c) d2 += (b[S * i + c] - a[S * i + c]) * (b[S * i + c] - a[S * i + c]);
-    out[i] = Increment<P>(d2);
-  }
-}
-
 // sum_x a[x] * b[x] (b == nullptr: sum_x a[x]) with eight independent partial sums, so that
 // the loop vectorises instead of waiting on one chain of dependent additions.
 double Dot(const double* a, const double* b, int64_t n) {
@@ -115,8 +104,12 @@ inline double InverseLength(double length) {
 //  - i: each grid row is a whole line, normalised at once;
 //  - j: a k-plane holds whole j-lines; their increments wait for the end of the plane;
 //  - k: lines span the block; their increments wait for the end of the block.
-// Memory beyond the input: two rows, the j-increments of one plane and the k-increments of the
-// block (each a third of the input at most; the first for surfaces, the second for volumes).
+// Every row is read once, into coordinate arrays (RowSoA); the last row read at each j is kept,
+// so that a row's j-neighbour (the row before it in this plane) and its k-neighbour (the same
+// row of the previous plane) are at hand without reading the points again (reading them twice,
+// interleaved, took 10% longer at 128^3).
+// Memory beyond the input: one plane of points (two rows for surfaces), the j-increments of one
+// plane and the k-increments of the block (a third of the input for volumes).
 template <int S, Parametrization P>
 std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
   const Extents& n = block.extents();
@@ -128,12 +121,15 @@ std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
   std::unique_ptr<double[]> inc_k(new double[(nk - 1) * plane]);
   std::vector<double> inc_i(ni), length_j(ni), length_k(nk > 1 ? plane : 0, 0.0);
   const double* coords = block.coords().data();
-  RowSoA<S> row, next;
+  // last[slot(j)]: row j of the current plane once read, else of the previous plane. A surface
+  // needs only the previous row.
+  auto slot = [nk](int64_t j) { return nk > 1 ? j : j % 2; };
+  std::vector<RowSoA<S>> last(nk > 1 ? nj : 2);
+  RowSoA<S> row;
   for (int64_t k = 0; k < nk; ++k) {
-    const double* plane_k = coords + S * plane * k;
-    row.Load(plane_k, ni);
     std::fill(length_j.begin(), length_j.end(), 0.0);
     for (int64_t j = 0; j < nj; ++j) {
+      row.Load(coords + S * (plane * k + ni * j), ni);
       if (ni > 1) {
         SegmentIncrements<S, P>(row, 0, row, 1, ni - 1, inc_i.data());
         if (const double inv = InverseLength(Dot(inc_i.data(), nullptr, ni - 1)); inv > 0.0) {
@@ -141,20 +137,18 @@ std::array<LineAverage, 3> SweepIncrements(const StructuredBlock& block) {
           ++avg[0].lines;
         }
       }
-      if (j + 1 < nj) {
-        next.Load(plane_k + S * ni * (j + 1), ni);
-        double* inc = plane_j.get() + ni * j;
-        SegmentIncrements<S, P>(row, 0, next, 0, ni, inc);
+      if (j > 0) {
+        double* inc = plane_j.get() + ni * (j - 1);
+        SegmentIncrements<S, P>(last[slot(j - 1)], 0, row, 0, ni, inc);
         for (int64_t i = 0; i < ni; ++i) length_j[i] += inc[i];
       }
-      if (k + 1 < nk) {
-        const double* p = plane_k + S * ni * j;
-        double* inc = inc_k.get() + plane * k + ni * j;
-        SegmentIncrements<S, P>(p, p + S * plane, ni, inc);
+      if (k > 0) {
+        double* inc = inc_k.get() + plane * (k - 1) + ni * j;
+        SegmentIncrements<S, P>(last[j], 0, row, 0, ni, inc);
         double* length = length_k.data() + ni * j;
         for (int64_t i = 0; i < ni; ++i) length[i] += inc[i];
       }
-      std::swap(row, next);
+      std::swap(last[slot(j)], row);
     }
     if (nj > 1) {
       for (double& len : length_j) {
