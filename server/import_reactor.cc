@@ -88,6 +88,12 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
         return absl::InvalidArgumentError(
             absl::StrCat("header.plot3d.total_bytes = ", total, "; must be positive"));
       }
+      if (header.plot3d().planar_view() && header.plot3d().planar_view_if_two_planes()) {
+        return absl::InvalidArgumentError(
+            "header.plot3d.planar_view and header.plot3d.planar_view_if_two_planes are both "
+            "true; give one (planar_view fails for a file that is not a two-plane grid, "
+            "planar_view_if_two_planes stores such a file as read)");
+      }
       return absl::OkStatus();  // charged as the bytes arrive (AcceptBytes)
     }
     if (header.has_cgns()) {
@@ -118,9 +124,9 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
       SG_RETURN_IF_ERROR(ValidateExtents(extents, absl::StrCat("header.points.blocks[", b, "]")));
       extents_.push_back(extents);
     }
-    coords_.resize(extents_.size());  // empty: they grow as points arrive (AcceptPoints)
+    coords_.resize(extents_.size());           // empty: they grow as points arrive (AcceptPoints)
     header_.mutable_points()->clear_blocks();  // kept in extents_
-    ReleaseMessage();  // drops the header's capacity
+    ReleaseMessage();                          // drops the header's capacity
     return absl::OkStatus();
   }
 
@@ -169,18 +175,20 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
 
   // Decodes a CGNS upload in a child process (on the pool); its boundaries go to `boundaries`
   // and its stated 1-to-1 connections to connections_ (compared with the found ones in Store).
-  absl::StatusOr<MultiBlockGrid> BuildCgnsSource(std::string* format, SourceBoundaries* boundaries) {
+  absl::StatusOr<MultiBlockGrid> BuildCgnsSource(std::string* format,
+                                                 SourceBoundaries* boundaries) {
     if (static_cast<int64_t>(bytes_.size()) != header_.cgns().total_bytes()) {
       return absl::InvalidArgumentError(absl::StrCat("cgns: ", bytes_.size(),
                                                      " bytes arrived but the header announced ",
                                                      header_.cgns().total_bytes()));
     }
-    SG_ASSIGN_OR_RETURN(ImportedGrid imported,
-                        DecodeCgnsUpload(bytes_, state_->options.cgns_decoder, &state_->budget,
-                                         &grid_memory_, [this] { return context_->IsCancelled(); }));
+    SG_ASSIGN_OR_RETURN(
+        ImportedGrid imported,
+        DecodeCgnsUpload(bytes_, state_->options.cgns_decoder, &state_->budget, &grid_memory_,
+                         [this] { return context_->IsCancelled(); }));
     bytes_ = std::string();
-    SG_RETURN_IF_ERROR(state_->budget.Resize(&grid_memory_, SourceBytes(imported.grid),
-                                             "the imported grid"));
+    SG_RETURN_IF_ERROR(
+        state_->budget.Resize(&grid_memory_, SourceBytes(imported.grid), "the imported grid"));
     *format = std::move(imported.format);
     *boundaries = std::move(imported.boundaries);
     connections_ = std::move(imported.connections);
@@ -210,7 +218,8 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
           state_->budget.Resize(&grid_memory_, SourceBytes(grid), "the imported grid"));
       *format = absl::StrCat("plot3d ", DescribePlot3dFormat(detected));
       plot3d_format_.emplace().file = detected;  // kept so evaluations can be written back alike
-      if (header_.plot3d().planar_view()) {
+      if (header_.plot3d().planar_view() ||
+          (header_.plot3d().planar_view_if_two_planes() && IsTwoPlaneGrid(grid))) {
         SG_RETURN_IF_ERROR(
             state_->budget.Resize(&grid_memory_, 2 * SourceBytes(grid), "the planar view"));
         SG_ASSIGN_OR_RETURN(grid, PlanarView(grid, {}, &plot3d_format_->two_planes));
@@ -258,8 +267,8 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
         state_->budget.Resize(&grid_memory_, SourceBytes(source->grid), "the imported grid"));
     source->memory = std::move(grid_memory_);
     SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
-    for (std::string& note : CompareConnections(connections_, source->connectivity,
-                                                source->boundaries.block_names)) {
+    for (std::string& note :
+         CompareConnections(connections_, source->connectivity, source->boundaries.block_names)) {
       source->boundaries.notes.push_back(std::move(note));
     }
     auto grid = std::make_shared<StoredGrid>();
@@ -279,11 +288,11 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
   v1::ImportHeader header_;
   MemoryReservation upload_;       // what arrived (capacity), charged as it grows
   MemoryReservation grid_memory_;  // the grid being built: the parser's bound, then its size
-  std::string bytes_;                         // Plot3D or CGNS file
+  std::string bytes_;              // Plot3D or CGNS file
   std::optional<Plot3dSourceFormat> plot3d_format_;  // Plot3D source: its layout, once parsed
-  std::vector<Extents> extents_;              // points source: the header's blocks
-  std::vector<std::vector<double>> coords_;   // and their coordinates so far
-  std::vector<StatedConnection> connections_;  // CGNS source: the file's 1-to-1 connections
+  std::vector<Extents> extents_;                     // points source: the header's blocks
+  std::vector<std::vector<double>> coords_;          // and their coordinates so far
+  std::vector<StatedConnection> connections_;        // CGNS source: the file's 1-to-1 connections
 };
 
 }  // namespace

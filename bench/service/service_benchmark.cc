@@ -44,8 +44,6 @@
 #include "benchmark/benchmark.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
-#include "core/io/planar_view.h"
-#include "core/io/plot3d.h"
 #include "tests/core/test_data.h"
 
 namespace splinegrid::bench {
@@ -390,10 +388,13 @@ void BM_FitThroughApi(benchmark::State& state) {
   state.SetLabel(file);
   auto client = client::Client::Connect(SharedServer().target());
   const std::string bytes = ReadFileToString(SharedDataPath(file)).value();
-  const bool planar = IsTwoPlaneGrid(ParsePlot3d(bytes, file).value());
+  v1::Plot3dSource as_the_cli_does;
+  as_the_cli_does.set_planar_view_if_two_planes(true);
   const std::string id = absl::StrCat("fit-", state.range(0));
   (void)client->Delete(id);
-  if (!client->ImportPlot3d(bytes, id, file, planar).ok()) return state.SkipWithError("import");
+  if (!client->ImportPlot3d(bytes, id, file, as_the_cli_does).ok()) {
+    return state.SkipWithError("import");
+  }
   v1::FitSpec spec;
   spec.mutable_boundary_tolerances();
   double ratio = 0.0;

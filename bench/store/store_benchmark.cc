@@ -42,8 +42,6 @@
 #include "benchmark/benchmark.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
-#include "core/io/planar_view.h"
-#include "core/io/plot3d.h"
 #include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
@@ -271,11 +269,12 @@ absl::StatusOr<v1::FitGridResponse> ImportAndFit(client::Client& client, const s
                                                  double* fit_us) {
   absl::StatusOr<std::string> bytes = ReadFileToString(SharedDataPath(file));
   if (!bytes.ok()) return bytes.status();
-  absl::StatusOr<MultiBlockGrid> parsed = ParsePlot3d(*bytes, file);
-  if (!parsed.ok()) return parsed.status();
-  const bool planar = IsTwoPlaneGrid(*parsed);
+  v1::Plot3dSource as_the_cli_does;
+  as_the_cli_does.set_planar_view_if_two_planes(true);
   auto start = std::chrono::steady_clock::now();
-  if (absl::Status s = client.ImportPlot3d(*bytes, id, file, planar).status(); !s.ok()) return s;
+  if (absl::Status s = client.ImportPlot3d(*bytes, id, file, as_the_cli_does).status(); !s.ok()) {
+    return s;
+  }
   *import_us = MicrosecondsSince(start);
   v1::FitSpec spec;
   spec.mutable_boundary_tolerances();

@@ -33,12 +33,10 @@
 #include "core/fit/airfoil_fit.h"
 #include "core/io/airfoil.h"
 #include "core/io/file_util.h"
-#include "core/io/planar_view.h"
-#include "core/io/plot3d.h"
 #include "core/io/record_file.h"
-#include "proto/convert/plot3d_format_convert.h"
 #include "core/util/status_macros.h"
 #include "io/cgns/cgns_io.h"
+#include "proto/convert/plot3d_format_convert.h"
 #include "server/server.h"
 
 namespace splinegrid::cli {
@@ -338,25 +336,17 @@ absl::Status Fit(const Args& args) {
   }
   // --plot3d_layout: the value order of 3D text and C-stream files (Fortran records show it).
   SG_ASSIGN_OR_RETURN(const v1::Plot3dLayout layout, Plot3dLayoutFlag());
-  Plot3dReadOptions read_options;
-  read_options.layout = Plot3dLayoutFromProto(layout);
-  // Only two-plane files get the planar view; anything else is stored as read.
-  bool planar = false;
-  if (!cgns && absl::GetFlag(FLAGS_planar)) {
-    absl::StatusOr<MultiBlockGrid> local = ParsePlot3d(bytes, path, read_options);
-    if (!local.ok()) return local.status();
-    planar = IsTwoPlaneGrid(*local);
-  }
+  // --planar: the server stores the planar view of two-plane files, anything else as read.
   v1::Plot3dSource plot3d_options;
-  plot3d_options.set_planar_view(planar);
+  plot3d_options.set_planar_view_if_two_planes(absl::GetFlag(FLAGS_planar));
   plot3d_options.set_layout(layout);
   ProgressLine upload("upload");
   const std::string grid_id = client::GridName(id).substr(6);
   const std::string display_name = std::filesystem::path(path).filename().string();
-  SG_ASSIGN_OR_RETURN(const v1::Grid grid,
-                      cgns ? client->ImportCgns(bytes, grid_id, display_name, upload.callback())
-                           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options,
-                                                  upload.callback()));
+  SG_ASSIGN_OR_RETURN(
+      const v1::Grid grid,
+      cgns ? client->ImportCgns(bytes, grid_id, display_name, upload.callback())
+           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options, upload.callback()));
   upload.Done();
   // What the import mapped with a choice or left out (CGNS), never silently.
   for (const std::string& note : grid.source().boundaries().notes()) {

@@ -90,7 +90,6 @@ from splinegrid._transport import (GRID_ROUTING_HEADER, SERVICE, _as, _Attempt,
                                    _decode_health_response, _encode_health_request, _read_pem,
                                    _routing_grid, _routing_metadata, _serialize, Metadata)
 from splinegrid.filekind import FileKind, detect_file_kind
-from splinegrid.plot3d import two_plane_file
 from splinegrid.errors import SplinegridError, _code, _data_loss, _translated_errors
 from splinegrid.results import (ArchiveSummary, BoundaryPoints, EvaluatedBlock, EvaluatedGrid,
                                 EvaluatedPoints, FaceRangeLike, FullGrid, SplineArrays,
@@ -281,7 +280,7 @@ class Client:
         its contents before anything is sent (:func:`splinegrid.filekind.detect_file_kind`):
         an ``.sgrid`` archive goes to :meth:`import_archive` (``grid_id`` "" keeps the
         archive's id), a CGNS file to :meth:`import_cgns`, anything else to
-        :meth:`import_plot3d` (planar view decided locally). ``display_name`` defaults to the
+        :meth:`import_plot3d` (the server stores the planar view of two-plane files). ``display_name`` defaults to the
         file's name (Plot3D, CGNS). Returns the grid (BASIC view)."""
         kind = detect_file_kind(path)
         if kind is FileKind.ARCHIVE:
@@ -299,15 +298,14 @@ class Client:
         The file goes in 1 MiB pieces after an ImportHeader, once. ``grid_id`` is the new
         name's last segment ("" lets the server pick). ``planar_view=True`` stores the 2-D view
         of a grid held as two planes (CFL3D style) and fails for any other grid; ``False``
-        stores the file as read. ``None`` (the default) decides before the upload: planar
-        exactly when the file is a two-plane grid, read here as the server would
-        (:func:`splinegrid.plot3d.two_plane_file`; only files with an extent of 2 are read in
-        full, a layout it does not read is stored as read).
+        stores the file as read. ``None`` (the default) lets the server decide from the file it
+        parsed: the planar view exactly when every block is a two-plane block
+        (``planar_view_if_two_planes``; ``grid.source.format`` then ends in ", planar view").
         """
         data = _read_bytes(path_or_bytes)
-        if planar_view is None:
-            planar_view = two_plane_file(data)
-        source = service_pb2.Plot3dSource(total_bytes=len(data), planar_view=planar_view)
+        source = service_pb2.Plot3dSource(total_bytes=len(data),
+                                          planar_view=planar_view is True,
+                                          planar_view_if_two_planes=planar_view is None)
         header = service_pb2.ImportHeader(grid_id=_grid_id(grid_id), display_name=display_name,
                                           plot3d=source)
         return self._upload_file(header, _PLOT3D_CHUNK_FIELD, data)

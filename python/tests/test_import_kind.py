@@ -1,7 +1,11 @@
 """The import path decides what a file is before uploading it, and uploads it once: file kinds
-by content, the two-plane (planar view) decision on the shared grids in every layout read
-locally, one ImportGrid call per import (counted by a fake server), and the real server
-agreeing with the decision."""
+by content, one ImportGrid call per import (counted by a fake server) asking for the planar view
+of two-plane files, and the real server deciding it for the shared grids in every Plot3D layout
+(text, Fortran records, C stream; either byte order, single or double, with and without
+iblank)."""
+
+import itertools
+import re
 
 import struct
 from concurrent import futures
@@ -10,7 +14,7 @@ import grpc
 import numpy as np
 import pytest
 
-from splinegrid import Client, FileKind, RetryPolicy, detect_file_kind, plot3d, records
+from splinegrid import Client, FileKind, RetryPolicy, detect_file_kind, records
 from splinegrid.v1 import archive_pb2, grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
@@ -24,8 +28,21 @@ M6 = DATA / "surfaces" / "m6_small.fmt"
 
 
 def text_blocks(path):
-    blocks = plot3d.read_3d_blocks(path.read_bytes())
-    assert blocks is not None, path
+    """The blocks of a 3-D formatted Plot3D file with a block count, as (nk, nj, ni, 3) arrays
+    (Fortran ``n*value`` repeats and ``D`` exponents expanded): enough for the shared files."""
+    values = []
+    for token in re.split(r"[\s,]+", path.read_text().strip()):
+        count, _, value = token.rpartition("*")
+        values += [float(value.replace("D", "E").replace("d", "e"))] * int(count or 1)
+    nblocks = int(values[0])
+    extents = [tuple(int(v) for v in values[1 + 3 * b:4 + 3 * b]) for b in range(nblocks)]
+    at, blocks = 1 + 3 * nblocks, []
+    for ni, nj, nk in extents:
+        n = ni * nj * nk
+        xyz = np.array(values[at:at + 3 * n]).reshape(3, nk, nj, ni)
+        blocks.append(np.moveaxis(xyz, 0, -1))
+        at += 3 * n
+    assert at == len(values), path
     return blocks
 
 
@@ -75,56 +92,55 @@ class TestFileKind:
             detect_file_kind(tmp_path / "none.x")
 
 
-class TestTwoPlane:
-    def test_shared_grids(self):
-        assert plot3d.two_plane_file(RAE.read_bytes())
-        assert plot3d.two_plane_file(PITCH.read_bytes())
-        assert not plot3d.two_plane_file(NACA.read_bytes())   # 2-D: nothing to drop
-        assert not plot3d.two_plane_file(M6.read_bytes())     # no extent 2
-        box = text_blocks(BOX)
-        assert box[0].shape == (6, 2, 6, 3)
-        assert not plot3d.two_plane_file(BOX.read_bytes())    # planes differ in-plane
+_ids = itertools.count()
 
-    def test_text_layout_is_whole(self):
+
+class TestServerDecidesPlanarView:
+    def test_text_reader_of_these_tests(self):
         (block,) = text_blocks(RAE)
         assert block.shape == (97, 257, 2, 3)                 # (nk, nj, ni, 3)
         assert np.all(block[:, :, 0, 1] == 0.0) and np.all(block[:, :, 1, 1] == -1.0)
         assert block[0, 0, 0, 0] == 20.0                      # "2*20." expands along i
+        assert text_blocks(BOX)[0].shape == (6, 2, 6, 3)
+
+    def test_shared_grids(self, server):
+        with Client(server, timeout=60) as client:
+            for path, dim, planar in [(RAE, 2, True), (PITCH, 2, True), (NACA, 2, False),
+                                      (M6, 3, False), (BOX, 3, False)]:
+                grid = client.import_plot3d(str(path), grid_id=f"shared-{next(_ids)}")
+                assert grid.source.spatial_dim == dim, path
+                assert grid.source.format.endswith(", planar view") is planar, path
 
     @pytest.mark.parametrize("order", "<>")
     @pytest.mark.parametrize("real", ["f8", "f4"])
     @pytest.mark.parametrize("iblank", [False, True])
     @pytest.mark.parametrize("writer", [fortran_records, c_stream])
-    def test_binary_layouts(self, order, real, iblank, writer):
-        rae = text_blocks(RAE)
-        data = writer(rae, order=order, real=real, iblank=iblank)
-        blocks = plot3d.read_3d_blocks(data)
-        assert blocks is not None and blocks[0].shape == rae[0].shape
-        np.testing.assert_allclose(blocks[0], rae[0], rtol=1e-6 if real == "f4" else 0)
-        assert plot3d.two_plane_file(data)
-        assert not plot3d.two_plane_file(writer(text_blocks(BOX), order=order, real=real,
-                                                 iblank=iblank))
+    def test_binary_layouts(self, server, order, real, iblank, writer):
+        with Client(server, timeout=60) as client:
+            rae = writer(text_blocks(RAE), order=order, real=real, iblank=iblank)
+            grid = client.import_plot3d(rae, grid_id=f"rae-{next(_ids)}")
+            assert grid.source.spatial_dim == 2
+            assert [(b.i, b.j, b.k) for b in grid.source.blocks] == [(257, 97, 1)]
+            box = writer(text_blocks(BOX), order=order, real=real, iblank=iblank)
+            assert client.import_plot3d(box, grid_id=f"box-{next(_ids)}").source.spatial_dim == 3
 
-    def test_single_block_without_count(self):
-        assert plot3d.two_plane_file(fortran_records(text_blocks(RAE), count=False))
-        assert plot3d.two_plane_file(c_stream(text_blocks(RAE), count=False))
+    def test_single_block_without_count(self, server):
+        with Client(server, timeout=60) as client:
+            for writer in (fortran_records, c_stream):
+                data = writer(text_blocks(RAE), count=False)
+                assert client.import_plot3d(data, grid_id=f"one-{next(_ids)}").source.spatial_dim == 2
 
-    def test_one_moved_point_breaks_it(self):
+    def test_one_moved_point_keeps_the_file_as_read(self, server):
         (block,) = text_blocks(RAE)
-        block = block.copy()
-        block[40, 100, 1, 0] += 1e-3                          # x differs between the planes
-        assert not plot3d.is_two_plane_block(block)
-        assert not plot3d.two_plane_file(fortran_records([block]))
-        block[40, 100, 1, 0] -= 1e-3
-        block[40, 100, 1, 1] = -1.0 + 1e-3                    # y not constant on plane 1
-        assert not plot3d.is_two_plane_block(block)
-
-    def test_unreadable_files_are_not_two_plane(self):
-        good = RAE.read_bytes()
-        assert not plot3d.two_plane_file(good[:-200])          # truncated: counts differ
-        assert not plot3d.two_plane_file(fortran_records(text_blocks(RAE))[:-4])
-        assert not plot3d.two_plane_file(b"\x00\x01garbage")
-        assert not plot3d.two_plane_file(b"")
+        with Client(server, timeout=60) as client:
+            moved = block.copy()
+            moved[40, 100, 1, 0] += 1e-3                      # x differs between the planes
+            grid = client.import_plot3d(fortran_records([moved]), grid_id=f"moved-{next(_ids)}")
+            assert grid.source.spatial_dim == 3
+            moved = block.copy()
+            moved[40, 100, 1, 1] = -1.0 + 1e-3                # y not constant on plane 1
+            grid = client.import_plot3d(fortran_records([moved]), grid_id=f"moved-{next(_ids)}")
+            assert grid.source.spatial_dim == 3
 
 
 class CountingImports(service_grpc.SplineGridServicer):
@@ -162,14 +178,13 @@ def counting():
 
 
 class TestOneUpload:
-    @pytest.mark.parametrize("path, planar", [(RAE, True), (PITCH, True), (NACA, False),
-                                              (BOX, False)])
-    def test_planar_decided_before_the_upload(self, counting, path, planar):
+    @pytest.mark.parametrize("path", [RAE, NACA, BOX])
+    def test_the_server_decides_the_planar_view(self, counting, path):
         fake, client = counting
         client.import_plot3d(str(path), grid_id="g")
         assert len(fake.imports) == 1
         header, size = fake.imports[0]
-        assert header.plot3d.planar_view is planar
+        assert header.plot3d.planar_view_if_two_planes and not header.plot3d.planar_view
         assert size == header.plot3d.total_bytes == path.stat().st_size
 
     def test_import_file_uses_the_file_name(self, counting):
@@ -177,12 +192,15 @@ class TestOneUpload:
         client.import_file(RAE, grid_id="rae")
         (header, _), = fake.imports
         assert (header.grid_id, header.display_name) == ("rae", RAE.name)
-        assert header.plot3d.planar_view
+        assert header.plot3d.planar_view_if_two_planes
 
     def test_explicit_planar_view_is_kept(self, counting):
         fake, client = counting
         client.import_plot3d(RAE.read_bytes(), grid_id="g", planar_view=False)
-        assert fake.imports[0][0].plot3d.planar_view is False
+        client.import_plot3d(RAE.read_bytes(), grid_id="h", planar_view=True)
+        as_read, planar = (header.plot3d for header, _ in fake.imports)
+        assert not as_read.planar_view and not as_read.planar_view_if_two_planes
+        assert planar.planar_view and not planar.planar_view_if_two_planes
 
     def test_archive_goes_to_import_archive(self, counting, tmp_path):
         fake, client = counting
@@ -204,20 +222,3 @@ class TestOneUpload:
         assert header.WhichOneof("source") == "cgns"
         assert size == header.cgns.total_bytes == 72
         assert header.display_name == "grid.x"
-
-
-class TestRealServer:
-    """The server reads the files as the local decision assumed."""
-
-    def test_two_plane_file_is_stored_planar(self, server):
-        with Client(server, timeout=60) as client:
-            grid = client.import_file(RAE, grid_id="rae-planar")
-            assert grid.source.spatial_dim == 2
-            assert [(b.i, b.j, b.k) for b in grid.source.blocks] == [(257, 97, 1)]
-            naca = client.import_file(NACA, grid_id="naca-as-read")
-            assert naca.source.spatial_dim == 2
-            box = client.import_file(BOX, grid_id="box-as-read")
-            assert box.source.spatial_dim == 3
-            assert {g.name for g in client.list()} >= {"grids/rae-planar",
-                                                       "grids/naca-as-read",
-                                                       "grids/box-as-read"}

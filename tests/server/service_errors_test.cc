@@ -155,6 +155,13 @@ TEST_F(ServiceErrorsTest, MalformedImportsAreInvalid) {
               StatusIs(absl::StatusCode::kInvalidArgument, "plot3d"));
   EXPECT_THAT(client_->ImportPlot3d("1\n2 2\n0 1 0 1 0 0 1 1\n", "g", "", /*planar=*/true).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, ""));
+  // Two ways of asking for the planar view at once: refused before any byte is sent.
+  v1::Plot3dSource both;
+  both.set_planar_view(true);
+  both.set_planar_view_if_two_planes(true);
+  EXPECT_THAT(client_->ImportPlot3d("1\n2 2\n0 1 0 1 0 0 1 1\n", "g", "", both).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "header.plot3d.planar_view and header.plot3d.planar_view_if_two_planes"));
   // Announced size not matched.
   v1::ImportGridRequest header;
   header.mutable_header()->set_grid_id("g");

@@ -39,6 +39,31 @@ TEST_F(ServiceTest, ImportPlanarViewOfTwoPlaneFile) {
   EXPECT_THAT(grid.source().format(), HasSubstr("planar view"));
 }
 
+// planar_view_if_two_planes (what the CLI and the Python client send): the server decides from
+// the file it parsed; a 3D file with an extent of 2 that is a real box and a 2D file are stored
+// as read.
+TEST_F(ServiceTest, ImportPlanarViewIfTwoPlanesIsDecidedByTheServer) {
+  auto import = [&](const std::string& relative, const std::string& id) {
+    v1::Plot3dSource options;
+    options.set_planar_view_if_two_planes(true);
+    const std::string bytes = ReadFileToString(SharedDataPath(relative)).value();
+    absl::StatusOr<v1::Grid> grid = client_->ImportPlot3d(bytes, id, relative, options);
+    EXPECT_TRUE(grid.ok()) << relative << ": " << grid.status();
+    return grid.ok() ? *grid : v1::Grid();
+  };
+  const v1::Grid rae = import("grids/rae2822_257x97.fmt", "rae");
+  EXPECT_EQ(rae.source().spatial_dim(), 2);
+  EXPECT_EQ(rae.source().blocks(0).k(), 1);
+  EXPECT_THAT(rae.source().format(), HasSubstr("planar view"));
+  const v1::Grid box = import("surfaces/ffd_box_6x2x6.fmt", "box");
+  EXPECT_EQ(box.source().spatial_dim(), 3);
+  EXPECT_EQ(box.source().blocks(0).j(), 2);
+  EXPECT_THAT(box.source().format(), ::testing::Not(HasSubstr("planar view")));
+  const v1::Grid naca = import("grids/n0012_225-65.p2dfmt", "naca");
+  EXPECT_EQ(naca.source().spatial_dim(), 2);
+  EXPECT_THAT(naca.source().format(), ::testing::Not(HasSubstr("planar view")));
+}
+
 TEST_F(ServiceTest, ImportPointsWithServerChosenId) {
   const MultiBlockGrid sphere = ReadShared("surfaces/even_sphere.fmt");
   const v1::Grid grid = client_->ImportPoints(sphere, "", "sphere").value();
