@@ -48,15 +48,15 @@ absl::StatusOr<CgnsOutputContext> FetchCgnsOutputContext(client::Client& client,
   return context;
 }
 
-absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, const client::EvaluatedGrid& result,
+absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, client::EvaluatedGrid result,
                                         const CgnsOutputContext* context) {
   MultiBlockGrid grid;
   CgnsWriteOptions options;
   int64_t points = 0;
-  for (const client::EvaluatedBlock& block : result.blocks) {
-    grid.blocks.push_back(block.points);
+  for (client::EvaluatedBlock& block : result.blocks) {
     options.source_blocks.push_back(block.block);
     points += block.points.num_points();
+    grid.blocks.push_back(std::move(block.points));
   }
   if (context != nullptr) {
     const v1::SourceGrid& source = context->grid.source();

@@ -31,8 +31,9 @@ absl::StatusOr<CgnsOutputContext> FetchCgnsOutputContext(client::Client& client,
 
 // Writes `result` to `out`; with a context also the boundary conditions and 1-to-1 connections
 // of the written blocks (what cannot be written, e.g. hanging-node matches, is printed as a
-// note on stderr). Returns the number of points written.
-absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, const client::EvaluatedGrid& result,
+// note on stderr). Returns the number of points written. Takes `result` by value and moves its
+// blocks into the written grid (pass it with std::move: an evaluation can be gigabytes).
+absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, client::EvaluatedGrid result,
                                         const CgnsOutputContext* context);
 
 }  // namespace splinegrid::cli

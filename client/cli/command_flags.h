@@ -2,8 +2,9 @@
 // summary and the flags it reads. main.cc checks a command line against it before any flag is
 // parsed (command_line.h), and `splinegrid help CMD` prints it (command_help.h).
 //
-// The flags themselves stay Abseil flags (ABSL_FLAG in flags.cc, read with absl::GetFlag in
-// commands.cc); this table only says which command reads which. When a command starts reading a
+// The flags themselves stay Abseil flags (ABSL_FLAG in flags.cc, read with absl::GetFlag in the
+// command files, *_command(s).cc and command_util.cc); this table only says which command reads
+// which. When a command starts reading a
 // flag, add its name here: cli_tests fails for a flag that is defined but listed for no command,
 // and for a listed name that is not a defined flag.
 #ifndef SPLINEGRID_CLIENT_CLI_COMMAND_FLAGS_H_

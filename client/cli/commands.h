@@ -1,6 +1,11 @@
 // The `splinegrid` subcommands. Each takes its positional arguments (after the subcommand) and
 // reads the global flags; it prints its result to stdout (human-readable, or JSON with --json)
 // and returns the status that decides the exit code.
+//
+// One file per command or family: serve_command.cc, fit_commands.cc (fit, fair),
+// grid_commands.cc (get, list, rm, health), eval_command.cc, curvature_commands.cc (curvature,
+// airfoil), deform_command.cc, offset_command.cc, watch_command.cc, archive_commands.cc (export,
+// import); the helpers they share are command_util.h, PrepareConnection is command_util.cc.
 #ifndef SPLINEGRID_CLIENT_CLI_COMMANDS_H_
 #define SPLINEGRID_CLIENT_CLI_COMMANDS_H_
 

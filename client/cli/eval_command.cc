@@ -1,182 +1,121 @@
-#include "client/cli/eval_command.h"
-
-#include <stdlib.h>
-
-#include <cerrno>
-#include <filesystem>
-#include <map>
+// `splinegrid eval`: the EvaluateGrid request from the flags, then one output file or a series.
+#include <algorithm>
+#include <cstdio>
+#include <optional>
 #include <vector>
 
-#include "absl/cleanup/cleanup.h"
 #include "absl/flags/flag.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
-#include "client/cli/command_line.h"
+#include "client/cli/cgns_output.h"
+#include "client/cli/command_util.h"
+#include "client/cli/commands.h"
+#include "client/cli/eval_output.h"
+#include "client/cli/eval_support.h"
 #include "client/cli/flags.h"
-#include "core/io/file_util.h"
-#include "core/io/record_file.h"
+#include "client/cli/grid_output.h"
+#include "client/cli/output.h"
+#include "client/client.h"
 #include "core/util/status_macros.h"
-#include "proto/convert/archive_convert.h"
-#include "splinegrid/v1/archive.pb.h"
 
 namespace splinegrid::cli {
-namespace {
 
-// "a:b" -> {a, b} with 0 <= a <= b.
-absl::StatusOr<std::pair<int64_t, int64_t>> ParseSteps(const std::string& text) {
-  const std::vector<std::string> ends = absl::StrSplit(text, ':');
-  int64_t first = 0, last = 0;
-  if (ends.size() != 2 || !absl::SimpleAtoi(ends[0], &first) || !absl::SimpleAtoi(ends[1], &last) ||
-      first < 0 || last < first) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--steps = '", text, "': give a:b with 0 <= a <= b (time steps a to b)"));
+absl::Status Eval(const Args& args) {
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (args.size() != 1 || out.empty()) {
+    return Usage(
+        "usage: splinegrid eval NAME (--level L | --res a,b,c) [--revision R | --step N] "
+        "[--block b] [--derivs] [--jacobian] [--quality] [--deviation] [--nocompress] "
+        "-o OUT.{vts,vtm,x,xyz,cgns}, or --steps A:B -o OUT.pvd");
   }
-  return std::make_pair(first, last);
-}
-
-// The source points in the archive at `path` (the records up to the last source chunk).
-absl::StatusOr<MultiBlockGrid> ReadArchiveSource(const std::string& path) {
-  SG_ASSIGN_OR_RETURN(RecordReader reader, RecordReader::Open(path));
-  std::string payload;
-  SG_ASSIGN_OR_RETURN(bool more, reader.Next(&payload));
-  v1::ArchiveRecord record;
-  if (!more || !record.ParseFromString(payload) || !record.has_header()) {
-    return absl::InvalidArgumentError(absl::StrCat("archive '", path, "': no header record"));
+  v1::EvaluateGridRequest request;
+  request.set_name(args[0]);
+  SG_RETURN_IF_ERROR(RevisionOrStep([&](int64_t r) { request.set_revision(r); },
+                                    [&](int64_t s) { request.set_step(s); }));
+  const int level = absl::GetFlag(FLAGS_level);
+  const std::string res = absl::GetFlag(FLAGS_res);
+  if ((level >= 0) == !res.empty()) return Usage("give exactly one of --level and --res");
+  if (level >= 0) {
+    request.set_refinement_level(level);
+  } else {
+    SG_ASSIGN_OR_RETURN(Extents counts, ParseTriple(res, "--res"));
+    for (int& c : counts) c = std::max(c, 1);
+    request.mutable_counts()->set_i(counts[0]);
+    request.mutable_counts()->set_j(counts[1]);
+    request.mutable_counts()->set_k(counts[2]);
   }
-  SG_ASSIGN_OR_RETURN(SourceAssembler source, SourceAssembler::Create(record.header()));
-  while (!source.complete()) {
-    SG_ASSIGN_OR_RETURN(more, reader.Next(&payload));
-    if (!more || !record.ParseFromString(payload) || !record.has_source()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("archive '", path, "': the source points end early"));
+  if (!absl::GetFlag(FLAGS_block).empty()) {
+    for (absl::string_view part : absl::StrSplit(absl::GetFlag(FLAGS_block), ',')) {
+      int b;
+      if (!absl::SimpleAtoi(part, &b))
+        return Usage(absl::StrCat("--block: '", part, "' is not an integer"));
+      request.add_blocks(b);
     }
-    SG_RETURN_IF_ERROR(source.Add(record.source()));
   }
-  return std::move(source).Finish();
-}
-
-}  // namespace
-
-bool IsSeriesPath(const std::string& out) {
-  return std::filesystem::path(out).extension() == ".pvd";
-}
-
-absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& out,
-                                                             v1::EvaluateGridRequest* request) {
-  EvalOutputOptions options;
-  options.derivatives = absl::GetFlag(FLAGS_derivs);
-  options.jacobian = absl::GetFlag(FLAGS_jacobian);
-  options.quality = absl::GetFlag(FLAGS_quality);
-  options.deviation = absl::GetFlag(FLAGS_deviation);
-  options.compress = absl::GetFlag(FLAGS_compress);
-  if (options.deviation &&
-      (request->has_counts() || request->refinement_level() != 0 || request->has_index_box())) {
-    return absl::InvalidArgumentError(
-        "--deviation is measured at the source points: evaluate with --level 0 and no --box");
-  }
-  const std::string ext = std::filesystem::path(out).extension().string();
-  if ((options.jacobian || options.quality || options.deviation) && ext != ".vts" &&
-      ext != ".vtm" && ext != ".pvd") {
-    return absl::InvalidArgumentError(
-        absl::StrCat("-o ", out,
-                     ": --jacobian, --quality and --deviation are VTK fields; write "
-                     ".vts, .vtm or .pvd"));
-  }
-  // zlib is a storage option of VTK XML files: refused, not ignored, for Plot3D and CGNS.
-  if (FlagGiven("compress") && ext != ".vts" && ext != ".vtm" && ext != ".pvd") {
-    return absl::InvalidArgumentError(
-        absl::StrCat("-o ", out, ": ", options.compress ? "--compress" : "--nocompress",
-                     " applies to VTK files (.vts, .vtm, .pvd) only; drop it for this output"));
-  }
-  if (IsSeriesPath(out) == absl::GetFlag(FLAGS_steps).empty()) {
-    return absl::InvalidArgumentError(
-        "a time series takes both --steps a:b and -o NAME.pvd (and only a series writes .pvd)");
-  }
-  if (IsSeriesPath(out) && (request->revision() != 0 || request->has_step())) {
-    return absl::InvalidArgumentError("--steps selects the revisions; drop --revision/--step");
-  }
-  request->set_derivatives(options.derivatives || options.jacobian);
-  return options;
-}
-
-absl::StatusOr<EvalGridFacts> FetchEvalFacts(client::Client& client,
-                                             const v1::EvaluateGridRequest& request,
-                                             const EvalOutputOptions& options) {
-  v1::GetGridRequest get;
-  get.set_name(request.name());
-  get.set_view(v1::GRID_VIEW_BASIC);
-  get.set_revision(request.revision());
-  if (request.has_step()) get.set_step(request.step());
-  SG_ASSIGN_OR_RETURN(const v1::Grid grid, client.Get(get));
-  SG_ASSIGN_OR_RETURN(EvalGridFacts facts, EvalFactsFromGrid(grid));
-  if (options.deviation) {
-    // The archive goes to a private directory (mkdtemp: mode 0700, an unpredictable name under
-    // $TMPDIR), so that no other user can read, replace or pre-create it; the directory and
-    // whatever ExportGrid left in it are removed on every path out of this block.
-    std::error_code error;  // the overload that does not throw for a TMPDIR that is no directory
-    const std::filesystem::path temp = std::filesystem::temp_directory_path(error);
-    if (error) {
-      return ErrnoToStatusWithMessage(
-          error.value(), "--deviation: no temporary directory (set TMPDIR to a writable one)");
+  if (!absl::GetFlag(FLAGS_box).empty()) {
+    const std::vector<std::string> ranges = absl::StrSplit(absl::GetFlag(FLAGS_box), ',');
+    v1::IndexBox* box = request.mutable_index_box();
+    int begin[3] = {0, 0, 0}, end[3] = {0, 0, 0};
+    if (ranges.size() > 3) return Usage("--box: at most three ranges i0:i1,j0:j1,k0:k1");
+    for (size_t d = 0; d < ranges.size(); ++d) {
+      const std::vector<std::string> ends = absl::StrSplit(ranges[d], ':');
+      if (ends.size() != 2 || !absl::SimpleAtoi(ends[0], &begin[d]) ||
+          !absl::SimpleAtoi(ends[1], &end[d])) {
+        return Usage(absl::StrCat("--box: '", ranges[d], "' is not a range a:b"));
+      }
     }
-    std::string directory = (temp / "splinegrid-eval-XXXXXX").string();
-    if (mkdtemp(directory.data()) == nullptr) {
-      return ErrnoToStatusWithMessage(
-          errno, absl::StrCat("--deviation: cannot create a temporary directory '", directory,
-                              "' (set TMPDIR to a writable directory)"));
-    }
-    const absl::Cleanup remove_directory = [&directory] {
-      std::error_code ignored;
-      std::filesystem::remove_all(directory, ignored);
-    };
-    const std::string path = (std::filesystem::path(directory) / "source.sgrid").string();
-    SG_RETURN_IF_ERROR(client.ExportGrid(request.name(), path).status());
-    SG_ASSIGN_OR_RETURN(MultiBlockGrid source, ReadArchiveSource(path));
-    facts.source = std::move(source);
+    box->mutable_begin()->set_i(begin[0]);
+    box->mutable_begin()->set_j(begin[1]);
+    box->mutable_begin()->set_k(begin[2]);
+    box->mutable_end()->set_i(end[0]);
+    box->mutable_end()->set_j(end[1]);
+    box->mutable_end()->set_k(end[2]);
   }
-  return facts;
-}
-
-absl::StatusOr<std::string> RunEvalSeries(client::Client& client, v1::EvaluateGridRequest request,
-                                          const std::string& out, const EvalGridFacts& facts,
-                                          const EvalOutputOptions& options) {
-  SG_ASSIGN_OR_RETURN(const auto range, ParseSteps(absl::GetFlag(FLAGS_steps)));
-  v1::GetGridRequest get;
-  get.set_name(request.name());
-  get.set_view(v1::GRID_VIEW_BASIC);
-  SG_ASSIGN_OR_RETURN(const v1::Grid grid, client.Get(get));
-  // The latest deformed revision of each step, as --step picks it.
-  std::map<int64_t, const v1::RevisionInfo*> by_step;
-  for (const v1::RevisionInfo& info : grid.revisions()) {
-    if (info.origin() != v1::REVISION_ORIGIN_DEFORM) continue;
-    if (info.step() < range.first || info.step() > range.second) continue;
-    const v1::RevisionInfo*& latest = by_step[info.step()];
-    if (latest == nullptr || latest->revision() < info.revision()) latest = &info;
+  request.set_derivatives(absl::GetFlag(FLAGS_derivs));
+  request.set_precision(absl::GetFlag(FLAGS_float32) ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
+  // Output fields, the source's Plot3D layout and ParaView time series (eval_support.h).
+  SG_ASSIGN_OR_RETURN(const EvalOutputOptions eval_options,
+                      EvalOutputOptionsFromFlags(out, &request));
+  if (IsSeriesPath(out)) {
+    auto series_client = Connect();
+    SG_ASSIGN_OR_RETURN(const EvalGridFacts facts,
+                        FetchEvalFacts(*series_client, request, eval_options));
+    SG_ASSIGN_OR_RETURN(const std::string summary,
+                        RunEvalSeries(*series_client, request, out, facts, eval_options));
+    std::fwrite(summary.data(), 1, summary.size(), stdout);
+    return absl::OkStatus();
   }
-  if (by_step.empty()) {
-    return absl::NotFoundError(absl::StrCat(grid.name(), " has no deformed revision of steps ",
-                                            range.first, " to ", range.second));
+  SG_RETURN_IF_ERROR(CheckGridOutput(out));
+  auto client = Connect();
+  // A CGNS file also carries the grid's boundary conditions and connectivity at the level.
+  std::optional<CgnsOutputContext> cgns;
+  if (IsCgnsPath(out)) {
+    SG_ASSIGN_OR_RETURN(cgns, FetchCgnsOutputContext(*client, request));
   }
-  std::vector<SeriesStep> steps;
-  for (const auto& [step, info] : by_step) {
-    request.set_revision(info->revision());
-    request.clear_step();
-    SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client.Evaluate(request));
-    steps.push_back({step, info->time(), std::move(result)});
+  EvalGridFacts facts;  // VTK and Plot3D outputs (eval_output.h)
+  if (!cgns) {
+    SG_ASSIGN_OR_RETURN(facts, FetchEvalFacts(*client, request, eval_options));
   }
-  std::string note;
-  SG_ASSIGN_OR_RETURN(const int64_t points, WriteSeries(out, steps, facts, options, &note));
-  const int64_t missing = range.second - range.first + 1 - static_cast<int64_t>(steps.size());
-  std::string summary = absl::StrCat("wrote ", out, ": ", steps.size(), " time step(s) (steps ",
-                                     by_step.begin()->first, " to ", by_step.rbegin()->first, "), ",
-                                     points, " points\n");
-  if (missing > 0) {
-    absl::StrAppend(&summary, "note: ", missing, " step(s) from ", range.first, " to ",
-                    range.second, " have no deformed revision (retention or not deformed)\n");
+  ProgressLine download("evaluate");
+  SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client->Evaluate(request, download.callback()));
+  download.Done();
+  v1::EvaluationHeader summary;  // for --json; taken before the blocks move to the writer
+  summary.set_revision(result.revision);
+  for (const client::EvaluatedBlock& block : result.blocks) {
+    v1::EvaluatedBlock* eb = summary.add_blocks();
+    eb->set_block(block.block);
+    eb->mutable_extents()->set_i(block.points.extent(0));
+    eb->mutable_extents()->set_j(block.points.extent(1));
+    eb->mutable_extents()->set_k(block.points.extent(2));
   }
-  if (!note.empty()) absl::StrAppend(&summary, "note: ", note, "\n");
-  return summary;
+  SG_ASSIGN_OR_RETURN(const int64_t points, WriteGridOutput(out, std::move(result), facts,
+                                                            eval_options, cgns ? &*cgns : nullptr));
+  summary.set_total_points(points);
+  Print(absl::StrCat("wrote ", out, ": ", summary.blocks_size(), " block(s), ", points,
+                     " points (revision ", summary.revision(), ")\n"),
+        summary);
+  return absl::OkStatus();
 }
 
 }  // namespace splinegrid::cli

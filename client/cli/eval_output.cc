@@ -96,7 +96,7 @@ absl::StatusOr<BlockFields> FieldsOf(const client::EvaluatedBlock& block,
 }
 
 absl::StatusOr<int64_t> WriteVtk(const std::string& out, const std::string& ext,
-                                 const client::EvaluatedGrid& result, const EvalGridFacts& facts,
+                                 client::EvaluatedGrid result, const EvalGridFacts& facts,
                                  const EvalOutputOptions& options) {
   MultiBlockGrid grid;
   // A deque: growing it never moves (or copies) earlier blocks, whose arrays point into them.
@@ -104,12 +104,12 @@ absl::StatusOr<int64_t> WriteVtk(const std::string& out, const std::string& ext,
   std::vector<std::vector<VtkPointArray>> arrays;
   std::vector<int> numbers;
   int64_t points = 0;
-  for (const client::EvaluatedBlock& block : result.blocks) {
+  for (client::EvaluatedBlock& block : result.blocks) {
     SG_ASSIGN_OR_RETURN(BlockFields f, FieldsOf(block, facts, options));
-    fields.push_back(std::move(f));
-    grid.blocks.push_back(block.points);
+    fields.push_back(std::move(f));  // points into block.du, dv, dw (kept), not its points
     numbers.push_back(block.block);
     points += block.points.num_points();
+    grid.blocks.push_back(std::move(block.points));
   }
   for (const BlockFields& f : fields) arrays.push_back(f.arrays);
   VtkWriteOptions vtk;
@@ -126,10 +126,12 @@ absl::StatusOr<int64_t> WriteVtk(const std::string& out, const std::string& ext,
   return points;
 }
 
-// The derivative functions of `block` as the Plot3D grid file holds it (`written`, restored to
-// two planes when `planes` is given): dX_du, dX_dv[, dX_dw], each with the file's coordinates.
+// The derivative functions of `block` (its points moved out; `extents` were theirs) as the
+// Plot3D grid file holds it (`written`, restored to two planes when `planes` is given): dX_du,
+// dX_dv[, dX_dw], each with the file's coordinates.
 absl::StatusOr<Plot3dFunctionBlock> DerivativeFunctions(const client::EvaluatedBlock& block,
-                                                        int pdim, const StructuredBlock& written,
+                                                        int pdim, const Extents& extents,
+                                                        const StructuredBlock& written,
                                                         const TwoPlaneLayout* planes) {
   std::vector<std::span<const double>> derivatives = {block.du};
   if (pdim >= 2) derivatives.push_back(block.dv);
@@ -143,7 +145,7 @@ absl::StatusOr<Plot3dFunctionBlock> DerivativeFunctions(const client::EvaluatedB
     std::vector<double> vectors(derivatives[d].begin(), derivatives[d].end());
     if (planes != nullptr) {
       // A tangent of the planar view is a vector in the plane: 0 along the normal coordinate.
-      StructuredBlock tangent(block.points.extents(), 2);
+      StructuredBlock tangent(extents, 2);
       std::copy(vectors.begin(), vectors.end(), tangent.coords().begin());
       TwoPlaneLayout in_plane = *planes;
       in_plane.plane_values[0] = in_plane.plane_values[1] = 0.0;
@@ -160,7 +162,7 @@ absl::StatusOr<Plot3dFunctionBlock> DerivativeFunctions(const client::EvaluatedB
 }
 
 absl::StatusOr<int64_t> WritePlot3d(const std::string& out, const std::string& ext,
-                                    const client::EvaluatedGrid& result, const EvalGridFacts& facts,
+                                    client::EvaluatedGrid result, const EvalGridFacts& facts,
                                     const EvalOutputOptions& options) {
   if (options.jacobian || options.quality || options.deviation) {
     return absl::InvalidArgumentError(
@@ -173,13 +175,20 @@ absl::StatusOr<int64_t> WritePlot3d(const std::string& out, const std::string& e
   MultiBlockGrid evaluated;
   std::vector<int> indices;
   int64_t points = 0;
-  for (const client::EvaluatedBlock& block : result.blocks) {
-    evaluated.blocks.push_back(block.points);
+  // The derivative functions below need each block's extents, parametric dimension and
+  // derivatives, not its points.
+  std::vector<Extents> extents;
+  std::vector<int> pdims;
+  for (client::EvaluatedBlock& block : result.blocks) {
+    extents.push_back(block.points.extents());
+    pdims.push_back(ParametricDim(facts, block));
+    evaluated.blocks.push_back(std::move(block.points));
     indices.push_back(block.block);
   }
   Plot3dWriteBack write;
   if (facts.plot3d.has_value()) {
-    SG_ASSIGN_OR_RETURN(write, ToPlot3dSourceForm(evaluated, indices, *facts.plot3d, encoding));
+    SG_ASSIGN_OR_RETURN(write,
+                        ToPlot3dSourceForm(std::move(evaluated), indices, *facts.plot3d, encoding));
   } else {
     write.format = DefaultPlot3dFormat(evaluated, encoding);
     write.grid = std::move(evaluated);
@@ -195,9 +204,8 @@ absl::StatusOr<int64_t> WritePlot3d(const std::string& out, const std::string& e
           facts.plot3d.has_value() && !facts.plot3d->two_planes.empty()
               ? &facts.plot3d->two_planes.at(static_cast<size_t>(block.block))
               : nullptr;
-      SG_ASSIGN_OR_RETURN(
-          Plot3dFunctionBlock f,
-          DerivativeFunctions(block, ParametricDim(facts, block), write.grid.blocks[b], planes));
+      SG_ASSIGN_OR_RETURN(Plot3dFunctionBlock f, DerivativeFunctions(block, pdims[b], extents[b],
+                                                                     write.grid.blocks[b], planes));
       functions.push_back(std::move(f));
     }
     SG_ASSIGN_OR_RETURN(function_bytes, EncodePlot3dFunction(functions, write.format));
@@ -233,17 +241,19 @@ std::string FunctionFilePath(const std::string& grid_path) {
   return std::filesystem::path(grid_path).replace_extension(".f").string();
 }
 
-absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, const client::EvaluatedGrid& result,
+absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, client::EvaluatedGrid result,
                                         const EvalGridFacts& facts,
                                         const EvalOutputOptions& options) {
   const std::string ext = std::filesystem::path(out).extension().string();
-  if (ext == ".vts" || ext == ".vtm") return WriteVtk(out, ext, result, facts, options);
-  if (ext == ".x" || ext == ".xyz") return WritePlot3d(out, ext, result, facts, options);
+  if (ext == ".vts" || ext == ".vtm") return WriteVtk(out, ext, std::move(result), facts, options);
+  if (ext == ".x" || ext == ".xyz") {
+    return WritePlot3d(out, ext, std::move(result), facts, options);
+  }
   return absl::InvalidArgumentError(
       absl::StrCat("-o ", out, ": WriteEvaluation writes .vts, .vtm, .x or .xyz"));
 }
 
-absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, const std::vector<SeriesStep>& steps,
+absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, std::vector<SeriesStep> steps,
                                     const EvalGridFacts& facts, const EvalOutputOptions& options,
                                     std::string* note) {
   const std::filesystem::path path(pvd);
@@ -268,11 +278,12 @@ absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, const std::vector<Se
   }
   std::vector<PvdEntry> entries;
   int64_t points = 0;
-  for (const SeriesStep& step : steps) {
+  for (SeriesStep& step : steps) {
     const std::string name =
         absl::StrCat(stem, "_", step.step, step.result.blocks.size() == 1 ? ".vts" : ".vtm");
-    SG_ASSIGN_OR_RETURN(const int64_t written,
-                        WriteEvaluation((directory / name).string(), step.result, facts, options));
+    SG_ASSIGN_OR_RETURN(
+        const int64_t written,
+        WriteEvaluation((directory / name).string(), std::move(step.result), facts, options));
     points += written;
     entries.push_back(
         {use_steps ? static_cast<double>(step.step) : step.time, absl::StrCat(stem, "/", name)});

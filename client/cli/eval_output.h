@@ -53,8 +53,9 @@ std::string FunctionFilePath(const std::string& grid_path);
 // layout when `facts.plot3d` is known (ToPlot3dSourceForm), else the default; with
 // options.derivatives the function file FunctionFilePath(out) too. Returns the number of points
 // written. INVALID_ARGUMENT for VTK-only fields with a Plot3D file, a deviation without source
-// points or at another resolution, and whatever the writers refuse.
-absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, const client::EvaluatedGrid& result,
+// points or at another resolution, and whatever the writers refuse. Takes `result` by value and
+// moves its blocks into the written grid (pass it with std::move).
+absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, client::EvaluatedGrid result,
                                         const EvalGridFacts& facts,
                                         const EvalOutputOptions& options);
 
@@ -68,8 +69,9 @@ struct SeriesStep {
 // Writes the steps as `pvd` (which ends in ".pvd", say out/run.pvd): out/run/run_<step>.vts
 // (one block) or .vtm, and the .pvd listing them with TimeValue = each revision's time. When
 // times repeat (revisions deformed without --time), the steps are used as TimeValue and
-// `*note` says so. Returns the points written over all steps.
-absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, const std::vector<SeriesStep>& steps,
+// `*note` says so. Returns the points written over all steps. Moves each step's evaluation
+// into its writer (pass `steps` with std::move).
+absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, std::vector<SeriesStep> steps,
                                     const EvalGridFacts& facts, const EvalOutputOptions& options,
                                     std::string* note);
 

@@ -16,13 +16,13 @@ absl::Status CheckGridOutput(const std::string& out) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, const client::EvaluatedGrid& result,
+absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, client::EvaluatedGrid result,
                                         const EvalGridFacts& facts,
                                         const EvalOutputOptions& options,
                                         const CgnsOutputContext* cgns) {
   SG_RETURN_IF_ERROR(CheckGridOutput(out));
-  if (IsCgnsPath(out)) return WriteCgnsOutput(out, result, cgns);
-  return WriteEvaluation(out, result, facts, options);
+  if (IsCgnsPath(out)) return WriteCgnsOutput(out, std::move(result), cgns);
+  return WriteEvaluation(out, std::move(result), facts, options);
 }
 
 }  // namespace splinegrid::cli

@@ -23,8 +23,9 @@ absl::Status CheckGridOutput(const std::string& out);
 // Writes `result` to `out` by its extension: .cgns with WriteCgnsOutput (boundary conditions and
 // connectivity from `cgns`, points only when it is null), the others with WriteEvaluation
 // (`facts` and `options`; empty facts: the default Plot3D layout, parametric dimensions from the
-// blocks' extents). Returns the number of points written.
-absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, const client::EvaluatedGrid& result,
+// blocks' extents). Returns the number of points written. Takes `result` by value and moves
+// its blocks into the writer (pass it with std::move).
+absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, client::EvaluatedGrid result,
                                         const EvalGridFacts& facts,
                                         const EvalOutputOptions& options,
                                         const CgnsOutputContext* cgns);

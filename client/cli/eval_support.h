@@ -1,8 +1,8 @@
 // The parts of `splinegrid eval` around the evaluation: output options from the flags, what
 // the output needs to know about the grid (GetGrid, and the source points for --deviation),
 // and the ParaView time series of --steps.
-#ifndef SPLINEGRID_CLIENT_CLI_EVAL_COMMAND_H_
-#define SPLINEGRID_CLIENT_CLI_EVAL_COMMAND_H_
+#ifndef SPLINEGRID_CLIENT_CLI_EVAL_SUPPORT_H_
+#define SPLINEGRID_CLIENT_CLI_EVAL_SUPPORT_H_
 
 #include <string>
 
@@ -41,4 +41,4 @@ absl::StatusOr<std::string> RunEvalSeries(client::Client& client, v1::EvaluateGr
 
 }  // namespace splinegrid::cli
 
-#endif  // SPLINEGRID_CLIENT_CLI_EVAL_COMMAND_H_
+#endif  // SPLINEGRID_CLIENT_CLI_EVAL_SUPPORT_H_

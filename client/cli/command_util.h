@@ -1,0 +1,64 @@
+// The helpers shared by several `splinegrid` subcommands (one command's own stay in its file).
+// Usage errors, the connection, printing a result as text or JSON, and the flags more than one
+// command reads: the fit flags of fit and offset, --fair, --revision/--step, a size triple.
+#ifndef SPLINEGRID_CLIENT_CLI_COMMAND_UTIL_H_
+#define SPLINEGRID_CLIENT_CLI_COMMAND_UTIL_H_
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/flags/flag.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "client/cli/flags.h"
+#include "client/client.h"
+#include "core/grid/structured_grid.h"
+#include "google/protobuf/message.h"
+#include "splinegrid/v1/splinegrid_service.pb.h"
+
+namespace splinegrid::cli {
+
+// INVALID_ARGUMENT with `message` (exit status 2).
+absl::Status Usage(const std::string& message);
+
+// A client for --server with --timeout and the token and TLS settings of PrepareConnection.
+std::unique_ptr<client::Client> Connect();
+
+// Prints `human`, or with --json `message` as JSON, to stdout.
+void Print(const std::string& human, const google::protobuf::Message& message);
+
+// "24,16" -> {24, 16, 0}; `what` names the flag in errors.
+absl::StatusOr<Extents> ParseTriple(const std::string& text, const std::string& what);
+
+// --revision or --step (not both) into a request.
+template <typename SetRevision, typename SetStep>
+absl::Status RevisionOrStep(const SetRevision& set_revision, const SetStep& set_step) {
+  const std::optional<int64_t> step = absl::GetFlag(FLAGS_step);
+  if (step.has_value()) {
+    if (absl::GetFlag(FLAGS_revision) != 0) return Usage("give --revision or --step, not both");
+    set_step(*step);
+  } else {
+    set_revision(absl::GetFlag(FLAGS_revision));
+  }
+  return absl::OkStatus();
+}
+
+// A grid id from a file name: lower case, [a-z0-9-], starting with a letter.
+std::string IdFromPath(const std::string& path);
+
+// --fair: "" (none), "tol" (to tolerance) or a weight.
+absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag();
+
+// The FitSpec of the fit flags.
+absl::StatusOr<v1::FitSpec> SpecFromFlags();
+
+// After a stored fit: FAILED_PRECONDITION with exit status kExitQualityNotMet (3) when
+// --allow_folds let the server store a revision whose cells fold (its report says quality_met =
+// false), so that a script cannot mistake it for a good grid, nor for a call that failed (1).
+absl::Status FoldsStored(const std::string& name, const v1::FitGridResponse& fit);
+
+}  // namespace splinegrid::cli
+
+#endif  // SPLINEGRID_CLIENT_CLI_COMMAND_UTIL_H_

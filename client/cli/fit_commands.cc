@@ -1,0 +1,96 @@
+// `splinegrid fit` (import a file and fit it) and `splinegrid fair` (refit a stored grid).
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "absl/flags/flag.h"
+#include "absl/strings/str_cat.h"
+#include "client/cli/cgns_output.h"
+#include "client/cli/command_line.h"
+#include "client/cli/command_util.h"
+#include "client/cli/commands.h"
+#include "client/cli/flags.h"
+#include "client/cli/output.h"
+#include "client/client.h"
+#include "core/io/file_util.h"
+#include "core/util/status_macros.h"
+#include "io/cgns/cgns_io.h"
+
+namespace splinegrid::cli {
+
+namespace {
+
+// --plot3d_layout: "" (detect), "whole" or "planes".
+absl::StatusOr<v1::Plot3dLayout> Plot3dLayoutFlag() {
+  const std::string text = absl::GetFlag(FLAGS_plot3d_layout);
+  if (text.empty()) return v1::PLOT3D_LAYOUT_UNSPECIFIED;
+  if (text == "whole") return v1::PLOT3D_LAYOUT_WHOLE;
+  if (text == "planes") return v1::PLOT3D_LAYOUT_PLANES;
+  return Usage(absl::StrCat("--plot3d_layout = '", text, "': give whole or planes"));
+}
+
+}  // namespace
+
+absl::Status Fit(const Args& args) {
+  if (args.size() != 1) {
+    return Usage(
+        "usage: splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] "
+        "[--fair tol|LAMBDA]");
+  }
+  const std::string& path = args[0];
+  SG_ASSIGN_OR_RETURN(const v1::FitSpec spec, SpecFromFlags());
+  SG_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  const std::string id =
+      absl::GetFlag(FLAGS_name).empty() ? IdFromPath(path) : absl::GetFlag(FLAGS_name);
+  auto client = Connect();
+  // A CGNS file (by extension or signature) is decoded by the server, BCs included; it is
+  // stored as its zones are (--planar is about two-plane Plot3D files).
+  const bool cgns = IsCgnsPath(path) || LooksLikeCgns(bytes);
+  // Plot3D read options given for a CGNS file would be ignored: refused instead (the defaults,
+  // --planar=true included, are not "given").
+  for (const char* flag : {"planar", "plot3d_layout"}) {
+    if (cgns && FlagGiven(flag)) {
+      return Usage(absl::StrCat("--", flag, " is about Plot3D files; ", path,
+                                " is CGNS (stored as its zones are): drop --", flag));
+    }
+  }
+  // --plot3d_layout: the value order of 3D text and C-stream files (Fortran records show it).
+  SG_ASSIGN_OR_RETURN(const v1::Plot3dLayout layout, Plot3dLayoutFlag());
+  // --planar: the server stores the planar view of two-plane files, anything else as read.
+  v1::Plot3dSource plot3d_options;
+  plot3d_options.set_planar_view_if_two_planes(absl::GetFlag(FLAGS_planar));
+  plot3d_options.set_layout(layout);
+  ProgressLine upload("upload");
+  const std::string grid_id = client::GridName(id).substr(6);
+  const std::string display_name = std::filesystem::path(path).filename().string();
+  SG_ASSIGN_OR_RETURN(
+      const v1::Grid grid,
+      cgns ? client->ImportCgns(bytes, grid_id, display_name, upload.callback())
+           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options, upload.callback()));
+  upload.Done();
+  // What the import mapped with a choice or left out (CGNS), never silently.
+  for (const std::string& note : grid.source().boundaries().notes()) {
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+  }
+  absl::StatusOr<v1::FitGridResponse> fit = client->Fit(grid.name(), spec);
+  if (!fit.ok()) {
+    (void)client->Delete(grid.name());  // do not leave an unfitted grid behind
+    return fit.status();
+  }
+  Print(FormatFit(grid.name(), *fit), *fit);
+  return FoldsStored(grid.name(), *fit);
+}
+
+absl::Status Fair(const Args& args) {
+  if (args.size() != 1)
+    return Usage("usage: splinegrid fair NAME [--revision R] [--fair tol|LAMBDA]");
+  SG_ASSIGN_OR_RETURN(const std::optional<v1::Fairing> fairing, ParseFairFlag());
+  SG_ASSIGN_OR_RETURN(
+      const v1::FitGridResponse fit,
+      Connect()->Fair(args[0], absl::GetFlag(FLAGS_revision), fairing ? &*fairing : nullptr,
+                      absl::GetFlag(FLAGS_allow_folds)));
+  Print(FormatFit(client::GridName(args[0]), fit), fit);
+  return FoldsStored(client::GridName(args[0]), fit);
+}
+
+}  // namespace splinegrid::cli

@@ -1,0 +1,85 @@
+// `splinegrid offset`: an O-grid generated around an airfoil file's profile (GenerateGrid).
+#include <filesystem>
+
+#include "absl/flags/flag.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "client/cli/command_util.h"
+#include "client/cli/commands.h"
+#include "client/cli/eval_output.h"
+#include "client/cli/flags.h"
+#include "client/cli/grid_output.h"
+#include "client/cli/output.h"
+#include "client/client.h"
+#include "core/io/file_util.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid::cli {
+
+absl::Status Offset(const Args& args) {
+  constexpr char kUsage[] =
+      "usage: splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] "
+      "[--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
+      "[--profile_tol T] "
+      "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,vtm,x,xyz,cgns}]";
+  if (args.size() != 1) return Usage(kUsage);
+  const std::string& path = args[0];
+  const std::string out = absl::GetFlag(FLAGS_o);
+  if (!out.empty()) SG_RETURN_IF_ERROR(CheckGridOutput(out));
+  v1::GenerateGridRequest request;
+  request.set_grid_id(absl::GetFlag(FLAGS_name).empty()
+                          ? IdFromPath(path)
+                          : client::GridName(absl::GetFlag(FLAGS_name)).substr(6));
+  request.set_display_name(std::filesystem::path(path).filename().string());
+  SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(path));
+  const std::string method = absl::AsciiStrToLower(absl::GetFlag(FLAGS_method));
+  if (method == "offsets") {
+    request.set_method(v1::LAYER_METHOD_OFFSETS);
+  } else if (method == "transfinite") {
+    request.set_method(v1::LAYER_METHOD_TRANSFINITE);
+  } else if (method == "elliptic") {
+    request.set_method(v1::LAYER_METHOD_ELLIPTIC);
+  } else if (!method.empty()) {
+    return Usage(absl::StrCat("--method = '", absl::GetFlag(FLAGS_method),
+                              "': give offsets, transfinite or elliptic"));
+  }
+  if (const auto v = absl::GetFlag(FLAGS_layers)) request.set_layers(*v);
+  if (const auto v = absl::GetFlag(FLAGS_first)) request.set_first_height(*v);
+  if (const auto v = absl::GetFlag(FLAGS_far)) request.set_distance(*v);
+  if (const auto v = absl::GetFlag(FLAGS_points)) request.set_wall_points(*v);
+  if (const auto v = absl::GetFlag(FLAGS_orthogonalize)) request.set_orthogonalize(*v);
+  if (const auto v = absl::GetFlag(FLAGS_profile_tol)) request.set_fit_tolerance(*v);
+  // The grid fit: the fit flags when given, else the server's default (interpolation).
+  SG_ASSIGN_OR_RETURN(v1::FitSpec spec, SpecFromFlags());
+  if (spec.resolution_case() != v1::FitSpec::RESOLUTION_NOT_SET || spec.has_fairing()) {
+    if (spec.resolution_case() == v1::FitSpec::RESOLUTION_NOT_SET) {
+      spec.mutable_boundary_tolerances();
+    }
+    *request.mutable_spec() = spec;
+  }
+  request.set_allow_folds(absl::GetFlag(FLAGS_allow_folds));
+  auto client = Connect();
+  SG_ASSIGN_OR_RETURN(const v1::GenerateGridResponse response, client->Generate(request));
+  std::string human = FormatGenerate(response);
+  if (!out.empty()) {
+    v1::EvaluateGridRequest evaluate;
+    evaluate.set_name(response.grid().name());
+    evaluate.set_revision(response.fit().revision());
+    evaluate.set_refinement_level(0);
+    ProgressLine download("evaluate");
+    SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result,
+                        client->Evaluate(evaluate, download.callback()));
+    download.Done();
+    const int64_t revision = result.revision;
+    // Points only, through eval's writers: no source layout (a generated grid has no file),
+    // parametric dimensions from the extents, no boundary conditions in a .cgns.
+    SG_ASSIGN_OR_RETURN(
+        const int64_t points,
+        WriteGridOutput(out, std::move(result), EvalGridFacts{}, EvalOutputOptions{}, nullptr));
+    absl::StrAppend(&human, "wrote ", out, ": ", points, " points (revision ", revision, ")\n");
+  }
+  Print(human, response);
+  return FoldsStored(response.grid().name(), response.fit());
+}
+
+}  // namespace splinegrid::cli
