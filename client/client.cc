@@ -72,7 +72,9 @@ class EvaluationAssembler {
     if (chunk.values_size() > 0) {
       std::memcpy(target + chunk.offset(), chunk.values().data(), n * sizeof(double));
     } else {
-      for (int64_t x = 0; x < n; ++x) target[chunk.offset() + x] = chunk.float_values(x);
+      // One widening copy of the packed floats (vectorised), not an accessor call per value.
+      const float* floats = chunk.float_values().data();
+      std::copy(floats, floats + n, target + chunk.offset());
     }
     received_ += n;
     if (progress_) progress_(received_ * 8, total_values_ * 8);

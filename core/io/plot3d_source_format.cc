@@ -5,7 +5,7 @@
 
 namespace splinegrid {
 
-absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(const MultiBlockGrid& evaluated,
+absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(MultiBlockGrid evaluated,
                                                    std::span<const int> block_indices,
                                                    const Plot3dSourceFormat& source,
                                                    Plot3dEncoding encoding) {
@@ -27,7 +27,7 @@ absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(const MultiBlockGrid& evaluat
   const bool two_planes = !source.two_planes.empty();
   out.grid.blocks.reserve(evaluated.blocks.size());
   for (size_t i = 0; i < evaluated.blocks.size(); ++i) {
-    const StructuredBlock& block = evaluated.blocks[i];
+    StructuredBlock& block = evaluated.blocks[i];
     const int b = block_indices[i];
     if (two_planes) {
       if (b < 0 || b >= static_cast<int>(source.two_planes.size())) {
@@ -42,7 +42,7 @@ absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(const MultiBlockGrid& evaluat
       }
       out.grid.blocks.push_back(*std::move(restored));
     } else {
-      out.grid.blocks.push_back(block);
+      out.grid.blocks.push_back(std::move(block));
     }
     StructuredBlock& written = out.grid.blocks.back();
     if (written.spatial_dim() != source.file.spatial_dim) {

@@ -38,8 +38,9 @@ struct Plot3dWriteBack {
 // written to a binary file gets little-endian double Fortran records and a binary source
 // written as text gets text. Layout and block-count line are the source's (a file without
 // block count with one block evaluated stays so). INVALID_ARGUMENT when a block index is
-// outside the source or the blocks do not match the source's dimension.
-absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(const MultiBlockGrid& evaluated,
+// outside the source or the blocks do not match the source's dimension. Blocks that need no
+// restoring are moved into the result (pass `evaluated` with std::move when done with it).
+absl::StatusOr<Plot3dWriteBack> ToPlot3dSourceForm(MultiBlockGrid evaluated,
                                                    std::span<const int> block_indices,
                                                    const Plot3dSourceFormat& source,
                                                    Plot3dEncoding encoding);
