@@ -5,8 +5,10 @@
 
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
+#include "core/grid/connectivity.h"
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
+#include "proto/convert/archive_convert.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
 #include "server/service.h"
@@ -111,6 +113,25 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
   std::deque<v1::ExportGridResponse> records_;
 };
 
+// Fits reuse the connectivity a grid keeps with its source points (found once, at import), so
+// an archive's must be the one its points have: INVALID_ARGUMENT otherwise (a damaged or edited
+// archive would make fits share boundaries that do not coincide, or miss ones that do).
+absl::Status CheckConnectivity(const SourcePoints& source) {
+  SG_ASSIGN_OR_RETURN(const Connectivity found, FindConnectivity(source.grid));
+  v1::StoredConnectivity stored, expected;
+  EncodeStoredConnectivity(source.connectivity, &stored);
+  EncodeStoredConnectivity(found, &expected);
+  if (stored.SerializeAsString() != expected.SerializeAsString()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "header.connectivity does not match the archive's source points: it lists ",
+        source.connectivity.matches.size(), " block boundary match(es), the points have ",
+        found.matches.size(),
+        source.connectivity.matches.size() == found.matches.size() ? " other ones" : "",
+        "; the archive was changed or damaged"));
+  }
+  return absl::OkStatus();
+}
+
 // Assembles the records as they arrive (memory charged as data comes, not as the header
 // announces), then stores the grid on the pool: nothing is stored unless the whole archive
 // arrived and checks out.
@@ -150,6 +171,7 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
                         assembler_->Finish(/*check_counts=*/true));
     grid->owner = caller_.owner();  // the importer's, not the exporter's
+    SG_RETURN_IF_ERROR(CheckConnectivity(*grid->source));
     log_.set_grid(absl::StrCat("grids/", grid->id));
     SG_RETURN_IF_ERROR(state_->store->Create(grid));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
@@ -167,9 +189,8 @@ grpc::ServerWriteReactor<v1::ExportGridResponse>* SplineGridService::ExportGrid(
   return new ExportReactor(state_, context, request);
 }
 
-grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>>*
-SplineGridService::ImportArchiveStream(grpc::CallbackServerContext* context,
-                                       v1::Grid* response) {
+grpc::ServerReadReactor<Decoded<v1::ImportArchiveRequest>>* SplineGridService::ImportArchiveStream(
+    grpc::CallbackServerContext* context, v1::Grid* response) {
   return new ImportArchiveReactor(state_, context, response);
 }
 

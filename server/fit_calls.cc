@@ -31,7 +31,9 @@ absl::StatusOr<GridRevision> SplineGridService::FitRevision(const SourcePoints& 
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,
                       state_->budget.Reserve(2 * source.memory.bytes(), "the fit"));
-  absl::StatusOr<GridFit> fitted = splinegrid::FitGrid(source.grid, options, cancel);
+  // The connectivity found at import (kept with the source points), not found again.
+  absl::StatusOr<GridFit> fitted =
+      splinegrid::FitGrid(source.grid, source.connectivity, options, cancel);
   if (fitted.status().code() == absl::StatusCode::kFailedPrecondition) {
     // A grid that cannot be fitted, or one whose fit folds without options.allow_folds.
     return absl::FailedPreconditionError(

@@ -42,8 +42,8 @@ FitOptions BlockOptions(const GridFitOptions& options, int b) {
 }
 
 // Control-count mode: every block on its own.
-absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options,
-                       const CancelCheck& cancel, GridFit& result) {
+absl::Status FitBlocks(const MultiBlockGrid& grid, const Connectivity& connectivity,
+                       const GridFitOptions& options, const CancelCheck& cancel, GridFit& result) {
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
     FitOptions fit_options = BlockOptions(options, b);
     fit_options.cancel = cancel;
@@ -56,16 +56,16 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const GridFitOptions& options
   if (options.fairing.mode == FairingMode::kWeight) {
     result.report.fairing_weight = options.fairing.weight;
   }
-  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid));
+  result.connectivity = connectivity;
   SG_ASSIGN_OR_RETURN(result.kinds,
                       ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
   return absl::OkStatus();
 }
 
 // Tolerance mode: the watertight multi-block fit.
-absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& options,
-                             double reference_length, const CancelCheck& cancel,
-                             GridFit& result) {
+absl::Status FitToTolerances(const MultiBlockGrid& grid, const Connectivity& connectivity,
+                             const GridFitOptions& options, double reference_length,
+                             const CancelCheck& cancel, GridFit& result) {
   MultiBlockFitOptions mb;
   mb.order = options.order;
   mb.parametrization = options.parametrization;
@@ -76,7 +76,7 @@ absl::Status FitToTolerances(const MultiBlockGrid& grid, const GridFitOptions& o
   mb.check_quality = options.check_quality;
   mb.fairing = options.fairing;
   mb.cancel = cancel;
-  SG_ASSIGN_OR_RETURN(MultiBlockFit fit, FitMultiBlock(grid, mb));
+  SG_ASSIGN_OR_RETURN(MultiBlockFit fit, FitMultiBlock(grid, connectivity, mb));
   for (size_t b = 0; b < fit.blocks.size(); ++b) {
     BlockFit block;
     block.fitted = std::move(fit.blocks[b]);
@@ -169,8 +169,8 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
           absl::StrCat(field, " is outside [0, ", num_blocks - 1, "]"));
     }
     if (const int first = OverrideOf(*this, block); first != static_cast<int>(q)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, " repeats block_control_counts[", first, "]; give one entry per block"));
+      return absl::InvalidArgumentError(absl::StrCat(field, " repeats block_control_counts[", first,
+                                                     "]; give one entry per block"));
     }
   }
   // Every block against the counts it gets, named as the request names them.
@@ -185,36 +185,43 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
-                                const CancelCheck& cancel) {
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// OK for options and a grid FitGrid can start on: INVALID_ARGUMENT for the options,
+// FAILED_PRECONDITION for a block that cannot be fitted.
+absl::Status ValidateGridFit(const MultiBlockGrid& grid, const GridFitOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate(grid));
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     if (absl::Status s = ValidateFittable(grid.blocks[b], absl::StrCat("block ", b)); !s.ok()) {
       return absl::FailedPreconditionError(s.message());
     }
   }
+  return absl::OkStatus();
+}
+
+// FitGrid after ValidateGridFit.
+absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectivity& connectivity,
+                                     const GridFitOptions& options, const CancelCheck& cancel) {
+  const auto start = std::chrono::steady_clock::now();
   GridFit result;
   // The reference length: given, or, when tolerances by kind are relative to it, detected before
   // the fit from the kinds FitMultiBlock will find (the same connectivity and overrides); else
   // detected after the fit, for the report.
   std::optional<ReferenceLength> reference;
   if (options.reference_length) {
-    reference = ReferenceLength{*options.reference_length, ReferenceLengthSource::kGiven,
-                                absl::StrCat("given: reference_length = ",
-                                             *options.reference_length)};
+    reference =
+        ReferenceLength{*options.reference_length, ReferenceLengthSource::kGiven,
+                        absl::StrCat("given: reference_length = ", *options.reference_length)};
   } else if (options.boundary_tolerances && options.relative_kinds != 0) {
-    SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
-                        FindConnectivity(grid, MultiBlockFitOptions().connectivity));
     SG_ASSIGN_OR_RETURN(const BoundaryKinds kinds,
                         ClassifyBoundaries(grid, connectivity, options.face_kinds));
     reference = DetectReferenceLength(grid, kinds);
   }
   if (options.tolerance_mode()) {
-    SG_RETURN_IF_ERROR(
-        FitToTolerances(grid, options, reference ? reference->length : 1.0, cancel, result));
+    SG_RETURN_IF_ERROR(FitToTolerances(grid, connectivity, options,
+                                       reference ? reference->length : 1.0, cancel, result));
   } else {
-    SG_RETURN_IF_ERROR(FitBlocks(grid, options, cancel, result));
+    SG_RETURN_IF_ERROR(FitBlocks(grid, connectivity, options, cancel, result));
     // Nothing was measured against a tolerance: the report must not say one was met.
     result.report.tolerance_met = false;
     result.report.unmet_reason =
@@ -287,6 +294,21 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
     }
   }
   return result;
+}
+
+}  // namespace
+
+absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
+                                const CancelCheck& cancel) {
+  SG_RETURN_IF_ERROR(ValidateGridFit(grid, options));
+  SG_ASSIGN_OR_RETURN(const Connectivity connectivity, FindConnectivity(grid));
+  return FitValidated(grid, connectivity, options, cancel);
+}
+
+absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const Connectivity& connectivity,
+                                const GridFitOptions& options, const CancelCheck& cancel) {
+  SG_RETURN_IF_ERROR(ValidateGridFit(grid, options));
+  return FitValidated(grid, connectivity, options, cancel);
 }
 
 }  // namespace splinegrid

@@ -99,7 +99,7 @@ struct GridFitReport {
   // True only when measured: no folded or resized cell in any block, and no block with cells
   // whose every cell was skipped as collapsed (CellQuality::measured()).
   bool quality_met = false;
-  int num_matches = 0;        // of the connectivity
+  int num_matches = 0;  // of the connectivity
   // Largest distance between coinciding points of matched boundaries at levels 0..2 (0 when
   // watertight: the tolerance mode).
   double max_gap = 0.0;
@@ -138,6 +138,11 @@ struct GridFit {
 // inconsistently), CANCELLED.
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
                                 const CancelCheck& cancel = {});
+
+// The same for a grid whose connectivity is known: `connectivity` is FindConnectivity(grid)'s
+// (default options; the service finds it once, at import, and keeps it with the source points).
+absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const Connectivity& connectivity,
+                                const GridFitOptions& options, const CancelCheck& cancel = {});
 
 }  // namespace splinegrid
 

@@ -441,15 +441,21 @@ bool Better(const MultiBlockFit& a, const MultiBlockFit& b) {
   return key(a) < key(b);
 }
 
-}  // namespace
-
-absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
-                                            const MultiBlockFitOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+// OK for options and a grid FitMultiBlock can start on.
+absl::Status ValidateMultiBlockFit(const MultiBlockGrid& grid,
+                                   const MultiBlockFitOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate());
   if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  return absl::OkStatus();
+}
+
+// FitMultiBlock after ValidateMultiBlockFit.
+absl::StatusOr<MultiBlockFit> FitValidated(const MultiBlockGrid& grid,
+                                           const Connectivity& connectivity,
+                                           const MultiBlockFitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   MultiBlockFit result;
-  SG_ASSIGN_OR_RETURN(result.connectivity, FindConnectivity(grid, options.connectivity));
+  result.connectivity = connectivity;
   result.poles = FindPoles(grid, PoleTolerance(grid));
   SG_ASSIGN_OR_RETURN(result.kinds,
                       ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
@@ -473,6 +479,23 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
   const int nb = static_cast<int>(grid.blocks.size());
   for (FittedBlock& fitted : result.blocks) fitted.summary.seconds = result.seconds / nb;
   return result;
+}
+
+}  // namespace
+
+absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const MultiBlockFitOptions& options) {
+  SG_RETURN_IF_ERROR(ValidateMultiBlockFit(grid, options));
+  SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
+                      FindConnectivity(grid, options.connectivity));
+  return FitValidated(grid, connectivity, options);
+}
+
+absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const Connectivity& connectivity,
+                                            const MultiBlockFitOptions& options) {
+  SG_RETURN_IF_ERROR(ValidateMultiBlockFit(grid, options));
+  return FitValidated(grid, connectivity, options);
 }
 
 }  // namespace splinegrid

@@ -138,6 +138,13 @@ double MaxBoundaryGap(const Connectivity& connectivity, const std::vector<Fitted
 absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
                                             const MultiBlockFitOptions& options);
 
+// The same for a grid whose connectivity is known: `connectivity` is what
+// FindConnectivity(grid, options.connectivity) gives (the service finds it once, at import),
+// and options.connectivity is not used.
+absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const Connectivity& connectivity,
+                                            const MultiBlockFitOptions& options);
+
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
