@@ -8,6 +8,7 @@
 #include "capi/client_state.h"
 #include "capi/splinegrid.h"
 #include "client/client.h"
+#include "core/util/status_macros.h"
 
 namespace {
 
@@ -27,18 +28,12 @@ absl::Status Connect(const char* target, const char* token, const char* tls_ca_f
   if (timeout_seconds > 0.0) options.timeout = absl::Seconds(timeout_seconds);
   if (token != nullptr) options.token = token;
   if (tls_ca_file != nullptr && *tls_ca_file != '\0') {
-    if (absl::Status s = client::LoadTlsFiles(tls_ca_file, "", "", &options); !s.ok()) {
-      return absl::Status(s.code(), absl::StrCat("tls_ca_file: ", s.message()));
-    }
+    SG_RETURN_IF_ERROR(client::LoadTlsFiles(tls_ca_file, "", "", &options), "tls_ca_file: ");
   }
   *out = client::Client::Connect(target, options);
-  const absl::StatusOr<std::string> health = (*out)->Health();
-  if (!health.ok()) {
-    return absl::Status(health.status().code(),
-                        absl::StrCat("connect to ", target, ": ", health.status().message()));
-  }
-  if (*health != "SERVING") {
-    return absl::UnavailableError(absl::StrCat("connect to ", target, ": the server is ", *health));
+  SG_ASSIGN_OR_RETURN(const std::string health, (*out)->Health(), "connect to ", target, ": ");
+  if (health != "SERVING") {
+    return absl::UnavailableError(absl::StrCat("connect to ", target, ": the server is ", health));
   }
   return absl::OkStatus();
 }

@@ -166,12 +166,7 @@ absl::Status LoadTlsFiles(const std::string& ca_file, const std::string& cert_fi
   const auto read = [](const std::string& path, const char* flag,
                        std::string* pem) -> absl::Status {
     if (path.empty()) return absl::OkStatus();
-    absl::StatusOr<std::string> text = ReadFileToString(path);
-    if (!text.ok()) {
-      return absl::Status(text.status().code(),
-                          absl::StrCat("--", flag, ": ", text.status().message()));
-    }
-    *pem = *std::move(text);
+    SG_ASSIGN_OR_RETURN(*pem, ReadFileToString(path), "--", flag, ": ");
     return absl::OkStatus();
   };
   SG_RETURN_IF_ERROR(read(ca_file, "tls_ca", &options->tls_root_certs));

@@ -156,10 +156,7 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     } else if (!message.grid_id().empty()) {
       return absl::InvalidArgumentError("grid_id is set after the first message");
     }
-    const absl::Status added = assembler_->Add(message.record());
-    if (!added.ok()) {
-      return absl::Status(added.code(), absl::StrCat("record ", records_, ": ", added.message()));
-    }
+    SG_RETURN_IF_ERROR(assembler_->Add(message.record()), "record ", records_, ": ");
     ++records_;
     return absl::OkStatus();
   }

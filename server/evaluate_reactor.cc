@@ -122,12 +122,9 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       }
       seen[b] = true;
       const FittedBlock& fitted = revision_->blocks[b].fitted;
-      absl::StatusOr<Extents> extents = SampleExtents(fitted.distribution, resolution);
-      if (!extents.ok()) {
-        return absl::Status(extents.status().code(),
-                            absl::StrCat("block ", b, ": ", extents.status().message()));
-      }
-      total += NumPoints(*extents);
+      SG_ASSIGN_OR_RETURN(const Extents extents, SampleExtents(fitted.distribution, resolution),
+                          "block ", b, ": ");
+      total += NumPoints(extents);
       if (total > state_->options.max_output_points) {
         return absl::OutOfRangeError(absl::StrCat("the requested resolution gives over ", total,
                                                   " points, more than the server's cap of ",
@@ -136,14 +133,13 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
       }
       // The evaluator's intermediate nets: n_u' x n_v x n_w, and planes of n_u' x n_v.
       const Extents n = fitted.spline.control_extents();
-      const int64_t net = int64_t{s} * (*extents)[0] * n[1] * (n[2] + 3) * sizeof(double);
+      const int64_t net = int64_t{s} * extents[0] * n[1] * (n[2] + 3) * sizeof(double);
       work_bytes = std::max(work_bytes, net * (request_->derivatives() ? 2 : 1));
       v1::EvaluatedBlock* eb = h->add_blocks();
       eb->set_block(b);
-      EncodeExtents(*extents, eb->mutable_extents());
-      plan_.push_back({b, *extents, {}});
-      param_bytes +=
-          (int64_t{(*extents)[0]} + (*extents)[1] + (*extents)[2]) * int64_t{sizeof(double)};
+      EncodeExtents(extents, eb->mutable_extents());
+      plan_.push_back({b, extents, {}});
+      param_bytes += (int64_t{extents[0]} + extents[1] + extents[2]) * int64_t{sizeof(double)};
     }
     // Reserved before the parameters are sampled: a small request may ask for 2^30 of them.
     SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(work_bytes + param_bytes +

@@ -24,9 +24,7 @@ absl::StatusOr<GridRevision> SplineGridService::FitRevision(const SourcePoints& 
   // Options that do not suit the grid are refused, naming the request's field, value and limit
   // ("spec.control_counts[0] = 1000 exceeds the 113 points of block 0 in i"); nothing is
   // clamped, and nothing is stored.
-  if (absl::Status s = options.Validate(source.grid); !s.ok()) {
-    return absl::Status(s.code(), absl::StrCat(SpecField(origin, parent), s.message()));
-  }
+  SG_RETURN_IF_ERROR(options.Validate(source.grid), SpecField(origin, parent));
   // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,

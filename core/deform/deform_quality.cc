@@ -58,17 +58,15 @@ absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>
     const StructuredBlock was = EvaluateGrid(reference[b].spline, params);
     SG_ASSIGN_OR_RETURN(PointDistribution at_level, PointDistribution::Create(params));
     const FittedBlock now{deformed[b].spline, std::move(at_level), {}};
-    absl::StatusOr<CellQuality> q = CheckCellQuality(now, was, options);
-    if (!q.ok()) {
-      return absl::Status(q.status().code(), absl::StrCat("block ", b, ": ", q.status().message()));
-    }
-    check.cells_checked += q->cells_checked;
-    check.folded += q->folded;
-    check.max_jacobian_ratio = std::max(check.max_jacobian_ratio, q->max_ratio);
-    if (q->cells_checked > 0 && q->min_ratio < check.min_jacobian_ratio) {
-      check.min_jacobian_ratio = q->min_ratio;
+    SG_ASSIGN_OR_RETURN(const CellQuality q, CheckCellQuality(now, was, options), "block ", b,
+                        ": ");
+    check.cells_checked += q.cells_checked;
+    check.folded += q.folded;
+    check.max_jacobian_ratio = std::max(check.max_jacobian_ratio, q.max_ratio);
+    if (q.cells_checked > 0 && q.min_ratio < check.min_jacobian_ratio) {
+      check.min_jacobian_ratio = q.min_ratio;
       check.worst_block = static_cast<int>(b);
-      check.worst_cell = q->worst_cell;
+      check.worst_cell = q.worst_cell;
     }
   }
   for (const WallLine& line : FindWallLines(reference, kinds)) {

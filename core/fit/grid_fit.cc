@@ -15,11 +15,6 @@ namespace {
 // Refinement level of the wall curvature report (three samples between grid points).
 constexpr int kCurvatureLevel = 2;
 
-// The status with "block b: " in front of its message.
-absl::Status InBlock(int b, const absl::Status& status) {
-  return absl::Status(status.code(), absl::StrCat("block ", b, ": ", status.message()));
-}
-
 // The index in options.block_control_counts of block b's override, or -1.
 int OverrideOf(const GridFitOptions& options, int b) {
   for (size_t q = 0; q < options.block_control_counts.size(); ++q) {
@@ -47,10 +42,8 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const Connectivity& connectiv
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
     FitOptions fit_options = BlockOptions(options, b);
     fit_options.cancel = cancel;
-    absl::StatusOr<FittedBlock> fit = FitBlock(grid.blocks[b], fit_options);
-    if (!fit.ok()) return InBlock(b, fit.status());
     BlockFit block;
-    block.fitted = *std::move(fit);
+    SG_ASSIGN_OR_RETURN(block.fitted, FitBlock(grid.blocks[b], fit_options), "block ", b, ": ");
     result.blocks.push_back(std::move(block));
   }
   if (options.fairing.mode == FairingMode::kWeight) {
@@ -241,10 +234,9 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
                                                                    result.kinds.point_kinds[b]));
     }
     if (quality) {
-      absl::StatusOr<CellQuality> q =
-          CheckCellQuality(block.fitted, grid.blocks[b], quality_options);
-      if (!q.ok()) return InBlock(static_cast<int>(b), q.status());
-      block.quality = *std::move(q);
+      SG_ASSIGN_OR_RETURN(block.quality,
+                          CheckCellQuality(block.fitted, grid.blocks[b], quality_options), "block ",
+                          b, ": ");
     }
     result.report.quality_met =
         result.report.quality_met && block.quality.ok() && block.quality.measured();

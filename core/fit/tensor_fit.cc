@@ -107,14 +107,10 @@ absl::StatusOr<TensorSpline> FitTensor(const StructuredBlock& block,
                                                      " parameters for ", m[d], " points"));
     }
     const std::vector<PenaltyRow> penalties = JumpPenaltyRows(knots[d], params[d], fairing);
-    absl::StatusOr<DirectionFit> fit =
-        DirectionFit::Create(knots[d], params[d], ends, pins[d], penalties);
-    if (!fit.ok()) {
-      return absl::Status(fit.status().code(),
-                          absl::StrCat("direction ", std::string(1, kDirectionNames[d]), ": ",
-                                       fit.status().message()));
-    }
-    fits.push_back(*std::move(fit));
+    SG_ASSIGN_OR_RETURN(DirectionFit fit,
+                        DirectionFit::Create(knots[d], params[d], ends, pins[d], penalties),
+                        "direction ", std::string(1, kDirectionNames[d]), ": ");
+    fits.push_back(std::move(fit));
   }
   // Pass d fits direction d of a tensor whose already fitted directions hold control values:
   // shape (s * cur_0 .. cur_{d-1}, m_d, cur_{d+1} .. cur_2) -> n_d. The slowest direction goes

@@ -222,12 +222,9 @@ absl::StatusOr<std::string> EncodePlot3d(const MultiBlockGrid& grid, const Plot3
 
 absl::Status WritePlot3dFile(const std::string& path, const MultiBlockGrid& grid,
                              const Plot3dFormat& format) {
-  absl::StatusOr<std::string> bytes = EncodePlot3d(grid, format);
-  if (!bytes.ok()) {
-    return absl::Status(bytes.status().code(),
-                        absl::StrCat("writing '", path, "': ", bytes.status().message()));
-  }
-  return WriteFileAtomically(path, *bytes);
+  SG_ASSIGN_OR_RETURN(const std::string bytes, EncodePlot3d(grid, format), "writing '", path,
+                      "': ");
+  return WriteFileAtomically(path, bytes);
 }
 
 }  // namespace splinegrid

@@ -160,12 +160,9 @@ absl::StatusOr<std::string> EncodePlot3dFunction(std::span<const Plot3dFunctionB
 absl::Status WritePlot3dFunctionFile(const std::string& path,
                                      std::span<const Plot3dFunctionBlock> blocks,
                                      const Plot3dFormat& format) {
-  absl::StatusOr<std::string> bytes = EncodePlot3dFunction(blocks, format);
-  if (!bytes.ok()) {
-    return absl::Status(bytes.status().code(),
-                        absl::StrCat("writing '", path, "': ", bytes.status().message()));
-  }
-  return WriteFileAtomically(path, *bytes);
+  SG_ASSIGN_OR_RETURN(const std::string bytes, EncodePlot3dFunction(blocks, format), "writing '",
+                      path, "': ");
+  return WriteFileAtomically(path, bytes);
 }
 
 }  // namespace splinegrid

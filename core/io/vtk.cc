@@ -289,12 +289,9 @@ absl::StatusOr<std::string> EncodeVts(const StructuredBlock& block,
 
 absl::Status WriteVts(const std::string& path, const StructuredBlock& block,
                       std::span<const VtkPointArray> arrays, const VtkWriteOptions& options) {
-  absl::StatusOr<std::string> contents = EncodeVts(block, arrays, options);
-  if (!contents.ok()) {
-    return absl::Status(contents.status().code(),
-                        absl::StrCat("writing '", path, "': ", contents.status().message()));
-  }
-  return WriteFileAtomically(path, *contents);
+  SG_ASSIGN_OR_RETURN(const std::string contents, EncodeVts(block, arrays, options), "writing '",
+                      path, "': ");
+  return WriteFileAtomically(path, contents);
 }
 
 absl::Status WriteVtm(const std::string& path, const MultiBlockGrid& grid,
@@ -342,11 +339,8 @@ absl::Status WriteVtm(const std::string& path, const MultiBlockGrid& grid,
     const std::string file = absl::StrCat(name, "_", number, ".vts");
     const std::span<const VtkPointArray> arrays =
         block_arrays.empty() ? std::span<const VtkPointArray>() : block_arrays[b];
-    absl::Status status = WriteVts((directory / file).string(), grid.blocks[b], arrays, options);
-    if (!status.ok()) {
-      return absl::Status(status.code(),
-                          absl::StrCat("block ", number, " of '", path, "': ", status.message()));
-    }
+    SG_RETURN_IF_ERROR(WriteVts((directory / file).string(), grid.blocks[b], arrays, options),
+                       "block ", number, " of '", path, "': ");
     absl::StrAppend(&xml, "    <DataSet index=\"", b, "\" name=\"block_", number, "\" file=\"",
                     XmlEscape(absl::StrCat(name, "/", file)), "\"/>\n");
   }

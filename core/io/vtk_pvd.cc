@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid {
 namespace {
@@ -62,12 +63,8 @@ absl::StatusOr<std::string> EncodePvd(std::span<const PvdEntry> entries) {
 }
 
 absl::Status WritePvd(const std::string& path, std::span<const PvdEntry> entries) {
-  absl::StatusOr<std::string> text = EncodePvd(entries);
-  if (!text.ok()) {
-    return absl::Status(text.status().code(),
-                        absl::StrCat("writing '", path, "': ", text.status().message()));
-  }
-  return WriteFileAtomically(path, *text);
+  SG_ASSIGN_OR_RETURN(const std::string text, EncodePvd(entries), "writing '", path, "': ");
+  return WriteFileAtomically(path, text);
 }
 
 }  // namespace splinegrid

@@ -469,14 +469,10 @@ absl::StatusOr<std::unique_ptr<GridStore>> OpenRedisStore(const std::string& spe
         "max_deform_revisions = ", options.max_deform_revisions, " must be at least 1"));
   }
   if (options.key_prefix.empty()) return absl::InvalidArgumentError("key_prefix is empty");
-  absl::StatusOr<std::unique_ptr<RedisConnection>> first =
-      RedisConnection::Open(address, options.connection);
-  if (!first.ok()) {
-    return absl::Status(first.status().code(),
-                        absl::StrCat("--store=", spec, ": ", first.status().message()));
-  }
-  SG_RETURN_IF_ERROR(CheckVersion(**first));
-  WarnAboutDurability(**first);
+  SG_ASSIGN_OR_RETURN(const std::unique_ptr<RedisConnection> first,
+                      RedisConnection::Open(address, options.connection), "--store=", spec, ": ");
+  SG_RETURN_IF_ERROR(CheckVersion(*first));
+  WarnAboutDurability(*first);
   return std::make_unique<RedisStore>(address, options, budget);
 }
 
