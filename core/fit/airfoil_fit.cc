@@ -398,8 +398,8 @@ struct Start {
 absl::StatusOr<Placement> Place(ProfileFitter& fitter, const Start& start, const Start& scratch,
                                 double target, int cap, bool remove,
                                 const std::function<std::optional<double>(const Fitted&)>& cusp) {
-  SG_ASSIGN_OR_RETURN(Placement placed, PlaceKnots(fitter, start.interior, start.params, target,
-                                                   cap, remove, cusp));
+  SG_ASSIGN_OR_RETURN(Placement placed,
+                      PlaceKnots(fitter, start.interior, start.params, target, cap, remove, cusp));
   placed.inserted += start.inserted;
   placed.removed += start.removed;
   if (placed.stop.empty()) return placed;
@@ -481,6 +481,184 @@ absl::StatusOr<Start> CoarseStart(
   return out;
 }
 
+// Trailing edge: ends within the tolerance are one point (a sharp trailing edge).
+bool SharpTrailingEdge(const std::vector<double>& data, double tolerance) {
+  const size_t m = data.size() / 2;
+  const double gap = std::hypot(data[0] - data[2 * m - 2], data[1] - data[2 * m - 1]);
+  return gap <= tolerance;
+}
+
+// The data the curve is fitted to: `data` with the ends of a sharp trailing edge merged into
+// their midpoint.
+std::vector<double> MergeTrailingEdge(const std::vector<double>& data, bool sharp) {
+  const size_t m = data.size() / 2;
+  std::vector<double> fit_data = data;
+  if (sharp) {
+    for (int c = 0; c < 2; ++c) {
+      fit_data[c] = fit_data[2 * m - 2 + c] = 0.5 * (data[c] + data[2 * m - 2 + c]);
+    }
+  }
+  return fit_data;
+}
+
+// INVALID_ARGUMENT naming the segments when the outline `fit_data` (closed when `sharp`)
+// crosses itself.
+absl::Status CheckSimpleOutline(const std::vector<double>& fit_data, bool sharp) {
+  if (const std::optional<PolylineCrossing> crossing = FindPolylineCrossing(fit_data, sharp)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "points: the outline crosses itself: segment ", crossing->first, "-", crossing->first + 1,
+        " meets segment ", crossing->second, "-", crossing->second + 1,
+        " (points must go once around the profile, in Selig order)"));
+  }
+  return absl::OkStatus();
+}
+
+// Leading edge: the point of `data` farthest from the trailing-edge midpoint of `fit_data`.
+int LeadingEdge(const std::vector<double>& data, const std::vector<double>& fit_data) {
+  const int m = static_cast<int>(data.size() / 2);
+  const double te_x = 0.5 * (fit_data[0] + fit_data[2 * m - 2]);
+  const double te_y = 0.5 * (fit_data[1] + fit_data[2 * m - 1]);
+  double farthest = -1.0;
+  int leading_edge = 0;
+  for (int i = 0; i < m; ++i) {
+    const double d = std::hypot(data[2 * i] - te_x, data[2 * i + 1] - te_y);
+    if (d > farthest) farthest = d, leading_edge = i;
+  }
+  return leading_edge;
+}
+
+// The most control points of a fit of m points (`max_control_points`, 0: m); INVALID_ARGUMENT
+// when that is below what order k and the feature points need.
+absl::StatusOr<int> ControlCap(int m, int k, size_t num_features, int max_control_points) {
+  const int min_controls = k + static_cast<int>(num_features) * (k - 1);
+  const int cap = max_control_points == 0 ? m : std::min(max_control_points, m);
+  if (cap < min_controls) {
+    const std::string need = absl::StrCat("order ", k, " and ", num_features,
+                                          " feature points need at least ", min_controls);
+    return absl::InvalidArgumentError(
+        cap < m ? absl::StrCat("max_control_points = ", cap, ": ", need)
+                : absl::StrCat("points: ", m, " points are too few, ", need, " controls"));
+  }
+  return cap;
+}
+
+// The parameters of the outline `points` with the coordinates `fit_data` (merged trailing
+// edge).
+std::vector<double> OutlineParameters(const StructuredBlock& points,
+                                      const std::vector<double>& fit_data,
+                                      Parametrization parametrization) {
+  StructuredBlock work = points;
+  std::copy(fit_data.begin(), fit_data.end(), work.coords().begin());
+  return ParametrizeBlock(work, parametrization)[0];
+}
+
+// The reference (file comment): the fairest curve within the tolerance, and its largest
+// curvature, which bounds every accepted fit's (kCurvatureGuard). Too few points for its knots
+// (high orders on tiny outlines): no reference, every extremum counts as spurious. Sets
+// result.reference_curvature; returns the curvature limit (infinite without a reference).
+absl::StatusOr<double> FitReference(ProfileFitter& fitter, const std::vector<double>& params,
+                                    const AirfoilFitOptions& options, AirfoilFit& result) {
+  const int m = static_cast<int>(params.size());
+  const std::vector<int>& anchors = fitter.anchors();
+  const std::vector<double> dense_knots = ReferenceKnots(anchors, params, options.order);
+  if (fitter.NumControls(dense_knots) > m || !fitter.WellPosed(dense_knots, params)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  SG_ASSIGN_OR_RETURN(const Fitted dense, FitAndMeasure(fitter, dense_knots, {}, params));
+  SG_ASSIGN_OR_RETURN(const Fitted reference,
+                      FairToTolerance(fitter, dense_knots, dense, options.fairing.weight,
+                                      options.tolerance, [](const Fitted&) { return true; }));
+  result.reference_curvature =
+      MeasureCurvature(reference, anchors, result.leading_edge, options.curvature_level);
+  CountSpurious(result.reference_curvature, result.reference_curvature);
+  return kCurvatureGuard * result.reference_curvature.total.max_abs_curvature;
+}
+
+// The placed fit `fitted` converged (parameter correction to the end) at knots `interior`: the
+// converged fit when it is within `target` without a cusp, or when placement stopped short
+// (`stop` not empty); else `fitted`.
+absl::StatusOr<Fitted> Converged(ProfileFitter& fitter, const std::vector<double>& interior,
+                                 Fitted fitted, const std::string& stop, double target,
+                                 const std::function<std::optional<double>(const Fitted&)>& cusp) {
+  SG_ASSIGN_OR_RETURN(Fitted converged, FitAndMeasure(fitter, interior, {}, fitted.params));
+  if (!stop.empty() || (converged.max() <= target && !cusp(converged))) return converged;
+  return fitted;
+}
+
+// Step 5: fairing of `fitted` (to tolerance when `to_tolerance`, else with the fixed weight of
+// FairingMode::kWeight, else none). A faired curve must also be no less fair than the unfaired
+// one by the measures reported: squared curvature differences and spurious extrema. Sets the
+// unfaired and final curvature of `result`.
+absl::StatusOr<Fitted> Fair(ProfileFitter& fitter, const std::vector<double>& interior,
+                            Fitted fitted, bool to_tolerance, double curvature_limit,
+                            const AirfoilFitOptions& options, AirfoilFit& result) {
+  const std::vector<int>& anchors = fitter.anchors();
+  const int level = options.curvature_level;
+  result.unfaired_curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
+  CountSpurious(result.reference_curvature, result.unfaired_curvature);
+  if (to_tolerance) {
+    const ProfileCurvature& before = result.unfaired_curvature;
+    auto fairer = [&](const Fitted& fit) {
+      ProfileCurvature c = MeasureCurvature(fit, anchors, result.leading_edge, level);
+      CountSpurious(result.reference_curvature, c);
+      return c.total.max_abs_curvature <= curvature_limit &&
+             c.total.sum_squared_differences <= before.total.sum_squared_differences &&
+             c.spurious() <= before.spurious();
+    };
+    SG_ASSIGN_OR_RETURN(fitted, FairToTolerance(fitter, interior, fitted, options.fairing.weight,
+                                                options.tolerance, fairer));
+  } else if (options.fairing.mode == FairingMode::kWeight) {
+    SG_ASSIGN_OR_RETURN(
+        fitted,
+        FitAndMeasure(fitter, interior, {options.fairing.weight, MedianCappedScales(fitted.curve)},
+                      fitted.params));
+  }
+  result.curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
+  CountSpurious(result.reference_curvature, result.curvature);
+  return fitted;
+}
+
+// Why `result` (its fields set by Assemble) is not met: the cusp or the worst point of `data`,
+// and the control points with the fixed fairing weight or the placement's `stop`.
+std::string UnmetReason(const AirfoilFit& result, const std::vector<double>& data, double tolerance,
+                        double curvature_limit, const std::string& stop) {
+  const int w = result.worst_point;
+  const double peak = result.curvature.total.max_abs_curvature;
+  std::string reason =
+      result.max_deviation <= tolerance
+          ? absl::StrCat("the curve has a cusp: curvature ", peak, " exceeds ", kCurvatureGuard,
+                         " times the reference's ", curvature_limit / kCurvatureGuard)
+          : absl::StrCat("point ", w, " at (", data[2 * w], ", ", data[2 * w + 1], ") is ",
+                         result.max_deviation, " from the curve, over the tolerance ", tolerance);
+  absl::StrAppend(
+      &reason, " with ", result.num_control_points, " control points: ",
+      stop.empty() ? absl::StrCat("the fixed fairing weight ", result.fairing_weight) : stop);
+  return reason;
+}
+
+// The result from the final fit: the curve, its distances and worst point, and whether the
+// tolerance and the curvature limit are met (else why not).
+absl::Status Assemble(Fitted fitted, const std::vector<double>& data, double tolerance,
+                      double curvature_limit, const std::string& stop, AirfoilFit& result) {
+  SG_ASSIGN_OR_RETURN(result.curve,
+                      TensorSpline::Create({fitted.curve.knots, KnotVector(), KnotVector()}, 2,
+                                           fitted.curve.control));
+  result.num_control_points = fitted.curve.knots.num_controls();
+  result.fairing_weight = fitted.lambda;
+  result.params = std::move(fitted.feet);
+  result.distances = std::move(fitted.distances);
+  result.worst_point =
+      static_cast<int>(std::max_element(result.distances.begin(), result.distances.end()) -
+                       result.distances.begin());
+  result.max_deviation = result.distances[result.worst_point];
+  const double peak = result.curvature.total.max_abs_curvature;
+  result.met = result.max_deviation <= tolerance && peak <= curvature_limit;
+  if (!result.met) {
+    result.unmet_reason = UnmetReason(result, data, tolerance, curvature_limit, stop);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 int64_t ProfileCurvature::spurious() const {
@@ -524,65 +702,20 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
   const std::vector<double> data(points.coords().begin(), points.coords().end());
   AirfoilFit result;
 
-  // Trailing edge: ends within the tolerance are one point, their midpoint. Leading edge: the
-  // point farthest from the trailing-edge midpoint.
-  std::vector<double> fit_data = data;
-  const double gap = std::hypot(data[0] - data[2 * m - 2], data[1] - data[2 * m - 1]);
-  result.sharp_trailing_edge = gap <= tolerance;
-  if (result.sharp_trailing_edge) {
-    for (int c = 0; c < 2; ++c) {
-      fit_data[c] = fit_data[2 * m - 2 + c] = 0.5 * (data[c] + data[2 * m - 2 + c]);
-    }
-  }
-  if (const std::optional<PolylineCrossing> crossing =
-          FindPolylineCrossing(fit_data, result.sharp_trailing_edge)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "points: the outline crosses itself: segment ", crossing->first, "-", crossing->first + 1,
-        " meets segment ", crossing->second, "-", crossing->second + 1,
-        " (points must go once around the profile, in Selig order)"));
-  }
-  const double te_x = 0.5 * (fit_data[0] + fit_data[2 * m - 2]);
-  const double te_y = 0.5 * (fit_data[1] + fit_data[2 * m - 1]);
-  double farthest = -1.0;
-  for (int i = 0; i < m; ++i) {
-    const double d = std::hypot(data[2 * i] - te_x, data[2 * i + 1] - te_y);
-    if (d > farthest) farthest = d, result.leading_edge = i;
-  }
-  result.features =
-      OutlineFeatures(points, options.features, result.leading_edge, k, tolerance);
-  const int min_controls = k + static_cast<int>(result.features.size()) * (k - 1);
-  const int cap = options.max_control_points == 0 ? m : std::min(options.max_control_points, m);
-  if (cap < min_controls) {
-    const std::string need = absl::StrCat("order ", k, " and ", result.features.size(),
-                                          " feature points need at least ", min_controls);
-    return absl::InvalidArgumentError(
-        cap < m ? absl::StrCat("max_control_points = ", cap, ": ", need)
-                : absl::StrCat("points: ", m, " points are too few, ", need, " controls"));
-  }
+  result.sharp_trailing_edge = SharpTrailingEdge(data, tolerance);
+  const std::vector<double> fit_data = MergeTrailingEdge(data, result.sharp_trailing_edge);
+  SG_RETURN_IF_ERROR(CheckSimpleOutline(fit_data, result.sharp_trailing_edge));
+  result.leading_edge = LeadingEdge(data, fit_data);
+  result.features = OutlineFeatures(points, options.features, result.leading_edge, k, tolerance);
+  SG_ASSIGN_OR_RETURN(const int cap,
+                      ControlCap(m, k, result.features.size(), options.max_control_points));
 
-  StructuredBlock work = points;
-  std::copy(fit_data.begin(), fit_data.end(), work.coords().begin());
-  const std::vector<double> params = ParametrizeBlock(work, options.parametrization)[0];
+  const std::vector<double> params = OutlineParameters(points, fit_data, options.parametrization);
   ProfileFitter fitter(fit_data, data, k, result.features, options.max_parameter_corrections,
                        options.cancel);
-  const std::vector<int>& anchors = fitter.anchors();
   std::vector<double> interior;
   for (int r : result.features) interior.insert(interior.end(), k - 1, params[r]);
-
-  // The reference (file comment): the fairest curve within the tolerance, and its largest
-  // curvature, which bounds every accepted fit's (kCurvatureGuard). Too few points for its knots
-  // (high orders on tiny outlines): no reference, every extremum counts as spurious.
-  double curvature_limit = std::numeric_limits<double>::infinity();
-  const std::vector<double> dense_knots = ReferenceKnots(anchors, params, k);
-  if (fitter.NumControls(dense_knots) <= m && fitter.WellPosed(dense_knots, params)) {
-    SG_ASSIGN_OR_RETURN(const Fitted dense, FitAndMeasure(fitter, dense_knots, {}, params));
-    SG_ASSIGN_OR_RETURN(const Fitted reference,
-                        FairToTolerance(fitter, dense_knots, dense, options.fairing.weight,
-                                        tolerance, [](const Fitted&) { return true; }));
-    result.reference_curvature = MeasureCurvature(reference, anchors, result.leading_edge, level);
-    CountSpurious(result.reference_curvature, result.reference_curvature);
-    curvature_limit = kCurvatureGuard * result.reference_curvature.total.max_abs_curvature;
-  }
+  SG_ASSIGN_OR_RETURN(const double curvature_limit, FitReference(fitter, params, options, result));
   auto cusp_at = [&](const ProfileFitter& by, const Fitted& fit) -> std::optional<double> {
     const auto [kappa, u] = CurvaturePeak(fit, by.anchors(), level);
     if (kappa > curvature_limit) return u;
@@ -601,65 +734,15 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
   result.knots_inserted = placed.inserted;
   result.knots_removed = placed.removed;
   interior = std::move(placed.interior);
-  Fitted fitted = std::move(placed.fitted);
-  {
-    SG_ASSIGN_OR_RETURN(Fitted converged, FitAndMeasure(fitter, interior, {}, fitted.params));
-    if (!placed.stop.empty() || (converged.max() <= target && !cusp(converged))) {
-      fitted = std::move(converged);
-    }
-  }
+  SG_ASSIGN_OR_RETURN(Fitted fitted, Converged(fitter, interior, std::move(placed.fitted),
+                                               placed.stop, target, cusp));
 
-  // Step 5: fairing. A faired curve must also be no less fair than the unfaired one by the
-  // measures reported: squared curvature differences and spurious extrema.
-  result.unfaired_curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
-  CountSpurious(result.reference_curvature, result.unfaired_curvature);
-  if (fair_to_tolerance && placed.stop.empty()) {
-    const ProfileCurvature& before = result.unfaired_curvature;
-    auto fairer = [&](const Fitted& fit) {
-      ProfileCurvature c = MeasureCurvature(fit, anchors, result.leading_edge, level);
-      CountSpurious(result.reference_curvature, c);
-      return c.total.max_abs_curvature <= curvature_limit &&
-             c.total.sum_squared_differences <= before.total.sum_squared_differences &&
-             c.spurious() <= before.spurious();
-    };
-    SG_ASSIGN_OR_RETURN(fitted, FairToTolerance(fitter, interior, fitted, options.fairing.weight,
-                                                tolerance, fairer));
-  } else if (options.fairing.mode == FairingMode::kWeight) {
-    SG_ASSIGN_OR_RETURN(
-        fitted,
-        FitAndMeasure(fitter, interior, {options.fairing.weight, MedianCappedScales(fitted.curve)},
-                      fitted.params));
-  }
-  result.curvature = MeasureCurvature(fitted, anchors, result.leading_edge, level);
-  CountSpurious(result.reference_curvature, result.curvature);
-
-  SG_ASSIGN_OR_RETURN(result.curve,
-                      TensorSpline::Create({fitted.curve.knots, KnotVector(), KnotVector()}, 2,
-                                           fitted.curve.control));
-  result.num_control_points = fitted.curve.knots.num_controls();
-  result.fairing_weight = fitted.lambda;
-  result.params = std::move(fitted.feet);
-  result.distances = std::move(fitted.distances);
-  result.worst_point =
-      static_cast<int>(std::max_element(result.distances.begin(), result.distances.end()) -
-                       result.distances.begin());
-  result.max_deviation = result.distances[result.worst_point];
+  SG_ASSIGN_OR_RETURN(
+      fitted, Fair(fitter, interior, std::move(fitted), fair_to_tolerance && placed.stop.empty(),
+                   curvature_limit, options, result));
   result.fits = fitter.fits() + start.fits;
-  const double peak = result.curvature.total.max_abs_curvature;
-  result.met = result.max_deviation <= tolerance && peak <= curvature_limit;
-  if (!result.met) {
-    const int w = result.worst_point;
-    result.unmet_reason =
-        result.max_deviation <= tolerance
-            ? absl::StrCat("the curve has a cusp: curvature ", peak, " exceeds ", kCurvatureGuard,
-                           " times the reference's ", curvature_limit / kCurvatureGuard)
-            : absl::StrCat("point ", w, " at (", data[2 * w], ", ", data[2 * w + 1], ") is ",
-                           result.max_deviation, " from the curve, over the tolerance ", tolerance);
-    absl::StrAppend(&result.unmet_reason, " with ", result.num_control_points, " control points: ",
-                    placed.stop.empty()
-                        ? absl::StrCat("the fixed fairing weight ", result.fairing_weight)
-                        : placed.stop);
-  }
+  SG_RETURN_IF_ERROR(
+      Assemble(std::move(fitted), data, tolerance, curvature_limit, placed.stop, result));
   return result;
 }
 

@@ -63,6 +63,65 @@ void ScatterRow(const double* buffer, int64_t a, int64_t rows, int64_t r, int64_
   });
 }
 
+// OK for `params` (m >= 1, strictly increasing) and, without penalty rows, at least as many
+// points as the n controls; else INVALID_ARGUMENT.
+absl::Status ValidateData(std::span<const double> params, int n, bool no_penalties) {
+  const int m = static_cast<int>(params.size());
+  if (m < 1) return absl::InvalidArgumentError("no data points");
+  if (no_penalties && m < n) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(n, " control points cannot be fitted to ", m, " points"));
+  }
+  for (int i = 1; i < m; ++i) {
+    if (!(params[i] > params[i - 1])) {
+      return absl::InvalidArgumentError(absl::StrCat("parameters are not strictly increasing at ",
+                                                     i, ": ", params[i - 1], ", ", params[i]));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// The data rows and the penalty rows over all controls, and the bandwidth they need.
+struct MergedRows {
+  std::vector<FullRow> rows;
+  int bandwidth = 0;
+};
+
+// Data rows come with non-decreasing first columns (sorted parameters); penalty rows are
+// merged in by their first column. INVALID_ARGUMENT for a penalty row outside the n controls.
+absl::StatusOr<MergedRows> MergeRows(const SampledBasis& basis,
+                                     std::span<const PenaltyRow> penalties, int n) {
+  const int m = basis.num_samples(), k = basis.order;
+  MergedRows merged;
+  merged.bandwidth = k;
+  std::vector<const PenaltyRow*> sorted_penalties;
+  sorted_penalties.reserve(penalties.size());
+  for (const PenaltyRow& p : penalties) {
+    const int size = static_cast<int>(p.values.size());
+    if (p.first < 0 || size < 1 || p.first + size > n) {
+      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first, " with ",
+                                                     size, " entries exceeds ", n, " controls"));
+    }
+    sorted_penalties.push_back(&p);
+    merged.bandwidth = std::max(merged.bandwidth, size);
+  }
+  std::stable_sort(sorted_penalties.begin(), sorted_penalties.end(),
+                   [](const PenaltyRow* x, const PenaltyRow* y) { return x->first < y->first; });
+  std::vector<FullRow>& full = merged.rows;
+  full.reserve(m + penalties.size());
+  for (int r = 0, q = 0; r < m || q < static_cast<int>(sorted_penalties.size());) {
+    if (q < static_cast<int>(sorted_penalties.size()) &&
+        (r == m || sorted_penalties[q]->first < basis.first[r])) {
+      const PenaltyRow& p = *sorted_penalties[q++];
+      full.push_back({p.first, p.values.data(), static_cast<int>(p.values.size()), -1});
+    } else {
+      full.push_back({basis.first[r], basis.Row(r), k, r});
+      ++r;
+    }
+  }
+  return merged;
+}
+
 }  // namespace
 
 bool SchoenbergWhitneyHolds(const KnotVector& knots, std::span<const double> params,
@@ -93,104 +152,26 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
   const int m = static_cast<int>(params.size());
   const int n = knots.num_controls();
   const int k = knots.order();
-  if (m < 1) return absl::InvalidArgumentError("no data points");
+  SG_RETURN_IF_ERROR(ValidateData(params, n, penalties.empty()));
   if (n < 2) ends = EndCondition::kFree;
-  if (penalties.empty() && m < n) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(n, " control points cannot be fitted to ", m, " points"));
-  }
-  for (int i = 1; i < m; ++i) {
-    if (!(params[i] > params[i - 1])) {
-      return absl::InvalidArgumentError(absl::StrCat("parameters are not strictly increasing at ",
-                                                     i, ": ", params[i - 1], ", ", params[i]));
-    }
-  }
   DirectionFit fit;
   fit.num_points_ = m;
   fit.num_controls_ = n;
   fit.zero_pins_ = ends == EndCondition::kZero;
-  std::vector<int> pin_of(n, -1);  // control -> pin index
-  auto add_pin = [&](Pin pin) -> absl::Status {
-    if (pin.control < 0 || pin.control >= n || pin.data_row < 0 || pin.data_row >= m ||
-        pin_of[pin.control] >= 0) {
-      return absl::InvalidArgumentError(absl::StrCat("pin of control ", pin.control,
-                                                     " to data row ", pin.data_row,
-                                                     " is out of range or repeated"));
-    }
-    pin_of[pin.control] = static_cast<int>(fit.pins_.size());
-    fit.pins_.push_back(pin);
-    return absl::OkStatus();
-  };
-  if (ends != EndCondition::kFree) {
-    SG_RETURN_IF_ERROR(add_pin({0, 0}));
-    SG_RETURN_IF_ERROR(add_pin({n - 1, m - 1}));
-  }
-  for (const Pin& pin : interior_pins) SG_RETURN_IF_ERROR(add_pin(pin));
-  std::vector<int> free_index(n, -1);
-  for (int col = 0; col < n; ++col) {
-    if (pin_of[col] < 0) {
-      free_index[col] = static_cast<int>(fit.free_columns_.size());
-      fit.free_columns_.push_back(col);
-    }
-  }
+  SG_ASSIGN_OR_RETURN(const std::vector<int> pin_of, fit.PinControls(ends, interior_pins));
+  const std::vector<int> free_index = fit.SetFreeColumns(pin_of);
   const int n_free = static_cast<int>(fit.free_columns_.size());
 
   const SampledBasis basis = SampleBasis(knots, params, 0);
-  // Data rows come with non-decreasing first columns (sorted parameters); penalty rows are
-  // merged in by their first column.
-  int bandwidth = k;
-  std::vector<const PenaltyRow*> sorted_penalties;
-  sorted_penalties.reserve(penalties.size());
-  for (const PenaltyRow& p : penalties) {
-    const int size = static_cast<int>(p.values.size());
-    if (p.first < 0 || size < 1 || p.first + size > n) {
-      return absl::InvalidArgumentError(absl::StrCat("penalty row at column ", p.first, " with ",
-                                                     size, " entries exceeds ", n, " controls"));
-    }
-    sorted_penalties.push_back(&p);
-    bandwidth = std::max(bandwidth, size);
-  }
-  std::stable_sort(sorted_penalties.begin(), sorted_penalties.end(),
-                   [](const PenaltyRow* x, const PenaltyRow* y) { return x->first < y->first; });
-  std::vector<FullRow> full;
-  full.reserve(m + penalties.size());
-  for (int r = 0, q = 0; r < m || q < static_cast<int>(sorted_penalties.size());) {
-    if (q < static_cast<int>(sorted_penalties.size()) &&
-        (r == m || sorted_penalties[q]->first < basis.first[r])) {
-      const PenaltyRow& p = *sorted_penalties[q++];
-      full.push_back({p.first, p.values.data(), static_cast<int>(p.values.size()), -1});
-    } else {
-      full.push_back({basis.first[r], basis.Row(r), k, r});
-      ++r;
-    }
-  }
-
+  SG_ASSIGN_OR_RETURN(const MergedRows full, MergeRows(basis, penalties, n));
   // Split every row into its free part (contiguous in free-index space, because pinned
   // columns are simply left out) and its pinned terms.
-  fit.qr_ = BandedQR(n_free, bandwidth, static_cast<int>(full.size()));
-  fit.rows_.reserve(full.size());
-  std::vector<double> free_values(bandwidth);
-  for (const FullRow& row : full) {
-    RowSource source{row.data_row, static_cast<int>(fit.pinned_terms_.size()), 0};
-    int first_free = -1, count = 0;
-    bool any = false;
-    for (int t = 0; t < row.size; ++t) {
-      const int col = row.first + t;
-      if (pin_of[col] >= 0) {
-        if (row.values[t] != 0.0) fit.pinned_terms_.push_back({pin_of[col], row.values[t]});
-        continue;
-      }
-      if (first_free < 0) first_free = free_index[col];
-      free_values[count++] = row.values[t];
-      any |= row.values[t] != 0.0;
-    }
-    source.pinned_end = static_cast<int>(fit.pinned_terms_.size());
-    if (!any) {
-      fit.pinned_terms_.resize(source.pinned_begin);  // the row constrains nothing free
-      continue;
-    }
-    fit.qr_.AddRow(first_free, std::span<const double>(free_values.data(), count));
-    fit.rows_.push_back(source);
+  fit.qr_ = BandedQR(n_free, full.bandwidth, static_cast<int>(full.rows.size()));
+  fit.rows_.reserve(full.rows.size());
+  std::vector<double> free_values(full.bandwidth);
+  for (const FullRow& row : full.rows) {
+    fit.AddSplitRow(row.first, std::span<const double>(row.values, row.size), row.data_row, pin_of,
+                    free_index, free_values);
   }
   if (n_free > 0) {
     if (absl::Status rank = fit.qr_.CheckRank(); !rank.ok()) {
@@ -199,6 +180,65 @@ absl::StatusOr<DirectionFit> DirectionFit::Create(const KnotVector& knots,
     }
   }
   return fit;
+}
+
+absl::StatusOr<std::vector<int>> DirectionFit::PinControls(EndCondition ends,
+                                                           std::span<const Pin> interior_pins) {
+  const int m = num_points_, n = num_controls_;
+  std::vector<int> pin_of(n, -1);  // control -> pin index
+  auto add_pin = [&](Pin pin) -> absl::Status {
+    if (pin.control < 0 || pin.control >= n || pin.data_row < 0 || pin.data_row >= m ||
+        pin_of[pin.control] >= 0) {
+      return absl::InvalidArgumentError(absl::StrCat("pin of control ", pin.control,
+                                                     " to data row ", pin.data_row,
+                                                     " is out of range or repeated"));
+    }
+    pin_of[pin.control] = static_cast<int>(pins_.size());
+    pins_.push_back(pin);
+    return absl::OkStatus();
+  };
+  if (ends != EndCondition::kFree) {
+    SG_RETURN_IF_ERROR(add_pin({0, 0}));
+    SG_RETURN_IF_ERROR(add_pin({n - 1, m - 1}));
+  }
+  for (const Pin& pin : interior_pins) SG_RETURN_IF_ERROR(add_pin(pin));
+  return pin_of;
+}
+
+std::vector<int> DirectionFit::SetFreeColumns(const std::vector<int>& pin_of) {
+  std::vector<int> free_index(num_controls_, -1);
+  for (int col = 0; col < num_controls_; ++col) {
+    if (pin_of[col] < 0) {
+      free_index[col] = static_cast<int>(free_columns_.size());
+      free_columns_.push_back(col);
+    }
+  }
+  return free_index;
+}
+
+void DirectionFit::AddSplitRow(int first, std::span<const double> values, int data_row,
+                               const std::vector<int>& pin_of, const std::vector<int>& free_index,
+                               std::vector<double>& free_values) {
+  RowSource source{data_row, static_cast<int>(pinned_terms_.size()), 0};
+  int first_free = -1, count = 0;
+  bool any = false;
+  for (int t = 0; t < static_cast<int>(values.size()); ++t) {
+    const int col = first + t;
+    if (pin_of[col] >= 0) {
+      if (values[t] != 0.0) pinned_terms_.push_back({pin_of[col], values[t]});
+      continue;
+    }
+    if (first_free < 0) first_free = free_index[col];
+    free_values[count++] = values[t];
+    any |= values[t] != 0.0;
+  }
+  source.pinned_end = static_cast<int>(pinned_terms_.size());
+  if (!any) {
+    pinned_terms_.resize(source.pinned_begin);  // the row constrains nothing free
+    return;
+  }
+  qr_.AddRow(first_free, std::span<const double>(free_values.data(), count));
+  rows_.push_back(source);
 }
 
 absl::Status DirectionFit::Apply(const double* in, int64_t a, int64_t b, double* out,

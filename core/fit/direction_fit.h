@@ -81,6 +81,20 @@ class DirectionFit {
 
   DirectionFit() = default;
 
+  // Steps of Create.
+  // Pins the ends (unless kFree) and `interior_pins` into pins_; returns the pin index of every
+  // control (-1: free). INVALID_ARGUMENT for a pin out of range or repeated.
+  absl::StatusOr<std::vector<int>> PinControls(EndCondition ends,
+                                               std::span<const Pin> interior_pins);
+  // Fills free_columns_ from `pin_of`; returns the free index of every control (-1: pinned).
+  std::vector<int> SetFreeColumns(const std::vector<int>& pin_of);
+  // Adds the row `values` over controls first.. (right side: data row `data_row`, or -1 for a
+  // penalty) to qr_ as its free part, its pinned terms to pinned_terms_; a row that constrains
+  // nothing free is dropped. `free_values` is scratch of the bandwidth's size.
+  void AddSplitRow(int first, std::span<const double> values, int data_row,
+                   const std::vector<int>& pin_of, const std::vector<int>& free_index,
+                   std::vector<double>& free_values);
+
   void ApplyBlock(const double* in, int64_t a, int64_t q0, int64_t q1, double* out,
                   std::vector<double>& scratch) const;
 

@@ -213,120 +213,184 @@ Reference BuildReference(const StructuredBlock& original, const RowLayout& layou
   return ref;
 }
 
+// The share of its parent each refined interval at `level` gets: 1 / (du_sub / du_parent) per
+// active direction (a = 0 fast, 1 mid for volumes, num_active - 1 slow), for the samples
+// `params` of `distribution` at that level.
+std::array<std::vector<double>, 3> InverseShares(const PointDistribution& distribution,
+                                                 const std::array<std::vector<double>, 3>& params,
+                                                 const std::array<int, 3>& active, int num_active,
+                                                 int level) {
+  std::array<std::vector<double>, 3> inverse_share;
+  for (int a = 0; a < num_active; ++a) {
+    const std::vector<double>& sub = params[active[a]];
+    const std::vector<double>& u = distribution.params(active[a]);
+    inverse_share[a].resize(sub.size() - 1);
+    for (size_t I = 0; I + 1 < sub.size(); ++I) {
+      const size_t p = I >> level;
+      inverse_share[a][I] = (u[p + 1] - u[p]) / (sub[I + 1] - sub[I]);
+    }
+  }
+  return inverse_share;
+}
+
+// The points per chunk of the fast direction. Chunks overlap by one point: GridEvaluator holds
+// the control net contracted in u, kStride * (chunk points) * n_v * n_w doubles (`stride` is
+// kStride), which the budget bounds (i fast only; otherwise that net is the control net itself).
+int ChunkPoints(int stride, int fast, int fast_points, const Extents& controls,
+                int64_t evaluator_budget) {
+  if (fast != 0) return fast_points;
+  const int64_t per_point = int64_t{stride} * controls[1] * controls[2];
+  return static_cast<int>(std::clamp<int64_t>(evaluator_budget / per_point, 2, fast_points));
+}
+
+// The size-ratio check of a fitted block's cells against the original grid's (BuildReference)
+// at refinement levels 0..max_level, one chunk of refined rows at a time; the state its steps
+// share.
 template <CellKind K>
-absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlock& original,
-                                  const std::array<int, 3>& active, int num_active,
-                                  const CellQualityOptions& options) {
-  constexpr int width = kWidth<K>;
-  Reference ref = BuildReference<K>(original, MakeLayout(original.extents(), active, num_active));
-  const double low = 1.0 / options.max_size_ratio, high = options.max_size_ratio;
-  const Extents controls = fitted.spline.control_extents();
-  const int fast = active[0];
-  CellQuality q;
-  int64_t worst_parent = 0;
-  q.folded_by_level.assign(options.max_level + 1, 0);
-  for (int level = 0; level <= options.max_level; ++level) {
+class CellChecker {
+ public:
+  CellChecker(const FittedBlock& fitted, const StructuredBlock& original,
+              const std::array<int, 3>& active, int num_active, const CellQualityOptions& options)
+      : fitted_(fitted),
+        active_(active),
+        num_active_(num_active),
+        options_(options),
+        ref_(BuildReference<K>(original, MakeLayout(original.extents(), active, num_active))),
+        low_(1.0 / options.max_size_ratio),
+        high_(options.max_size_ratio) {
+    q_.folded_by_level.assign(options.max_level + 1, 0);
+  }
+
+  // Checks every sub-cell of refinement level `level`.
+  absl::Status CheckLevel(int level) {
     Resolution resolution;
     resolution.level = level;
-    SG_ASSIGN_OR_RETURN(const auto params, SampleParameters(fitted.distribution, resolution));
-    // The share of its parent each refined interval gets: 1 / (du_sub / du_parent) per active
-    // direction (a = 0 fast, 1 mid for volumes, num_active - 1 slow).
-    std::array<std::vector<double>, 3> inverse_share;
-    for (int a = 0; a < num_active; ++a) {
-      const std::vector<double>& sub = params[active[a]];
-      const std::vector<double>& u = fitted.distribution.params(active[a]);
-      inverse_share[a].resize(sub.size() - 1);
-      for (size_t I = 0; I + 1 < sub.size(); ++I) {
-        const size_t p = I >> level;
-        inverse_share[a][I] = (u[p + 1] - u[p]) / (sub[I + 1] - sub[I]);
-      }
-    }
-    const std::vector<double>& slow_share = inverse_share[num_active - 1];
-    // Chunks of the fast direction, overlapping by one point: GridEvaluator holds the control
-    // net contracted in u, kStride * (chunk points) * n_v * n_w doubles, which the budget bounds
-    // (i fast only; otherwise that net is the control net itself).
+    SG_ASSIGN_OR_RETURN(const auto params, SampleParameters(fitted_.distribution, resolution));
+    const std::array<std::vector<double>, 3> inverse_share =
+        InverseShares(fitted_.distribution, params, active_, num_active_, level);
+    const int fast = active_[0];
     const int fast_points = static_cast<int>(params[fast].size());
-    int chunk = fast_points;
-    if (fast == 0) {
-      const int64_t per_point = int64_t{kStride<K>} * controls[1] * controls[2];
-      chunk = static_cast<int>(
-          std::clamp<int64_t>(options.evaluator_budget / per_point, 2, fast_points));
-    }
+    const int chunk = ChunkPoints(kStride<K>, fast, fast_points, fitted_.spline.control_extents(),
+                                  options_.evaluator_budget);
     std::array<std::vector<double>, 3> part = params;
     for (int first = 0; first + 1 < fast_points; first += chunk - 1) {
       const int last = std::min(fast_points - 1, first + chunk - 1);
       part[fast].assign(params[fast].begin() + first, params[fast].begin() + last + 1);
-      GridEvaluator evaluator(fitted.spline, part, /*first_derivatives=*/false);
-      const RowLayout layout = MakeLayout(evaluator.extents(), active, num_active);
-      const int64_t row_size = kStride<K> * layout.row_points;
-      std::vector<double> lo(row_size), hi(row_size);
-      evaluator.EvaluateLines(0, layout.lines_per_row, lo.data());
-      for (int r = 0; r + 1 < layout.rows; ++r) {
-        SG_RETURN_IF_ERROR(PollCancel(options.cancel));
-        evaluator.EvaluateLines((r + 1) * layout.lines_per_row, (r + 2) * layout.lines_per_row,
-                                hi.data());
-        const int64_t parent_row = int64_t{ref.fast_cells} * ref.mid_cells * (r >> level);
-        ForEachCell<K>(lo.data(), hi.data(), layout, [&](int I, int J, const Corners& x) {
-          const int64_t parent =
-              parent_row + ((first + I) >> level) + int64_t{ref.fast_cells} * (J >> level);
-          uint8_t& state = ref.state[parent];
-          if (state == kSkipped) {
-            ++q.cells_skipped;
-            return;
-          }
-          double m[width];
-          Measure<K>(x, m);
-          const double* w = ref.weight.data() + width * parent;
-          double ratio = 0.0;
-          for (int c = 0; c < width; ++c) ratio += m[c] * w[c];
-          ratio *= inverse_share[0][first + I] * slow_share[r];
-          if constexpr (K == CellKind::kVolume) ratio *= inverse_share[1][J];
-          ++q.cells_checked;
-          if (ratio < q.min_ratio) {
-            q.min_ratio = ratio;
-            q.worst_level = level;
-            worst_parent = parent;
-          }
-          q.max_ratio = std::max(q.max_ratio, std::abs(ratio));
-          if (ratio <= 0.0) {
-            ++q.folded;
-            ++q.folded_by_level[level];
-            state = kFolded;
-          } else if (ratio < low || ratio > high) {
-            ++q.out_of_size;
-            if (state != kFolded) state = kBad;
-          }
-        });
-        std::swap(lo, hi);
+      SG_RETURN_IF_ERROR(CheckChunk(level, part, first, inverse_share));
+    }
+    return absl::OkStatus();
+  }
+
+  // The quality after the levels were checked: the worst cell and the bad and folded cells.
+  CellQuality Finish() {
+    if (q_.cells_checked > 0) q_.worst_cell = ToCell(worst_parent_);
+    for (int64_t parent = 0; parent < static_cast<int64_t>(ref_.state.size()); ++parent) {
+      if (ref_.state[parent] != kBad && ref_.state[parent] != kFolded) continue;
+      if (ref_.state[parent] == kFolded) {
+        ++q_.num_folded_cells;
+        if (static_cast<int64_t>(q_.folded_cells.size()) < options_.max_reported_cells) {
+          q_.folded_cells.push_back(ToCell(parent));
+        }
+      }
+      ++q_.num_bad_cells;
+      if (static_cast<int64_t>(q_.bad_cells.size()) < options_.max_reported_cells) {
+        q_.bad_cells.push_back(ToCell(parent));
       }
     }
+    return std::move(q_);
   }
+
+ private:
+  // Checks the sub-cells of level `level` in the chunk of fast points from `first` (the
+  // parameters `part`), row by row of the slowest direction.
+  absl::Status CheckChunk(int level, const std::array<std::vector<double>, 3>& part, int first,
+                          const std::array<std::vector<double>, 3>& inverse_share) {
+    constexpr int width = kWidth<K>;
+    const std::vector<double>& slow_share = inverse_share[num_active_ - 1];
+    GridEvaluator evaluator(fitted_.spline, part, /*first_derivatives=*/false);
+    const RowLayout layout = MakeLayout(evaluator.extents(), active_, num_active_);
+    const int64_t row_size = kStride<K> * layout.row_points;
+    std::vector<double> lo(row_size), hi(row_size);
+    evaluator.EvaluateLines(0, layout.lines_per_row, lo.data());
+    for (int r = 0; r + 1 < layout.rows; ++r) {
+      SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
+      evaluator.EvaluateLines((r + 1) * layout.lines_per_row, (r + 2) * layout.lines_per_row,
+                              hi.data());
+      const int64_t parent_row = int64_t{ref_.fast_cells} * ref_.mid_cells * (r >> level);
+      ForEachCell<K>(lo.data(), hi.data(), layout, [&](int I, int J, const Corners& x) {
+        const int64_t parent =
+            parent_row + ((first + I) >> level) + int64_t{ref_.fast_cells} * (J >> level);
+        uint8_t& state = ref_.state[parent];
+        if (state == kSkipped) {
+          ++q_.cells_skipped;
+          return;
+        }
+        double m[width];
+        Measure<K>(x, m);
+        const double* w = ref_.weight.data() + width * parent;
+        double ratio = 0.0;
+        for (int c = 0; c < width; ++c) ratio += m[c] * w[c];
+        ratio *= inverse_share[0][first + I] * slow_share[r];
+        if constexpr (K == CellKind::kVolume) ratio *= inverse_share[1][J];
+        Tally(ratio, level, parent, state);
+      });
+      std::swap(lo, hi);
+    }
+    return absl::OkStatus();
+  }
+
+  // Counts a checked sub-cell of `parent` with Jacobian ratio `ratio`: the worst so far, folded
+  // (ratio <= 0) or out of size, and marks the parent's `state`.
+  void Tally(double ratio, int level, int64_t parent, uint8_t& state) {
+    ++q_.cells_checked;
+    if (ratio < q_.min_ratio) {
+      q_.min_ratio = ratio;
+      q_.worst_level = level;
+      worst_parent_ = parent;
+    }
+    q_.max_ratio = std::max(q_.max_ratio, std::abs(ratio));
+    if (ratio <= 0.0) {
+      ++q_.folded;
+      ++q_.folded_by_level[level];
+      state = kFolded;
+    } else if (ratio < low_ || ratio > high_) {
+      ++q_.out_of_size;
+      if (state != kFolded) state = kBad;
+    }
+  }
+
   // Parent index -> original-grid cell (lower corner).
-  auto to_cell = [&](int64_t parent) {
+  Extents ToCell(int64_t parent) const {
     Extents cell = {0, 0, 0};
-    const int64_t per_row = int64_t{ref.fast_cells} * ref.mid_cells;
-    cell[active[0]] = static_cast<int>(parent % ref.fast_cells);
-    if (num_active == 3) {
-      cell[active[1]] = static_cast<int>(parent / ref.fast_cells % ref.mid_cells);
+    const int64_t per_row = int64_t{ref_.fast_cells} * ref_.mid_cells;
+    cell[active_[0]] = static_cast<int>(parent % ref_.fast_cells);
+    if (num_active_ == 3) {
+      cell[active_[1]] = static_cast<int>(parent / ref_.fast_cells % ref_.mid_cells);
     }
-    cell[active[num_active - 1]] = static_cast<int>(parent / per_row);
+    cell[active_[num_active_ - 1]] = static_cast<int>(parent / per_row);
     return cell;
-  };
-  if (q.cells_checked > 0) q.worst_cell = to_cell(worst_parent);
-  for (int64_t parent = 0; parent < static_cast<int64_t>(ref.state.size()); ++parent) {
-    if (ref.state[parent] != kBad && ref.state[parent] != kFolded) continue;
-    if (ref.state[parent] == kFolded) {
-      ++q.num_folded_cells;
-      if (static_cast<int64_t>(q.folded_cells.size()) < options.max_reported_cells) {
-        q.folded_cells.push_back(to_cell(parent));
-      }
-    }
-    ++q.num_bad_cells;
-    if (static_cast<int64_t>(q.bad_cells.size()) < options.max_reported_cells) {
-      q.bad_cells.push_back(to_cell(parent));
-    }
   }
-  return q;
+
+  const FittedBlock& fitted_;
+  const std::array<int, 3> active_;
+  const int num_active_;
+  const CellQualityOptions& options_;
+  Reference ref_;
+  const double low_, high_;  // the size ratios allowed
+  CellQuality q_;
+  int64_t worst_parent_ = 0;
+};
+
+// The cell quality of `fitted` against `original` (CheckCellQuality after its checks).
+template <CellKind K>
+absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlock& original,
+                                  const std::array<int, 3>& active, int num_active,
+                                  const CellQualityOptions& options) {
+  CellChecker<K> checker(fitted, original, active, num_active, options);
+  for (int level = 0; level <= options.max_level; ++level) {
+    SG_RETURN_IF_ERROR(checker.CheckLevel(level));
+  }
+  return checker.Finish();
 }
 
 std::string ExtentsString(const Extents& e) { return absl::StrCat(e[0], " x ", e[1], " x ", e[2]); }

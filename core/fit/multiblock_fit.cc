@@ -311,27 +311,41 @@ std::vector<std::array<std::vector<double>, 3>> BlockParameters(const MultiBlock
   return params;
 }
 
-// The fit with the given parameters; `result` holds the connectivity and kinds already.
-absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
-                               const std::vector<std::array<std::vector<double>, 3>>& params,
-                               MultiBlockFit& result) {
+// What every point of a block is fitted to, and where each direction may be cut.
+struct PointTargets {
+  std::vector<std::vector<double>> tolerances;       // per block, per point
+  std::vector<std::vector<double>> edge_tolerances;  // per block, per point (refinement.h)
+  std::vector<std::array<std::vector<int>, 3>> features;
+};
+
+// The point and edge tolerances of every block by the kinds of `result`, and the feature
+// points of every direction.
+PointTargets TargetsAndFeatures(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+                                const MultiBlockFit& result) {
   const int nb = static_cast<int>(grid.blocks.size());
-  std::vector<std::vector<double>> tolerances(nb), edge_tolerances(nb);
-  std::vector<std::array<std::vector<int>, 3>> features(nb);
+  PointTargets targets;
+  targets.tolerances.resize(nb);
+  targets.edge_tolerances.resize(nb);
+  targets.features.resize(nb);
   for (int b = 0; b < nb; ++b) {
-    tolerances[b] = PointTolerances(result.kinds, b, options.tolerances);
-    edge_tolerances[b] = PointEdgeTolerances(result.kinds, b, options.tolerances);
+    targets.tolerances[b] = PointTolerances(result.kinds, b, options.tolerances);
+    targets.edge_tolerances[b] = PointEdgeTolerances(result.kinds, b, options.tolerances);
     for (int d = 0; d < 3; ++d) {
-      features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
+      targets.features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
     }
   }
-  // No edge ratio (refinement.h) at the points of a pole: the edges along a collapsed line have
-  // no length to be relative to (within kPoleRelativeTolerance of 0, not always exactly 0, so a
-  // ratio of rounding noise would refine every class it touches down to interpolation), and
-  // the fit keeps them collapsed exactly (CollapsePoles). An edge ratio of 0 at one end switches
-  // the edge off, so the edges from the pole to the first ring go too; the ring's own points and
-  // edges still bind it.
-  for (const Pole& pole : result.poles) {
+  return targets;
+}
+
+// No edge ratio (refinement.h) at the points of a pole: the edges along a collapsed line have
+// no length to be relative to (within kPoleRelativeTolerance of 0, not always exactly 0, so a
+// ratio of rounding noise would refine every class it touches down to interpolation), and
+// the fit keeps them collapsed exactly (CollapsePoles). An edge ratio of 0 at one end switches
+// the edge off, so the edges from the pole to the first ring go too; the ring's own points and
+// edges still bind it.
+void SwitchOffPoleEdges(const MultiBlockGrid& grid, const std::vector<Pole>& poles,
+                        std::vector<std::vector<double>>& edge_tolerances) {
+  for (const Pole& pole : poles) {
     const StructuredBlock& block = grid.blocks[pole.block];
     if (edge_tolerances[pole.block].size() != static_cast<size_t>(block.num_points())) continue;
     for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
@@ -342,32 +356,35 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
       }
     }
   }
-  const Connectivity none;
-  const Connectivity& shared = options.watertight ? result.connectivity : none;
-  SG_ASSIGN_OR_RETURN(SegmentModel model,
-                      SegmentModel::Build(grid, params, shared, features, options.order,
-                                          options.max_controls_per_direction));
+}
+
+// The adaptive engine's options from `options`; the quality check (when on) uses `quality`,
+// which must outlive the engine's run.
+EngineOptions EngineOptionsFor(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+                               const CellQualityOptions& quality) {
   EngineOptions engine;
   engine.max_iterations = options.max_iterations;
   engine.remove_unneeded_knots = options.remove_unneeded_knots;
   engine.fairing = options.fairing;
   engine.cancel = options.cancel;
-  CellQualityOptions quality = options.quality;
-  quality.cancel = options.cancel;
   if (options.check_quality) {
-    engine.quality = [&](int b, const FittedBlock& fitted) {
+    engine.quality = [&grid, &quality](int b, const FittedBlock& fitted) {
       return CheckCellQuality(fitted, grid.blocks[b], quality);
     };
   }
-  SG_ASSIGN_OR_RETURN(EngineResult run,
-                      RunAdaptiveFit(grid, model, tolerances, edge_tolerances, engine));
+  return engine;
+}
+
+// Takes the blocks and counts of the engine's `run` into `result`, then makes them watertight:
+// poles first (each line to its mean), then the shared controls and the pole lines made one
+// value across blocks.
+void TakeRun(EngineResult run, const MultiBlockGrid& grid, const SegmentModel& model,
+             const Connectivity& shared, bool watertight, MultiBlockFit& result) {
   result.blocks = std::move(run.blocks);
   result.unfaired = std::move(run.unfaired);
-  // Poles first (each line to its mean), then the shared controls and the pole lines made one
-  // value across blocks.
   CollapsePoles(result.poles, grid, result.blocks);
   CollapsePoles(result.poles, grid, result.unfaired);
-  if (options.watertight || !result.poles.empty()) {
+  if (watertight || !result.poles.empty()) {
     CopySharedControls(model, shared, result.poles, grid, result.blocks);
     if (!result.unfaired.empty()) {
       CopySharedControls(model, shared, result.poles, grid, result.unfaired);
@@ -378,41 +395,58 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
   result.knots_removed = run.knots_removed;
   result.quality_rounds = run.quality_rounds;
   result.fairing_weight = run.fairing_weight;
+}
+
+// The report of block b of `result` against the original (untightened) tolerances: its
+// deviation (into the block's summary too), by kind, and its cell quality.
+absl::StatusOr<BlockFitReport> ReportBlock(const MultiBlockGrid& grid,
+                                           const MultiBlockFitOptions& options,
+                                           const CellQualityOptions& quality, int b,
+                                           MultiBlockFit& result) {
+  FittedBlock& fitted = result.blocks[b];
+  const std::vector<double> tol = PointTolerances(result.kinds, b, options.tolerances);
+  std::array<std::vector<double>, 3> p;
+  for (int d = 0; d < 3; ++d) p[d] = fitted.distribution.params(d);
+  SG_ASSIGN_OR_RETURN(fitted.summary.deviation,
+                      MeasureDeviation(fitted.spline, p, grid.blocks[b], options.cancel, tol));
+  BlockFitReport report;
+  SG_ASSIGN_OR_RETURN(report.max_deviation,
+                      DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
+  SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
+  const Deviation& dev = fitted.summary.deviation;
+  report.tolerance_met = dev.max_ratio <= 1.0;
+  if (!report.tolerance_met) {
+    const Extents& at = dev.max_ratio_at;
+    const uint8_t kind = result.kinds.point_kinds[b][grid.blocks[b].Index(at[0], at[1], at[2])];
+    report.unmet_reason = absl::StrCat("block ", b, " ", KindNames(kind), " point (", at[0], ", ",
+                                       at[1], ", ", at[2], ") deviates ", dev.max_ratio,
+                                       " times its tolerance of ", options.tolerances.For(kind));
+  }
+  fitted.summary.num_points = grid.blocks[b].num_points();
+  fitted.summary.num_control_points = fitted.spline.num_control_points();
+  fitted.summary.compression_ratio =
+      static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
+  return report;
+}
+
+// The reports of every block (ReportBlock), whether all are met (the first unmet block's
+// reason), the point and control counts, the largest boundary gap and the wall curvature.
+absl::Status ReportBlocks(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+                          const CellQualityOptions& quality, MultiBlockFit& result) {
   result.met = true;
   result.quality_met = true;
   result.reports.clear();
   result.num_points = result.num_control_points = 0;
   result.unmet_reason.clear();
-  // Reports against the original (untightened) tolerances.
-  for (int b = 0; b < nb; ++b) {
-    FittedBlock& fitted = result.blocks[b];
-    const std::vector<double> tol = PointTolerances(result.kinds, b, options.tolerances);
-    std::array<std::vector<double>, 3> p;
-    for (int d = 0; d < 3; ++d) p[d] = fitted.distribution.params(d);
-    SG_ASSIGN_OR_RETURN(fitted.summary.deviation,
-                        MeasureDeviation(fitted.spline, p, grid.blocks[b], options.cancel, tol));
-    BlockFitReport report;
-    SG_ASSIGN_OR_RETURN(report.max_deviation,
-                        DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
-    SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
+  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
+    SG_ASSIGN_OR_RETURN(BlockFitReport report, ReportBlock(grid, options, quality, b, result));
     result.quality_met = result.quality_met && report.quality.ok() && report.quality.measured();
-    const Deviation& dev = fitted.summary.deviation;
-    report.tolerance_met = dev.max_ratio <= 1.0;
     if (!report.tolerance_met) {
-      const Extents& at = dev.max_ratio_at;
-      const uint8_t kind = result.kinds.point_kinds[b][grid.blocks[b].Index(at[0], at[1], at[2])];
-      report.unmet_reason = absl::StrCat("block ", b, " ", KindNames(kind), " point (", at[0], ", ",
-                                         at[1], ", ", at[2], ") deviates ", dev.max_ratio,
-                                         " times its tolerance of ", options.tolerances.For(kind));
       if (result.met) result.unmet_reason = report.unmet_reason;
       result.met = false;
     }
     result.num_points += grid.blocks[b].num_points();
-    result.num_control_points += fitted.spline.num_control_points();
-    fitted.summary.num_points = grid.blocks[b].num_points();
-    fitted.summary.num_control_points = fitted.spline.num_control_points();
-    fitted.summary.compression_ratio =
-        static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
+    result.num_control_points += result.blocks[b].spline.num_control_points();
     result.reports.push_back(std::move(report));
   }
   result.max_gap = options.watertight ? MaxBoundaryGap(result.connectivity, result.blocks,
@@ -425,6 +459,26 @@ absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOp
         WallCurvatureMetrics(result.unfaired, result.kinds, kCurvatureLevel);
   }
   return absl::OkStatus();
+}
+
+// The fit with the given parameters; `result` holds the connectivity and kinds already.
+absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+                               const std::vector<std::array<std::vector<double>, 3>>& params,
+                               MultiBlockFit& result) {
+  PointTargets targets = TargetsAndFeatures(grid, options, result);
+  SwitchOffPoleEdges(grid, result.poles, targets.edge_tolerances);
+  const Connectivity none;
+  const Connectivity& shared = options.watertight ? result.connectivity : none;
+  SG_ASSIGN_OR_RETURN(SegmentModel model,
+                      SegmentModel::Build(grid, params, shared, targets.features, options.order,
+                                          options.max_controls_per_direction));
+  CellQualityOptions quality = options.quality;
+  quality.cancel = options.cancel;
+  SG_ASSIGN_OR_RETURN(EngineResult run,
+                      RunAdaptiveFit(grid, model, targets.tolerances, targets.edge_tolerances,
+                                     EngineOptionsFor(grid, options, quality)));
+  TakeRun(std::move(run), grid, model, shared, options.watertight, result);
+  return ReportBlocks(grid, options, quality, result);
 }
 
 // Whether fit a is better than b: tolerances met, then fewer bad cells, fewer folded

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <deque>
+#include <optional>
 #include <set>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/check.h"
@@ -51,59 +53,29 @@ std::string DirectionName(int b, int d) {
   return absl::StrCat("block ", b, " direction ", std::string(1, kNames[d]));
 }
 
-}  // namespace
+// Split points (data indices) per block direction.
+using SplitSets = std::vector<std::array<std::set<int>, 3>>;
 
-int SegmentModel::Member::ClassCoord(int r) const {
-  const int offset = stride * (r - r0);
-  return reversed ? stride * (r1 - r0) - offset : offset;
-}
-
-absl::Status ValidateControlCap(int max_controls, int order) {
-  if (max_controls < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("max_controls_per_direction = ", max_controls, " is negative"));
-  }
-  if (max_controls > 0 && max_controls < order) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "max_controls_per_direction = ", max_controls, " is below order = ", order,
-        ": a direction of order k starts with k control points; give at least ", order,
-        ", or 0 for no cap",
-        max_controls >= 2 ? absl::StrCat(", or order <= ", max_controls) : std::string()));
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<SegmentModel> SegmentModel::Build(
-    const MultiBlockGrid& grid, const std::vector<std::array<std::vector<double>, 3>>& params,
-    const Connectivity& connectivity, const std::vector<std::array<std::vector<int>, 3>>& features,
-    int order, int max_controls) {
-  SegmentModel model;
-  const int nb = static_cast<int>(grid.blocks.size());
-  model.directions_.resize(nb);
-  std::vector<std::array<std::set<int>, 3>> splits(nb), required(nb);
-  for (int b = 0; b < nb; ++b) {
-    for (int d = 0; d < 3; ++d) {
-      Direction& dir = model.directions_[b][d];
-      dir.m = grid.blocks[b].extent(d);
-      dir.order = dir.m == 1 ? 1 : std::min(order, dir.m);
-      dir.cap = max_controls > 0 ? std::min(dir.m, std::max(max_controls, dir.order)) : dir.m;
-      dir.own_params = params[b][d];
-    }
-  }
-  const std::vector<RangeLink> links = RangeLinks(connectivity);
+// The splits the matches require: the interior ends of every matched range (where a partial
+// match begins or ends).
+SplitSets RequiredSplits(const MultiBlockGrid& grid, const std::vector<RangeLink>& links) {
+  SplitSets required(grid.blocks.size());
   for (const RangeLink& l : links) {
     for (int r : {l.a0, l.a1}) {
-      if (r > 0 && r < model.directions_[l.ba][l.da].m - 1) required[l.ba][l.da].insert(r);
+      if (r > 0 && r < grid.blocks[l.ba].extent(l.da) - 1) required[l.ba][l.da].insert(r);
     }
     for (int q : {l.b0, l.b1}) {
-      if (q > 0 && q < model.directions_[l.bb][l.db].m - 1) required[l.bb][l.db].insert(q);
+      if (q > 0 && q < grid.blocks[l.bb].extent(l.db) - 1) required[l.bb][l.db].insert(q);
     }
   }
-  for (int b = 0; b < nb; ++b) {
-    for (int d = 0; d < 3; ++d) splits[b][d] = required[b][d];
-  }
-  // Propagate the required splits through the matches until every matched range is cut the
-  // same way.
+  return required;
+}
+
+// Propagate the required splits through the matches until every matched range is cut the
+// same way. A split that falls between two points of a coarse side is dropped (a kink on a
+// hanging node is kept smooth); FAILED_PRECONDITION, naming the match, if it is required.
+absl::Status PropagateSplits(const std::vector<RangeLink>& links, const Connectivity& connectivity,
+                             SplitSets& splits, SplitSets& required) {
   for (bool changed = true; changed;) {
     changed = false;
     for (const RangeLink& l : links) {
@@ -131,159 +103,309 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
       }
     }
   }
-  // Features, each together with its images through the matches (its orbit) or not at all:
-  // every image must keep order - 1 intervals to the ends of its direction, to the splits
-  // already there and to the orbit's other points, must not fall between two points of a
-  // coarse side (a kink on a hanging node is kept smooth) and must stay within its direction's
-  // cap. A feature judged on its own direction only could cut the coarse side of a hanging-node
-  // match too short (fine index 4 is coarse index 2).
-  for (int b = 0; b < nb; ++b) {
-    for (int d = 0; d < 3; ++d) {
-      if (model.directions_[b][d].m == 1) continue;
-      for (int f : features[b][d]) {
-        std::vector<std::array<int, 3>> orbit = {{b, d, f}};  // (block, direction, index)
-        bool ok = true;
-        for (size_t i = 0; ok && i < orbit.size(); ++i) {
-          const auto [ob, od, r] = orbit[i];
-          if (splits[ob][od].count(r)) continue;  // already cut, with all its images
-          const Direction& dir = model.directions_[ob][od];
-          bool fits = r >= dir.order - 1 && r <= dir.m - dir.order;
-          for (int s : splits[ob][od]) fits &= std::abs(r - s) >= dir.order - 1;
-          int cuts = static_cast<int>(splits[ob][od].size()) + 1;
-          for (size_t o = 0; o < i; ++o) {
-            if (orbit[o][0] != ob || orbit[o][1] != od || splits[ob][od].count(orbit[o][2])) {
-              continue;
-            }
-            fits &= std::abs(r - orbit[o][2]) >= dir.order - 1;
-            ++cuts;
-          }
-          // Each split costs order - 1 controls.
-          ok = fits && dir.order + cuts * (dir.order - 1) <= dir.cap;
-          auto add = [&](int ib, int id, int ir) {
-            const std::array<int, 3> image = {ib, id, ir};
-            if (std::find(orbit.begin(), orbit.end(), image) == orbit.end()) orbit.push_back(image);
-          };
-          for (const RangeLink& l : links) {
-            if (!ok) break;
-            if (l.ba == ob && l.da == od && r > l.a0 && r < l.a1) add(l.bb, l.db, l.MapAB(r));
-            if (l.bb == ob && l.db == od && r > std::min(l.b0, l.b1) && r < std::max(l.b0, l.b1)) {
-              const int q = l.MapBA(r);
-              if (q < 0) {
-                ok = false;  // between two coarse points: keep the kink smooth
-              } else {
-                add(l.ba, l.da, q);
-              }
-            }
-          }
-        }
-        if (!ok) continue;
-        for (const auto& [ob, od, r] : orbit) splits[ob][od].insert(r);
-      }
-    }
+  return absl::OkStatus();
+}
+
+// A feature point and its images through the matches: (block, direction, data index) each.
+using Orbit = std::vector<std::array<int, 3>>;
+
+// Whether image i of `orbit` keeps order - 1 intervals to the ends of its direction, to the
+// splits already there and to the orbit's earlier images in that direction, and stays within
+// the direction's cap together with them.
+bool ImageFits(const SegmentModel& model, const MultiBlockGrid& grid, const SplitSets& splits,
+               const Orbit& orbit, size_t i) {
+  const auto [ob, od, r] = orbit[i];
+  const int order = model.order(ob, od), m = grid.blocks[ob].extent(od);
+  bool fits = r >= order - 1 && r <= m - order;
+  for (int s : splits[ob][od]) fits &= std::abs(r - s) >= order - 1;
+  int cuts = static_cast<int>(splits[ob][od].size()) + 1;
+  for (size_t o = 0; o < i; ++o) {
+    if (orbit[o][0] != ob || orbit[o][1] != od || splits[ob][od].count(orbit[o][2])) continue;
+    fits &= std::abs(r - orbit[o][2]) >= order - 1;
+    ++cuts;
   }
-  // Segments and their ids.
-  struct SegmentRef {
-    int block, dir, r0, r1;
+  // Each split costs order - 1 controls.
+  return fits && order + cuts * (order - 1) <= model.cap(ob, od);
+}
+
+// Appends the images of `point` through every link to `orbit` (those not in it yet); false if
+// one falls between two points of a coarse side (the kink is then kept smooth).
+bool AddImages(const std::vector<RangeLink>& links, const std::array<int, 3> point, Orbit& orbit) {
+  const auto [ob, od, r] = point;
+  auto add = [&](int ib, int id, int ir) {
+    const std::array<int, 3> image = {ib, id, ir};
+    if (std::find(orbit.begin(), orbit.end(), image) == orbit.end()) orbit.push_back(image);
   };
-  std::vector<SegmentRef> segments;
-  std::vector<std::array<std::vector<int>, 3>> segment_ids(nb);
-  for (int b = 0; b < nb; ++b) {
+  for (const RangeLink& l : links) {
+    if (l.ba == ob && l.da == od && r > l.a0 && r < l.a1) add(l.bb, l.db, l.MapAB(r));
+    if (l.bb == ob && l.db == od && r > std::min(l.b0, l.b1) && r < std::max(l.b0, l.b1)) {
+      const int q = l.MapBA(r);
+      if (q < 0) return false;  // between two coarse points: keep the kink smooth
+      add(l.ba, l.da, q);
+    }
+  }
+  return true;
+}
+
+// The orbit of feature index f of direction d of block b, or nullopt when an image breaks the
+// rules of AddFeatureSplits.
+std::optional<Orbit> FeatureOrbit(const SegmentModel& model, const MultiBlockGrid& grid,
+                                  const std::vector<RangeLink>& links, const SplitSets& splits,
+                                  int b, int d, int f) {
+  Orbit orbit = {{b, d, f}};
+  for (size_t i = 0; i < orbit.size(); ++i) {
+    const auto [ob, od, r] = orbit[i];
+    if (splits[ob][od].count(r)) continue;  // already cut, with all its images
+    if (!ImageFits(model, grid, splits, orbit, i) || !AddImages(links, orbit[i], orbit)) {
+      return std::nullopt;
+    }
+  }
+  return orbit;
+}
+
+// Features, each together with its images through the matches (its orbit) or not at all:
+// every image must keep order - 1 intervals to the ends of its direction, to the splits
+// already there and to the orbit's other points, must not fall between two points of a
+// coarse side (a kink on a hanging node is kept smooth) and must stay within its direction's
+// cap. A feature judged on its own direction only could cut the coarse side of a hanging-node
+// match too short (fine index 4 is coarse index 2).
+void AddFeatureSplits(const SegmentModel& model, const MultiBlockGrid& grid,
+                      const std::vector<RangeLink>& links,
+                      const std::vector<std::array<std::vector<int>, 3>>& features,
+                      SplitSets& splits) {
+  for (int b = 0; b < model.num_blocks(); ++b) {
     for (int d = 0; d < 3; ++d) {
-      Direction& dir = model.directions_[b][d];
-      if (dir.m == 1) continue;
-      dir.splits.assign(splits[b][d].begin(), splits[b][d].end());
-      std::vector<int> bounds = {0};
-      bounds.insert(bounds.end(), dir.splits.begin(), dir.splits.end());
-      bounds.push_back(dir.m - 1);
-      for (size_t s = 0; s + 1 < bounds.size(); ++s) {
-        if (bounds[s + 1] - bounds[s] < dir.order - 1) {
-          return absl::FailedPreconditionError(
-              absl::StrCat(DirectionName(b, d), ": the matches cut a segment [", bounds[s], ", ",
-                           bounds[s + 1], "] with fewer points than the spline order ", dir.order));
-        }
-        segment_ids[b][d].push_back(static_cast<int>(segments.size()));
-        segments.push_back({b, d, bounds[s], bounds[s + 1]});
+      if (!model.active(b, d)) continue;
+      for (int f : features[b][d]) {
+        const std::optional<Orbit> orbit = FeatureOrbit(model, grid, links, splits, b, d, f);
+        if (!orbit) continue;
+        for (const auto& [ob, od, r] : *orbit) splits[ob][od].insert(r);
       }
     }
   }
-  auto find_segment = [&](int b, int d, int lo, int hi) {
-    for (int id : segment_ids[b][d]) {
-      if (segments[id].r0 == lo && segments[id].r1 == hi) return id;
+}
+
+// A segment of a block direction: data indices [r0, r1].
+struct SegmentRef {
+  int block, dir, r0, r1;
+};
+// The segments of every direction and their ids (indices into `all`).
+struct Segments {
+  std::vector<SegmentRef> all;
+  std::vector<std::array<std::vector<int>, 3>> ids;  // per block direction, in order
+
+  // The id of segment [lo, hi] of direction d of block b, or -1.
+  int Find(int b, int d, int lo, int hi) const {
+    for (int id : ids[b][d]) {
+      if (all[id].r0 == lo && all[id].r1 == hi) return id;
     }
     return -1;
-  };
-  // Segment links: (other segment, reversed, length ratio other / this as (num, den), match).
-  struct Edge {
-    int to;
-    bool reversed;
-    int num, den;
-    int match;
-  };
-  std::vector<std::vector<Edge>> edges(segments.size());
+  }
+};
+
+// The segments between the splits of every active direction; FAILED_PRECONDITION when one has
+// fewer points than the direction's order.
+absl::StatusOr<Segments> CutSegments(const SegmentModel& model, const MultiBlockGrid& grid,
+                                     const SplitSets& splits) {
+  Segments segments;
+  segments.ids.resize(grid.blocks.size());
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    for (int d = 0; d < 3; ++d) {
+      if (!model.active(b, d)) continue;
+      const int order = model.order(b, d);
+      std::vector<int> bounds = {0};
+      bounds.insert(bounds.end(), splits[b][d].begin(), splits[b][d].end());
+      bounds.push_back(grid.blocks[b].extent(d) - 1);
+      for (size_t s = 0; s + 1 < bounds.size(); ++s) {
+        if (bounds[s + 1] - bounds[s] < order - 1) {
+          return absl::FailedPreconditionError(
+              absl::StrCat(DirectionName(b, d), ": the matches cut a segment [", bounds[s], ", ",
+                           bounds[s + 1], "] with fewer points than the spline order ", order));
+        }
+        segments.ids[b][d].push_back(static_cast<int>(segments.all.size()));
+        segments.all.push_back({b, d, bounds[s], bounds[s + 1]});
+      }
+    }
+  }
+  return segments;
+}
+
+// Segment links: (other segment, reversed, length ratio other / this as (num, den), match).
+struct Edge {
+  int to;
+  bool reversed;
+  int num, den;
+  int match;
+};
+
+// The links of every segment to the segments it is matched with, both ways.
+std::vector<std::vector<Edge>> SegmentEdges(const Segments& segments,
+                                            const std::vector<RangeLink>& links) {
+  std::vector<std::vector<Edge>> edges(segments.all.size());
   for (const RangeLink& l : links) {
-    for (int id : segment_ids[l.ba][l.da]) {
-      const SegmentRef& sa = segments[id];
+    for (int id : segments.ids[l.ba][l.da]) {
+      const SegmentRef& sa = segments.all[id];
       if (sa.r0 < l.a0 || sa.r1 > l.a1) continue;
       const int q0 = l.MapAB(sa.r0), q1 = l.MapAB(sa.r1);
-      const int other = find_segment(l.bb, l.db, std::min(q0, q1), std::max(q0, q1));
+      const int other = segments.Find(l.bb, l.db, std::min(q0, q1), std::max(q0, q1));
       SG_CHECK(other >= 0);
       if (other == id) continue;
       edges[id].push_back({other, l.reversed, l.step, 1, l.match});
       edges[other].push_back({id, l.reversed, 1, l.step, l.match});
     }
   }
-  // Classes by breadth-first search, checking that every cycle of matches agrees.
-  std::vector<int> class_of(segments.size(), -1);
-  std::vector<bool> reversed(segments.size(), false);
-  for (int root = 0; root < static_cast<int>(segments.size()); ++root) {
-    if (class_of[root] >= 0) continue;
-    const int c = static_cast<int>(model.classes_.size());
-    model.classes_.emplace_back();
-    std::vector<int> members = {root};
-    class_of[root] = c;
-    std::deque<int> queue = {root};
-    while (!queue.empty()) {
-      const int u = queue.front();
-      queue.pop_front();
-      for (const Edge& e : edges[u]) {
-        const bool rev = reversed[u] != e.reversed;
-        const int lu = segments[u].r1 - segments[u].r0, lv = segments[e.to].r1 - segments[e.to].r0;
-        if (lu * e.num != lv * e.den) {
-          return absl::FailedPreconditionError(
-              absl::StrCat(connectivity.matches[e.match].Describe(),
-                           ": the matched segments have inconsistent point counts"));
-        }
-        if (class_of[e.to] < 0) {
-          class_of[e.to] = c;
-          reversed[e.to] = rev;
-          members.push_back(e.to);
-          queue.push_back(e.to);
-        } else if (reversed[e.to] != rev) {
-          return absl::FailedPreconditionError(
-              absl::StrCat(connectivity.matches[e.match].Describe(),
-                           " contradicts the other matches: a segment would run both ways"));
-        }
-      }
-    }
-    Class& cls = model.classes_[c];
-    for (int id : members) cls.length = std::max(cls.length, segments[id].r1 - segments[id].r0);
-    for (int id : members) {
-      const SegmentRef& s = segments[id];
-      const int len = s.r1 - s.r0;
-      if (cls.length % len != 0) {
+  return edges;
+}
+
+// The segments linked to `root` (itself first), by breadth-first search: marks them class c
+// in `class_of` with their orientation relative to root in `reversed`, checking that every
+// cycle of matches agrees (FAILED_PRECONDITION naming the match otherwise).
+absl::StatusOr<std::vector<int>> LinkedSegments(int root, int c, const Segments& segments,
+                                                const std::vector<std::vector<Edge>>& edges,
+                                                const Connectivity& connectivity,
+                                                std::vector<int>& class_of,
+                                                std::vector<bool>& reversed) {
+  std::vector<int> members = {root};
+  class_of[root] = c;
+  std::deque<int> queue = {root};
+  while (!queue.empty()) {
+    const int u = queue.front();
+    queue.pop_front();
+    for (const Edge& e : edges[u]) {
+      const bool rev = reversed[u] != e.reversed;
+      const SegmentRef &su = segments.all[u], &sv = segments.all[e.to];
+      const int lu = su.r1 - su.r0, lv = sv.r1 - sv.r0;
+      if (lu * e.num != lv * e.den) {
         return absl::FailedPreconditionError(
-            absl::StrCat(DirectionName(s.block, s.dir), ": segment [", s.r0, ", ", s.r1,
-                         "] does not divide its matched segments evenly"));
+            absl::StrCat(connectivity.matches[e.match].Describe(),
+                         ": the matched segments have inconsistent point counts"));
       }
-      cls.members.push_back({s.block, s.dir, s.r0, s.r1, reversed[id], cls.length / len});
+      if (class_of[e.to] < 0) {
+        class_of[e.to] = c;
+        reversed[e.to] = rev;
+        members.push_back(e.to);
+        queue.push_back(e.to);
+      } else if (reversed[e.to] != rev) {
+        return absl::FailedPreconditionError(
+            absl::StrCat(connectivity.matches[e.match].Describe(),
+                         " contradicts the other matches: a segment would run both ways"));
+      }
     }
   }
-  // Per direction: the class and member of each segment.
-  for (int c = 0; c < model.num_classes(); ++c) {
-    const Class& cls = model.classes_[c];
+  return members;
+}
+
+// The class of the segments `members`: its length is the longest member's, and every member
+// must divide it (its stride); FAILED_PRECONDITION naming the segment otherwise.
+absl::StatusOr<SegmentModel::Class> MakeClass(const std::vector<int>& members,
+                                              const Segments& segments,
+                                              const std::vector<bool>& reversed) {
+  SegmentModel::Class cls;
+  for (int id : members)
+    cls.length = std::max(cls.length, segments.all[id].r1 - segments.all[id].r0);
+  for (int id : members) {
+    const SegmentRef& s = segments.all[id];
+    const int len = s.r1 - s.r0;
+    if (cls.length % len != 0) {
+      return absl::FailedPreconditionError(
+          absl::StrCat(DirectionName(s.block, s.dir), ": segment [", s.r0, ", ", s.r1,
+                       "] does not divide its matched segments evenly"));
+    }
+    cls.members.push_back({s.block, s.dir, s.r0, s.r1, reversed[id], cls.length / len});
+  }
+  return cls;
+}
+
+// Classes by breadth-first search, checking that every cycle of matches agrees.
+absl::StatusOr<std::vector<SegmentModel::Class>> SegmentClasses(
+    const Segments& segments, const std::vector<std::vector<Edge>>& edges,
+    const Connectivity& connectivity) {
+  std::vector<SegmentModel::Class> classes;
+  std::vector<int> class_of(segments.all.size(), -1);
+  std::vector<bool> reversed(segments.all.size(), false);
+  for (int root = 0; root < static_cast<int>(segments.all.size()); ++root) {
+    if (class_of[root] >= 0) continue;
+    const int c = static_cast<int>(classes.size());
+    SG_ASSIGN_OR_RETURN(const std::vector<int> members,
+                        LinkedSegments(root, c, segments, edges, connectivity, class_of, reversed));
+    SG_ASSIGN_OR_RETURN(SegmentModel::Class cls, MakeClass(members, segments, reversed));
+    classes.push_back(std::move(cls));
+  }
+  return classes;
+}
+
+}  // namespace
+
+int SegmentModel::Member::ClassCoord(int r) const {
+  const int offset = stride * (r - r0);
+  return reversed ? stride * (r1 - r0) - offset : offset;
+}
+
+absl::Status ValidateControlCap(int max_controls, int order) {
+  if (max_controls < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_controls_per_direction = ", max_controls, " is negative"));
+  }
+  if (max_controls > 0 && max_controls < order) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_controls_per_direction = ", max_controls, " is below order = ", order,
+        ": a direction of order k starts with k control points; give at least ", order,
+        ", or 0 for no cap",
+        max_controls >= 2 ? absl::StrCat(", or order <= ", max_controls) : std::string()));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SegmentModel> SegmentModel::Build(
+    const MultiBlockGrid& grid, const std::vector<std::array<std::vector<double>, 3>>& params,
+    const Connectivity& connectivity, const std::vector<std::array<std::vector<int>, 3>>& features,
+    int order, int max_controls) {
+  SegmentModel model;
+  model.InitDirections(grid, params, order, max_controls);
+  const std::vector<RangeLink> links = RangeLinks(connectivity);
+  SplitSets required = RequiredSplits(grid, links);
+  SplitSets splits = required;
+  SG_RETURN_IF_ERROR(PropagateSplits(links, connectivity, splits, required));
+  AddFeatureSplits(model, grid, links, features, splits);
+  // The splits of every active direction, ascending.
+  for (int b = 0; b < model.num_blocks(); ++b) {
+    for (int d = 0; d < 3; ++d) {
+      Direction& dir = model.directions_[b][d];
+      if (dir.m > 1) dir.splits.assign(splits[b][d].begin(), splits[b][d].end());
+    }
+  }
+  SG_ASSIGN_OR_RETURN(const Segments segments, CutSegments(model, grid, splits));
+  SG_ASSIGN_OR_RETURN(model.classes_,
+                      SegmentClasses(segments, SegmentEdges(segments, links), connectivity));
+  model.IndexSegmentClasses();
+  model.UnifyOrders();
+  model.AverageClassParams();
+  model.SetGlobalParams();
+  return model;
+}
+
+void SegmentModel::InitDirections(const MultiBlockGrid& grid,
+                                  const std::vector<std::array<std::vector<double>, 3>>& params,
+                                  int order, int max_controls) {
+  const int nb = static_cast<int>(grid.blocks.size());
+  directions_.resize(nb);
+  for (int b = 0; b < nb; ++b) {
+    for (int d = 0; d < 3; ++d) {
+      Direction& dir = directions_[b][d];
+      dir.m = grid.blocks[b].extent(d);
+      dir.order = dir.m == 1 ? 1 : std::min(order, dir.m);
+      dir.cap = max_controls > 0 ? std::min(dir.m, std::max(max_controls, dir.order)) : dir.m;
+      dir.own_params = params[b][d];
+    }
+  }
+}
+
+void SegmentModel::IndexSegmentClasses() {
+  for (int c = 0; c < num_classes(); ++c) {
+    const Class& cls = classes_[c];
     for (int i = 0; i < static_cast<int>(cls.members.size()); ++i) {
       const Member& mem = cls.members[i];
-      Direction& dir = model.directions_[mem.block][mem.dir];
+      Direction& dir = directions_[mem.block][mem.dir];
       dir.segment_class.resize(dir.splits.size() + 1, -1);
       dir.segment_member.resize(dir.splits.size() + 1, -1);
       const auto it = std::lower_bound(dir.splits.begin(), dir.splits.end(), mem.r1);
@@ -292,15 +414,16 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
       dir.segment_member[s] = i;
     }
   }
-  // One order per linked set of directions: the smallest.
+}
+
+void SegmentModel::UnifyOrders() {
   for (bool changed = true; changed;) {
     changed = false;
-    for (const Class& cls : model.classes_) {
+    for (const Class& cls : classes_) {
       int o = kMaxOrder;
-      for (const Member& mem : cls.members)
-        o = std::min(o, model.directions_[mem.block][mem.dir].order);
+      for (const Member& mem : cls.members) o = std::min(o, directions_[mem.block][mem.dir].order);
       for (const Member& mem : cls.members) {
-        int& mo = model.directions_[mem.block][mem.dir].order;
+        int& mo = directions_[mem.block][mem.dir].order;
         if (mo != o) {
           mo = o;
           changed = true;
@@ -308,12 +431,14 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
       }
     }
   }
-  // Class parameters: the members' normalised own parameters, averaged in class coordinates.
-  for (Class& cls : model.classes_) {
+}
+
+void SegmentModel::AverageClassParams() {
+  for (Class& cls : classes_) {
     std::vector<double> sum(cls.length + 1, 0.0);
     std::vector<int> count(cls.length + 1, 0);
     for (const Member& mem : cls.members) {
-      const std::vector<double>& own = model.directions_[mem.block][mem.dir].own_params;
+      const std::vector<double>& own = directions_[mem.block][mem.dir].own_params;
       const double u0 = own[mem.r0], u1 = own[mem.r1];
       for (int r = mem.r0; r <= mem.r1; ++r) {
         const double q = (own[r] - u0) / (u1 - u0);
@@ -327,15 +452,16 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
     cls.params.front() = 0.0;
     cls.params.back() = 1.0;
   }
-  // Global parameters of every direction.
-  for (int b = 0; b < nb; ++b) {
-    for (int d = 0; d < 3; ++d) {
-      Direction& dir = model.directions_[b][d];
+}
+
+void SegmentModel::SetGlobalParams() {
+  for (std::array<Direction, 3>& block : directions_) {
+    for (Direction& dir : block) {
       dir.params = dir.own_params;
       if (dir.m == 1) continue;
       for (size_t s = 0; s < dir.segment_class.size(); ++s) {
-        const Member& mem = model.classes_[dir.segment_class[s]].members[dir.segment_member[s]];
-        const Class& cls = model.classes_[dir.segment_class[s]];
+        const Member& mem = classes_[dir.segment_class[s]].members[dir.segment_member[s]];
+        const Class& cls = classes_[dir.segment_class[s]];
         const double u0 = dir.own_params[mem.r0], u1 = dir.own_params[mem.r1];
         for (int r = mem.r0 + 1; r < mem.r1; ++r) {
           const double p = cls.params[mem.ClassCoord(r)];
@@ -344,7 +470,6 @@ absl::StatusOr<SegmentModel> SegmentModel::Build(
       }
     }
   }
-  return model;
 }
 
 absl::StatusOr<std::pair<KnotVector, std::vector<Pin>>> SegmentModel::DirectionKnots(int b,

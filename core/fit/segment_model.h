@@ -113,6 +113,21 @@ class SegmentModel {
   // The control index pinned at data index r (0, m-1 or an interior split) of direction d.
   int PinnedControl(int b, int d, int r, const KnotVector& knots) const;
 
+  // Steps of Build.
+  // Point counts, orders, control caps and own parameters of every direction.
+  void InitDirections(const MultiBlockGrid& grid,
+                      const std::vector<std::array<std::vector<double>, 3>>& params, int order,
+                      int max_controls);
+  // Per direction: the class and member of each segment.
+  void IndexSegmentClasses();
+  // One order per linked set of directions: the smallest.
+  void UnifyOrders();
+  // Class parameters: the members' normalised own parameters, averaged in class coordinates.
+  void AverageClassParams();
+  // Global parameters of every direction: its own at the ends of each segment, the class's in
+  // between.
+  void SetGlobalParams();
+
   std::vector<std::array<Direction, 3>> directions_;
   std::vector<Class> classes_;
 };
