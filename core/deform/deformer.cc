@@ -133,6 +133,145 @@ void CoonsInterior(const TensorSpline& spline, std::vector<Point3>& D) {
   D = std::move(out);
 }
 
+// The point extents of every block (its distribution's point counts).
+std::vector<Extents> PointExtents(const std::vector<FittedBlock>& blocks) {
+  std::vector<Extents> extents;
+  for (const FittedBlock& b : blocks) {
+    extents.push_back(
+        {b.distribution.num_points(0), b.distribution.num_points(1), b.distribution.num_points(2)});
+  }
+  return extents;
+}
+
+// The moved controls (block, index), block by block in control order, and their reference
+// positions.
+void CollectMovedControls(const std::vector<FittedBlock>& reference,
+                          const std::vector<std::vector<ControlRole>>& roles,
+                          std::vector<std::pair<int, int64_t>>& moved,
+                          std::vector<Point3>& positions) {
+  const int nb = static_cast<int>(reference.size());
+  for (int b = 0; b < nb; ++b) {
+    for (int64_t c = 0; c < static_cast<int64_t>(roles[b].size()); ++c) {
+      if (roles[b][c] == ControlRole::kMoved) {
+        moved.push_back({b, c});
+        positions.push_back(ControlPoint(reference[b].spline, c));
+      }
+    }
+  }
+}
+
+// The moved boundary, sampled at its grid points.
+std::vector<Point3> MovedBoundarySamples(const std::vector<FittedBlock>& reference,
+                                         const std::vector<std::vector<uint8_t>>& selected) {
+  std::vector<Point3> samples;
+  for (size_t b = 0; b < reference.size(); ++b) {
+    std::array<std::vector<double>, 3> params;
+    for (int d = 0; d < 3; ++d) params[d] = reference[b].distribution.params(d);
+    const StructuredBlock points = EvaluateGrid(reference[b].spline, params);
+    const int s = points.spatial_dim();
+    for (int64_t p = 0; p < points.num_points(); ++p) {
+      if (!selected[b][p]) continue;
+      const double* x = points.coords().data() + s * p;
+      samples.push_back({x[0], x[1], s == 3 ? x[2] : 0.0});
+    }
+  }
+  return samples;
+}
+
+// Per block, per control: the distance of a free or fixed control to the nearest of `samples`
+// (0 for moved ones); into `*nearest_fixed` the smallest over the fixed ones (infinity: none).
+std::vector<std::vector<double>> BoundaryDistances(
+    const std::vector<FittedBlock>& reference, const std::vector<std::vector<ControlRole>>& roles,
+    const std::vector<Point3>& samples, double* nearest_fixed) {
+  std::vector<std::vector<double>> distance(reference.size());
+  *nearest_fixed = std::numeric_limits<double>::infinity();
+  for (size_t b = 0; b < reference.size(); ++b) {
+    distance[b].assign(roles[b].size(), 0.0);
+    for (int64_t c = 0; c < static_cast<int64_t>(distance[b].size()); ++c) {
+      if (roles[b][c] == ControlRole::kMoved) continue;
+      const Point3 p = ControlPoint(reference[b].spline, c);
+      double best = std::numeric_limits<double>::infinity();
+      for (const Point3& q : samples) best = std::min(best, Distance2(p, q));
+      distance[b][c] = std::sqrt(best);
+      if (roles[b][c] == ControlRole::kFixed) {
+        *nearest_fixed = std::min(*nearest_fixed, distance[b][c]);
+      }
+    }
+  }
+  return distance;
+}
+
+// Per block, per control: the fraction of the motion it takes, 1 moved, 0 fixed, f(d) free.
+std::vector<std::vector<double>> MotionFractions(const std::vector<std::vector<ControlRole>>& roles,
+                                                 const std::vector<std::vector<double>>& distance,
+                                                 double rigid_radius, double decay_radius) {
+  std::vector<std::vector<double>> fraction(distance.size());
+  for (size_t b = 0; b < distance.size(); ++b) {
+    fraction[b].assign(distance[b].size(), 0.0);
+    for (size_t c = 0; c < distance[b].size(); ++c) {
+      switch (roles[b][c]) {
+        case ControlRole::kMoved:
+          fraction[b][c] = 1.0;
+          break;
+        case ControlRole::kFixed:
+          break;
+        case ControlRole::kFree:
+          fraction[b][c] = Fraction(distance[b][c], rigid_radius, decay_radius);
+          break;
+      }
+    }
+  }
+  return fraction;
+}
+
+// The groups of controls that coincide bitwise (shared boundaries of a watertight grid), each
+// sorted, the groups sorted.
+std::vector<std::vector<std::pair<int, int64_t>>> CoincidingControls(
+    const std::vector<FittedBlock>& reference) {
+  std::unordered_map<std::array<uint64_t, 3>, std::vector<std::pair<int, int64_t>>, BitsHash>
+      groups;
+  for (int b = 0; b < static_cast<int>(reference.size()); ++b) {
+    for (int64_t c = 0; c < reference[b].spline.num_control_points(); ++c) {
+      groups[Bits(ControlPoint(reference[b].spline, c))].push_back({b, c});
+    }
+  }
+  std::vector<std::vector<std::pair<int, int64_t>>> coinciding;
+  for (auto& [bits, members] : groups) {
+    if (members.size() > 1) {
+      std::sort(members.begin(), members.end());
+      coinciding.push_back(std::move(members));
+    }
+  }
+  std::sort(coinciding.begin(), coinciding.end());
+  return coinciding;
+}
+
+// The accumulated displacements of the moved controls, each averaged over the ranges that gave
+// it (`hits`), flattened to spatial_dim `s` values per control.
+std::vector<double> AveragedDisplacements(std::vector<Point3>& moved, const std::vector<int>& hits,
+                                          int s) {
+  for (size_t q = 0; q < moved.size(); ++q) {
+    if (hits[q] > 1) {
+      for (double& v : moved[q]) v /= hits[q];
+    }
+  }
+  std::vector<double> flat(moved.size() * s);
+  for (size_t q = 0; q < moved.size(); ++q) {
+    for (int e = 0; e < s; ++e) flat[s * q + e] = moved[q][e];
+  }
+  return flat;
+}
+
+// Whether control (a, b, c) of a net of `n` controls lies on no face (index 0 or n[d] - 1 of
+// an active direction d).
+bool InteriorControl(const Extents& n, int a, int b, int c) {
+  const int idx[3] = {a, b, c};
+  for (int d = 0; d < 3; ++d) {
+    if (n[d] > 1 && (idx[d] == 0 || idx[d] == n[d] - 1)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 absl::Status DeformOptions::Validate() const {
@@ -169,93 +308,29 @@ absl::StatusOr<Deformer> Deformer::Create(std::vector<FittedBlock> reference, Bo
   }
   Deformer deformer;
   deformer.options_ = options;
-  std::vector<Extents> extents;
-  for (const FittedBlock& b : reference) {
-    extents.push_back(
-        {b.distribution.num_points(0), b.distribution.num_points(1), b.distribution.num_points(2)});
-  }
-  SG_ASSIGN_OR_RETURN(deformer.selected_, SelectedPoints(extents, kinds, options.moved));
+  SG_ASSIGN_OR_RETURN(deformer.selected_,
+                      SelectedPoints(PointExtents(reference), kinds, options.moved));
   deformer.roles_ = ClassifyControls(reference, kinds, deformer.selected_);
-  const int nb = static_cast<int>(reference.size());
-  for (int b = 0; b < nb; ++b) {
-    for (int64_t c = 0; c < static_cast<int64_t>(deformer.roles_[b].size()); ++c) {
-      if (deformer.roles_[b][c] == ControlRole::kMoved) {
-        deformer.moved_.push_back({b, c});
-        deformer.moved_positions_.push_back(ControlPoint(reference[b].spline, c));
-      }
-    }
-  }
+  CollectMovedControls(reference, deformer.roles_, deformer.moved_, deformer.moved_positions_);
   if (deformer.moved_.empty()) {
     return absl::FailedPreconditionError(
         "no control point moves: the selection holds no boundary segment or face cell");
   }
-  // The moved boundary, sampled at its grid points.
-  std::vector<Point3> samples;
-  for (int b = 0; b < nb; ++b) {
-    std::array<std::vector<double>, 3> params;
-    for (int d = 0; d < 3; ++d) params[d] = reference[b].distribution.params(d);
-    const StructuredBlock points = EvaluateGrid(reference[b].spline, params);
-    const int s = points.spatial_dim();
-    for (int64_t p = 0; p < points.num_points(); ++p) {
-      if (!deformer.selected_[b][p]) continue;
-      const double* x = points.coords().data() + s * p;
-      samples.push_back({x[0], x[1], s == 3 ? x[2] : 0.0});
-    }
-  }
-  // Distances of the free and fixed controls to it; the nearest fixed one bounds the decay.
-  std::vector<std::vector<double>> distance(nb);
-  double nearest_fixed = std::numeric_limits<double>::infinity();
-  for (int b = 0; b < nb; ++b) {
-    distance[b].assign(deformer.roles_[b].size(), 0.0);
-    for (int64_t c = 0; c < static_cast<int64_t>(distance[b].size()); ++c) {
-      if (deformer.roles_[b][c] == ControlRole::kMoved) continue;
-      const Point3 p = ControlPoint(reference[b].spline, c);
-      double best = std::numeric_limits<double>::infinity();
-      for (const Point3& q : samples) best = std::min(best, Distance2(p, q));
-      distance[b][c] = std::sqrt(best);
-      if (deformer.roles_[b][c] == ControlRole::kFixed) {
-        nearest_fixed = std::min(nearest_fixed, distance[b][c]);
-      }
-    }
-  }
+  // Distances of the free and fixed controls to the moved boundary; the nearest fixed one
+  // bounds the decay.
+  double nearest_fixed = 0.0;
+  const std::vector<std::vector<double>> distance =
+      BoundaryDistances(reference, deformer.roles_,
+                        MovedBoundarySamples(reference, deformer.selected_), &nearest_fixed);
   deformer.decay_radius_ = options.decay_radius > 0.0 ? options.decay_radius : nearest_fixed;
   if (!(deformer.decay_radius_ > options.rigid_radius)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "rigid_radius = ", options.rigid_radius, " reaches the nearest fixed boundary control, ",
         deformer.decay_radius_, " from the moved boundary"));
   }
-  deformer.fraction_.resize(nb);
-  for (int b = 0; b < nb; ++b) {
-    deformer.fraction_[b].assign(distance[b].size(), 0.0);
-    for (size_t c = 0; c < distance[b].size(); ++c) {
-      switch (deformer.roles_[b][c]) {
-        case ControlRole::kMoved:
-          deformer.fraction_[b][c] = 1.0;
-          break;
-        case ControlRole::kFixed:
-          break;
-        case ControlRole::kFree:
-          deformer.fraction_[b][c] =
-              Fraction(distance[b][c], options.rigid_radius, deformer.decay_radius_);
-          break;
-      }
-    }
-  }
-  // Controls that coincide bitwise (shared boundaries of a watertight grid).
-  std::unordered_map<std::array<uint64_t, 3>, std::vector<std::pair<int, int64_t>>, BitsHash>
-      groups;
-  for (int b = 0; b < nb; ++b) {
-    for (int64_t c = 0; c < reference[b].spline.num_control_points(); ++c) {
-      groups[Bits(ControlPoint(reference[b].spline, c))].push_back({b, c});
-    }
-  }
-  for (auto& [bits, members] : groups) {
-    if (members.size() > 1) {
-      std::sort(members.begin(), members.end());
-      deformer.coinciding_.push_back(std::move(members));
-    }
-  }
-  std::sort(deformer.coinciding_.begin(), deformer.coinciding_.end());
+  deformer.fraction_ =
+      MotionFractions(deformer.roles_, distance, options.rigid_radius, deformer.decay_radius_);
+  deformer.coinciding_ = CoincidingControls(reference);
   deformer.reference_ = std::move(reference);
   deformer.kinds_ = std::move(kinds);
   return deformer;
@@ -272,6 +347,55 @@ void Deformer::Propagate(std::vector<FittedBlock>& blocks, const FreeMotion& fre
     }
   }
   Finish(blocks);
+}
+
+// Jacobi sweeps of the spring-analogy Laplacian (deformer.h) over the interior free controls.
+void Deformer::SmoothInterior(size_t b, std::vector<Point3>& D) const {
+  const Extents n = reference_[b].spline.control_extents();
+  for (int sweep = 0; sweep < options_.smoothing_iterations; ++sweep) {
+    std::vector<Point3> next = D;
+    for (int cc = 0; cc < n[2]; ++cc) {
+      for (int bb = 0; bb < n[1]; ++bb) {
+        for (int a = 0; a < n[0]; ++a) {
+          const int64_t c = a + int64_t{n[0]} * (bb + int64_t{n[1]} * cc);
+          if (!InteriorControl(n, a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
+          Point3 sum = {0, 0, 0};
+          double weights = 0.0;
+          const int64_t stride[3] = {1, n[0], int64_t{n[0]} * n[1]};
+          const Point3 here = ControlPoint(reference_[b].spline, c);
+          for (int d = 0; d < 3; ++d) {
+            if (n[d] == 1) continue;
+            for (int64_t q : {c - stride[d], c + stride[d]}) {
+              const double d2 = Distance2(here, ControlPoint(reference_[b].spline, q));
+              const double w = d2 > 0.0 ? 1.0 / d2 : 0.0;
+              for (int e = 0; e < 3; ++e) sum[e] += w * D[q][e];
+              weights += w;
+            }
+          }
+          if (weights > 0.0) {
+            for (int e = 0; e < 3; ++e) next[c][e] = sum[e] / weights;
+          }
+        }
+      }
+    }
+    D = std::move(next);
+  }
+}
+
+// Coinciding controls end up bitwise equal: the first member's value (a moved or fixed
+// member's, when there is one, so boundaries stay exact).
+void Deformer::EqualizeCoinciding(std::vector<FittedBlock>& blocks) const {
+  for (const auto& group : coinciding_) {
+    std::pair<int, int64_t> source = group.front();
+    for (const auto& member : group) {
+      if (roles_[member.first][member.second] != ControlRole::kFree) {
+        source = member;
+        break;
+      }
+    }
+    const Point3 value = ControlPoint(blocks[source.first].spline, source.second);
+    for (const auto& [b, c] : group) SetControlPoint(blocks[b].spline, c, value);
+  }
 }
 
 void Deformer::Finish(std::vector<FittedBlock>& blocks) const {
@@ -292,65 +416,19 @@ void Deformer::Finish(std::vector<FittedBlock>& blocks) const {
       D[c] = {now[0] - was[0], now[1] - was[1], now[2] - was[2]};
     }
     if (options_.propagation == Propagation::kTransfinite) CoonsInterior(spline, D);
-    auto interior = [&](int a, int bb, int cc) {
-      const int idx[3] = {a, bb, cc};
-      for (int d = 0; d < 3; ++d) {
-        if (n[d] > 1 && (idx[d] == 0 || idx[d] == n[d] - 1)) return false;
-      }
-      return true;
-    };
-    for (int sweep = 0; sweep < options_.smoothing_iterations; ++sweep) {
-      std::vector<Point3> next = D;
-      for (int cc = 0; cc < n[2]; ++cc) {
-        for (int bb = 0; bb < n[1]; ++bb) {
-          for (int a = 0; a < n[0]; ++a) {
-            const int64_t c = a + int64_t{n[0]} * (bb + int64_t{n[1]} * cc);
-            if (!interior(a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
-            Point3 sum = {0, 0, 0};
-            double weights = 0.0;
-            const int64_t stride[3] = {1, n[0], int64_t{n[0]} * n[1]};
-            const Point3 here = ControlPoint(reference_[b].spline, c);
-            for (int d = 0; d < 3; ++d) {
-              if (n[d] == 1) continue;
-              for (int64_t q : {c - stride[d], c + stride[d]}) {
-                const double d2 = Distance2(here, ControlPoint(reference_[b].spline, q));
-                const double w = d2 > 0.0 ? 1.0 / d2 : 0.0;
-                for (int e = 0; e < 3; ++e) sum[e] += w * D[q][e];
-                weights += w;
-              }
-            }
-            if (weights > 0.0) {
-              for (int e = 0; e < 3; ++e) next[c][e] = sum[e] / weights;
-            }
-          }
-        }
-      }
-      D = std::move(next);
-    }
+    SmoothInterior(b, D);
     for (int cc = 0; cc < n[2]; ++cc) {
       for (int bb = 0; bb < n[1]; ++bb) {
         for (int a = 0; a < n[0]; ++a) {
           const int64_t c = a + int64_t{n[0]} * (bb + int64_t{n[1]} * cc);
-          if (!interior(a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
+          if (!InteriorControl(n, a, bb, cc) || roles_[b][c] != ControlRole::kFree) continue;
           const Point3 was = ControlPoint(reference_[b].spline, c);
           SetControlPoint(spline, c, {was[0] + D[c][0], was[1] + D[c][1], was[2] + D[c][2]});
         }
       }
     }
   }
-  // Coinciding controls end up bitwise equal: the first member's value (a moved or fixed
-  // member's, when there is one, so boundaries stay exact).
-  for (const auto& group : coinciding_) {
-    std::pair<int, int64_t> source = group.front();
-    for (const auto& member : group) {
-      if (roles_[member.first][member.second] != ControlRole::kFree) {
-        source = member;
-        break;
-      }
-    }
-    const Point3 value = ControlPoint(blocks[source.first].spline, source.second);
-    for (const auto& [b, c] : group) SetControlPoint(blocks[b].spline, c, value);
-  }
+  EqualizeCoinciding(blocks);
 }
 
 absl::StatusOr<std::vector<FittedBlock>> Deformer::Rigid(const RigidMotion& motion) const {
@@ -451,6 +529,105 @@ absl::StatusOr<std::shared_ptr<const Deformer::BoundaryFit>> Deformer::FitFor(
   return std::shared_ptr<const BoundaryFit>(fit);
 }
 
+absl::StatusOr<std::shared_ptr<const Deformer::BoundaryFit>> Deformer::CheckedFit(
+    const BoundaryPoints& given, size_t r, const std::vector<Extents>& extents) const {
+  const int s = reference_.front().spline.spatial_dim();
+  const std::string name = absl::StrCat("boundary points ", r);
+  BoundarySelection one;
+  one.ranges = {given.range};
+  SG_ASSIGN_OR_RETURN(const std::vector<std::vector<uint8_t>> inside,
+                      SelectedPoints(extents, kinds_, one), name, ": ");
+  const int b = given.range.face.block;
+  for (size_t p = 0; p < inside[b].size(); ++p) {
+    if (inside[b][p] && !selected_[b][p]) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": point ", p, " of block ", b, " is not on the moved boundary"));
+    }
+  }
+  if (given.level < 0 || given.level > kMaxRefinementLevel) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": level = ", given.level,
+                                                   " is outside [0, ", kMaxRefinementLevel, "]"));
+  }
+  SG_ASSIGN_OR_RETURN(std::shared_ptr<const BoundaryFit> fit, FitFor(given.range, given.level));
+  if (fit->tangential.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": the range is a single point"));
+  }
+  int64_t count = 1;
+  for (const RangeFit& f : fit->fits) count *= f.num_samples();
+  if (static_cast<int64_t>(given.coordinates.size()) != count * s) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", given.coordinates.size(),
+                                                   " values for ", count, " points of ", s,
+                                                   " coordinates at level ", given.level));
+  }
+  for (size_t v = 0; v < given.coordinates.size(); ++v) {
+    if (!std::isfinite(given.coordinates[v])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": coordinates[", v, "] = ", given.coordinates[v], " is not finite"));
+    }
+  }
+  return fit;
+}
+
+std::vector<double> Deformer::SampleDisplacements(const BoundaryPoints& given,
+                                                  const BoundaryFit& fit) const {
+  std::vector<double> delta = given.coordinates;
+  if (!given.displacements) {
+    const StructuredBlock was = EvaluateGrid(reference_[fit.block].spline, fit.params);
+    for (size_t v = 0; v < delta.size(); ++v) delta[v] -= was.coords()[v];
+  }
+  return delta;
+}
+
+std::vector<double> Deformer::FitRangeControls(const BoundaryFit& fit,
+                                               const std::vector<double>& delta, int s) {
+  // Direction by direction: first tangential direction (fastest), then the second.
+  const RangeFit& f0 = fit.fits[0];
+  const int64_t rows1 = fit.fits.size() > 1 ? fit.fits[1].num_samples() : 1;
+  std::vector<double> stage(static_cast<size_t>(f0.num_controls()) * rows1 * s);
+  for (int64_t j = 0; j < rows1; ++j) {
+    f0.Apply(delta.data() + j * f0.num_samples() * s, s, stage.data() + j * f0.num_controls() * s);
+  }
+  if (fit.fits.size() == 1) return stage;
+  const RangeFit& f1 = fit.fits[1];
+  // Lines of direction 1 are strided by f0.num_controls() * s: transpose through a buffer.
+  const int64_t width = int64_t{f0.num_controls()} * s;
+  std::vector<double> controls(static_cast<size_t>(width) * f1.num_controls(), 0.0);
+  f1.Apply(stage.data(), width, controls.data());
+  return controls;
+}
+
+void Deformer::AccumulateMoved(const BoundaryPoints& given, const BoundaryFit& fit,
+                               const std::vector<double>& controls,
+                               const std::vector<Extents>& extents,
+                               const std::map<std::pair<int, int64_t>, size_t>& moved_index,
+                               std::vector<Point3>& moved, std::vector<int>& hits) const {
+  const int s = reference_.front().spline.spatial_dim();
+  const int b = given.range.face.block;
+  const RangeFit& f0 = fit.fits[0];
+  const int cols1 = fit.fits.size() > 1 ? fit.fits[1].num_controls() : 1;
+  const int first1 = fit.fits.size() > 1 ? fit.fits[1].first() : 0;
+  const Extents n = reference_[b].spline.control_extents();
+  const int t0 = fit.tangential[0];
+  const int t1 = fit.tangential.size() > 1 ? fit.tangential[1] : -1;
+  for (int a1 = 0; a1 < cols1; ++a1) {
+    for (int a0 = 0; a0 < f0.num_controls(); ++a0) {
+      Extents c = {0, 0, 0};
+      const int normal = given.range.face.normal;
+      if (reference_[b].spline.knots(normal).num_controls() > 1 && extents[b][normal] > 1) {
+        c[normal] = given.range.face.upper ? n[normal] - 1 : 0;
+      }
+      c[t0] = f0.first() + a0;
+      if (t1 >= 0) c[t1] = first1 + a1;
+      const int64_t index = c[0] + int64_t{n[0]} * (c[1] + int64_t{n[1]} * c[2]);
+      const auto it = moved_index.find({b, index});
+      if (it == moved_index.end()) continue;  // carries none of the moved boundary
+      const double* v = controls.data() + (int64_t{a1} * f0.num_controls() + a0) * s;
+      for (int e = 0; e < s; ++e) moved[it->second][e] += v[e];
+      ++hits[it->second];
+    }
+  }
+}
+
 absl::StatusOr<std::vector<FittedBlock>> Deformer::MoveBoundaryPoints(
     std::span<const BoundaryPoints> points) const {
   const int s = reference_.front().spline.spatial_dim();
@@ -458,106 +635,17 @@ absl::StatusOr<std::vector<FittedBlock>> Deformer::MoveBoundaryPoints(
   std::vector<int> hits(moved_.size(), 0);
   std::map<std::pair<int, int64_t>, size_t> moved_index;
   for (size_t q = 0; q < moved_.size(); ++q) moved_index[moved_[q]] = q;
-  std::vector<Extents> extents;
-  for (const FittedBlock& b : reference_) {
-    extents.push_back(
-        {b.distribution.num_points(0), b.distribution.num_points(1), b.distribution.num_points(2)});
-  }
+  const std::vector<Extents> extents = PointExtents(reference_);
   for (size_t r = 0; r < points.size(); ++r) {
-    const BoundaryPoints& given = points[r];
-    const std::string name = absl::StrCat("boundary points ", r);
-    BoundarySelection one;
-    one.ranges = {given.range};
-    absl::StatusOr<std::vector<std::vector<uint8_t>>> inside = SelectedPoints(extents, kinds_, one);
-    if (!inside.ok()) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": ", inside.status().message()));
-    }
-    const int b = given.range.face.block;
-    for (size_t p = 0; p < (*inside)[b].size(); ++p) {
-      if ((*inside)[b][p] && !selected_[b][p]) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(name, ": point ", p, " of block ", b, " is not on the moved boundary"));
-      }
-    }
-    if (given.level < 0 || given.level > kMaxRefinementLevel) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": level = ", given.level,
-                                                     " is outside [0, ", kMaxRefinementLevel, "]"));
-    }
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const BoundaryFit> fit,
-                        FitFor(given.range, given.level));
-    if (fit->tangential.empty()) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": the range is a single point"));
-    }
-    int64_t count = 1;
-    for (const RangeFit& f : fit->fits) count *= f.num_samples();
-    if (static_cast<int64_t>(given.coordinates.size()) != count * s) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": ", given.coordinates.size(),
-                                                     " values for ", count, " points of ", s,
-                                                     " coordinates at level ", given.level));
-    }
-    for (size_t v = 0; v < given.coordinates.size(); ++v) {
-      if (!std::isfinite(given.coordinates[v])) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            name, ": coordinates[", v, "] = ", given.coordinates[v], " is not finite"));
-      }
-    }
-    // Displacements at the samples.
-    std::vector<double> delta = given.coordinates;
-    if (!given.displacements) {
-      const StructuredBlock was = EvaluateGrid(reference_[b].spline, fit->params);
-      for (size_t v = 0; v < delta.size(); ++v) delta[v] -= was.coords()[v];
-    }
-    // Direction by direction: first tangential direction (fastest), then the second.
-    const RangeFit& f0 = fit->fits[0];
-    const int64_t rows1 = fit->fits.size() > 1 ? fit->fits[1].num_samples() : 1;
-    std::vector<double> stage(static_cast<size_t>(f0.num_controls()) * rows1 * s);
-    for (int64_t j = 0; j < rows1; ++j) {
-      f0.Apply(delta.data() + j * f0.num_samples() * s, s,
-               stage.data() + j * f0.num_controls() * s);
-    }
-    std::vector<double> controls = stage;
-    int cols1 = 1, first1 = 0;
-    if (fit->fits.size() > 1) {
-      const RangeFit& f1 = fit->fits[1];
-      cols1 = f1.num_controls();
-      first1 = f1.first();
-      // Lines of direction 1 are strided by f0.num_controls() * s: transpose through a buffer.
-      const int64_t width = int64_t{f0.num_controls()} * s;
-      controls.assign(static_cast<size_t>(width) * cols1, 0.0);
-      f1.Apply(stage.data(), width, controls.data());
-    }
-    // Accumulate into the moved controls of the range's face.
-    const Extents n = reference_[b].spline.control_extents();
-    const int t0 = fit->tangential[0];
-    const int t1 = fit->tangential.size() > 1 ? fit->tangential[1] : -1;
-    for (int a1 = 0; a1 < cols1; ++a1) {
-      for (int a0 = 0; a0 < f0.num_controls(); ++a0) {
-        Extents c = {0, 0, 0};
-        const int normal = given.range.face.normal;
-        if (reference_[b].spline.knots(normal).num_controls() > 1 && extents[b][normal] > 1) {
-          c[normal] = given.range.face.upper ? n[normal] - 1 : 0;
-        }
-        c[t0] = f0.first() + a0;
-        if (t1 >= 0) c[t1] = first1 + a1;
-        const int64_t index = c[0] + int64_t{n[0]} * (c[1] + int64_t{n[1]} * c[2]);
-        const auto it = moved_index.find({b, index});
-        if (it == moved_index.end()) continue;  // carries none of the moved boundary
-        const double* v = controls.data() + (int64_t{a1} * f0.num_controls() + a0) * s;
-        for (int e = 0; e < s; ++e) moved[it->second][e] += v[e];
-        ++hits[it->second];
-      }
-    }
+                        CheckedFit(points[r], r, extents));
+    // Displacements at the samples, fitted by the range's controls, accumulated into the moved
+    // controls of the range's face.
+    const std::vector<double> controls =
+        FitRangeControls(*fit, SampleDisplacements(points[r], *fit), s);
+    AccumulateMoved(points[r], *fit, controls, extents, moved_index, moved, hits);
   }
-  for (size_t q = 0; q < moved.size(); ++q) {
-    if (hits[q] > 1) {
-      for (double& v : moved[q]) v /= hits[q];
-    }
-  }
-  std::vector<double> flat(moved_.size() * s);
-  for (size_t q = 0; q < moved.size(); ++q) {
-    for (int e = 0; e < s; ++e) flat[s * q + e] = moved[q][e];
-  }
-  return DisplaceControls(flat);
+  return DisplaceControls(AveragedDisplacements(moved, hits, s));
 }
 
 }  // namespace splinegrid

@@ -131,11 +131,34 @@ class Deformer {
   // The Coons interior of one block from its faces (kTransfinite), then smoothing, then the
   // coinciding groups made equal.
   void Finish(std::vector<FittedBlock>& blocks) const;
+  // Finish step: options_.smoothing_iterations Jacobi sweeps of the weighted Laplacian of
+  // block b's control displacements D over its interior free controls.
+  void SmoothInterior(size_t b, std::vector<Point3>& D) const;
+  // Finish step: every group of coinciding controls set to one member's value.
+  void EqualizeCoinciding(std::vector<FittedBlock>& blocks) const;
   // The IDW-blended displacement of a free control at reference position p with fraction f.
   Point3 BlendedDisplacement(const Point3& p, double f,
                              const std::vector<Point3>& moved_displacements) const;
   absl::StatusOr<std::shared_ptr<const BoundaryFit>> FitFor(const FaceRange& range,
                                                             int level) const;
+  // MoveBoundaryPoints step: the fit of range r, `given` (blocks of point `extents`), after
+  // checking that it lies on the moved boundary and that its level, point count and values are
+  // valid (INVALID_ARGUMENT naming the range).
+  absl::StatusOr<std::shared_ptr<const BoundaryFit>> CheckedFit(
+      const BoundaryPoints& given, size_t r, const std::vector<Extents>& extents) const;
+  // MoveBoundaryPoints step: the given points' displacements at the fit's samples.
+  std::vector<double> SampleDisplacements(const BoundaryPoints& given,
+                                          const BoundaryFit& fit) const;
+  // MoveBoundaryPoints step: the least-squares control displacements of `delta` (s values per
+  // sample), direction by direction; controls of the first tangential direction fastest.
+  static std::vector<double> FitRangeControls(const BoundaryFit& fit,
+                                              const std::vector<double>& delta, int s);
+  // MoveBoundaryPoints step: adds those control displacements to the moved controls of the
+  // range's face (`moved`, by `moved_index`), counting the ranges that reach each in `hits`.
+  void AccumulateMoved(const BoundaryPoints& given, const BoundaryFit& fit,
+                       const std::vector<double>& controls, const std::vector<Extents>& extents,
+                       const std::map<std::pair<int, int64_t>, size_t>& moved_index,
+                       std::vector<Point3>& moved, std::vector<int>& hits) const;
 
   std::vector<FittedBlock> reference_;
   BoundaryKinds kinds_;

@@ -142,6 +142,139 @@ WallLoop EverySecond(const WallLoop& wall) {
   return out;
 }
 
+// The fitted differences' weights B(-phi), B(phi), B(-psi), B(psi) at every point.
+std::vector<double> FittedWeights(const ControlFunctions& control, int64_t num_points) {
+  std::vector<double> weights(4 * num_points);
+  for (int64_t p = 0; p < num_points; ++p) {
+    weights[4 * p] = Bernoulli(-control.phi[p]);
+    weights[4 * p + 1] = Bernoulli(control.phi[p]);
+    weights[4 * p + 2] = Bernoulli(-control.psi[p]);
+    weights[4 * p + 3] = Bernoulli(control.psi[p]);
+  }
+  return weights;
+}
+
+// Alternating line relaxation of an O-grid in place: every line of constant i solved at once
+// (tridiagonal in j), then every line of constant j (cyclic tridiagonal in i), each with its
+// neighbouring lines as they are, and relaxed by omega. Near the wall the flat cells couple
+// strongly in j, far out the stretched ones in i; point relaxation would carry either a point
+// per sweep. Layers below `first` and the outer loop stay.
+class LineRelaxation {
+ public:
+  LineRelaxation(StructuredBlock& g, const ControlFunctions& control, int first, double omega)
+      : g_(g),
+        ni_(g.extent(0)),
+        nj_(g.extent(1)),
+        first_(first),
+        rows_(nj_ - 1 - first),
+        cols_(ni_ - 1),
+        omega_(omega),
+        weights_(FittedWeights(control, g.num_points())) {}
+
+  // Unknowns j = first .. nj - 2 per line of constant i.
+  int rows() const { return rows_; }
+
+  // One sweep over both line directions; the largest move relative to the moved point's
+  // smallest spacing to its neighbours (infinity when a move is not finite).
+  double Sweep() {
+    largest_ = 0.0;
+    SweepLinesAlongJ();
+    SweepLinesAlongI();
+    return largest_;
+  }
+
+ private:
+  // The discrete equation at (i, j), split into the neighbours along the line and the rest.
+  void Stencil(int i, int j, bool along_j, double* lower, double* diag, double* upper,
+               Vec* rest) const {
+    const Neighbourhood h = Around(g_, i, j);
+    const Vec &e = h.e, &w = h.w, &n = h.n, &s = h.s, &cross = h.cross;
+    const double alpha = h.alpha, beta = h.beta, gamma = h.gamma;
+    const int64_t p = g_.Index(i, j, 0);
+    // (we + ww + wn + ws) x = we x_e + ww x_w + wn x_n + ws x_s - 2 beta x_xieta, with
+    // we = alpha B(-phi), ww = alpha B(phi), wn = gamma B(-psi), ws = gamma B(psi).
+    const double we = alpha * weights_[4 * p], ww = alpha * weights_[4 * p + 1];
+    const double wn = gamma * weights_[4 * p + 2], ws = gamma * weights_[4 * p + 3];
+    *diag = we + ww + wn + ws;
+    rest->x = -2.0 * beta * cross.x;
+    rest->y = -2.0 * beta * cross.y;
+    if (along_j) {
+      *lower = -ws;
+      *upper = -wn;
+      rest->x += we * e.x + ww * w.x;
+      rest->y += we * e.y + ww * w.y;
+    } else {
+      *lower = -ww;
+      *upper = -we;
+      rest->x += wn * n.x + ws * s.x;
+      rest->y += wn * n.y + ws * s.y;
+    }
+  }
+
+  // Moves point (i, j) by omega towards (x, y), tracking the largest move relative to the
+  // point's smallest spacing to its neighbours.
+  void Relax(int i, int j, double x, double y) {
+    double* p = g_.Point(i, j, 0);
+    const double dx = omega_ * (x - p[0]), dy = omega_ * (y - p[1]);
+    if (!std::isfinite(dx) || !std::isfinite(dy)) {
+      largest_ = std::numeric_limits<double>::infinity();
+      return;
+    }
+    const Vec b = {p[0], p[1]}, e = At(g_, i + 1, j), n = At(g_, i, j + 1), s = At(g_, i, j - 1);
+    const double h = std::min({std::hypot(e.x - b.x, e.y - b.y), std::hypot(n.x - b.x, n.y - b.y),
+                               std::hypot(s.x - b.x, s.y - b.y)});
+    p[0] += dx;
+    p[1] += dy;
+    if (h > 0.0) largest_ = std::max(largest_, std::hypot(dx, dy) / h);
+    if (i == 0) std::copy(p, p + 2, g_.Point(ni_ - 1, j, 0));
+  }
+
+  // Every line of constant i, tridiagonal in j.
+  void SweepLinesAlongJ() {
+    line_.Resize(rows_);
+    for (int i = 0; i < cols_; ++i) {
+      for (int r = 0; r < rows_; ++r) {
+        Vec rest;
+        Stencil(i, first_ + r, true, &line_.lower[r], &line_.diag[r], &line_.upper[r], &rest);
+        line_.bx[r] = rest.x;
+        line_.by[r] = rest.y;
+      }
+      // The held layer below and the outer loop above are fixed: move them to the right.
+      line_.bx[0] -= line_.lower[0] * At(g_, i, first_ - 1).x;
+      line_.by[0] -= line_.lower[0] * At(g_, i, first_ - 1).y;
+      line_.bx[rows_ - 1] -= line_.upper[rows_ - 1] * At(g_, i, nj_ - 1).x;
+      line_.by[rows_ - 1] -= line_.upper[rows_ - 1] * At(g_, i, nj_ - 1).y;
+      line_.Solve();
+      for (int r = 0; r < rows_; ++r) Relax(i, first_ + r, line_.bx[r], line_.by[r]);
+    }
+  }
+
+  // Every line of constant j, cyclic tridiagonal in i (periodic).
+  void SweepLinesAlongI() {
+    line_.Resize(cols_);
+    for (int j = first_; j + 1 < nj_; ++j) {
+      for (int i = 0; i < cols_; ++i) {
+        Vec rest;
+        Stencil(i, j, false, &line_.lower[i], &line_.diag[i], &line_.upper[i], &rest);
+        line_.bx[i] = rest.x;
+        line_.by[i] = rest.y;
+      }
+      line_.SolveCyclic();
+      for (int i = 0; i < cols_; ++i) Relax(i, j, line_.bx[i], line_.by[i]);
+    }
+  }
+
+  StructuredBlock& g_;
+  const int ni_, nj_;
+  const int first_;  // the first unknown layer
+  const int rows_;   // unknowns j = first .. nj - 2
+  const int cols_;   // unknowns i = 0 .. ni - 2 (periodic)
+  const double omega_;
+  const std::vector<double> weights_;
+  LineSystem line_;
+  double largest_ = 0.0;
+};
+
 }  // namespace
 
 ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
@@ -231,102 +364,15 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
     return absl::InvalidArgumentError(absl::StrCat("control functions for ", control.phi.size(),
                                                    " points; the grid has ", initial.num_points()));
   }
-  const int ni = initial.extent(0), nj = initial.extent(1);
+  const int nj = initial.extent(1);
   EllipticResult result;
   result.grid = initial;
-  StructuredBlock& g = result.grid;
   const int first = std::clamp(held_layers, 1, nj - 1);
-  const double omega = options.relaxation;
-  // Alternating line relaxation: every line of constant i solved at once (tridiagonal in j),
-  // then every line of constant j (cyclic tridiagonal in i), each with its neighbouring lines as
-  // they are, and relaxed by omega. Near the wall the flat cells couple strongly in j, far out
-  // the stretched ones in i; point relaxation would carry either a point per sweep.
-  const int rows = nj - 1 - first;  // unknowns j = first .. nj - 2
-  const int cols = ni - 1;          // unknowns i = 0 .. ni - 2 (periodic)
-  LineSystem line;
-  // The fitted differences' weights B(-phi), B(phi), B(-psi), B(psi) at every point.
-  std::vector<double> weights(4 * g.num_points());
-  for (int64_t p = 0; p < g.num_points(); ++p) {
-    weights[4 * p] = Bernoulli(-control.phi[p]);
-    weights[4 * p + 1] = Bernoulli(control.phi[p]);
-    weights[4 * p + 2] = Bernoulli(-control.psi[p]);
-    weights[4 * p + 3] = Bernoulli(control.psi[p]);
-  }
-  // The discrete equation at (i, j), split into the neighbours along the line and the rest.
-  const auto stencil = [&](int i, int j, bool along_j, double* lower, double* diag, double* upper,
-                           Vec* rest) {
-    const Neighbourhood h = Around(g, i, j);
-    const Vec &e = h.e, &w = h.w, &n = h.n, &s = h.s, &cross = h.cross;
-    const double alpha = h.alpha, beta = h.beta, gamma = h.gamma;
-    const int64_t p = g.Index(i, j, 0);
-    // (we + ww + wn + ws) x = we x_e + ww x_w + wn x_n + ws x_s - 2 beta x_xieta, with
-    // we = alpha B(-phi), ww = alpha B(phi), wn = gamma B(-psi), ws = gamma B(psi).
-    const double we = alpha * weights[4 * p], ww = alpha * weights[4 * p + 1];
-    const double wn = gamma * weights[4 * p + 2], ws = gamma * weights[4 * p + 3];
-    *diag = we + ww + wn + ws;
-    rest->x = -2.0 * beta * cross.x;
-    rest->y = -2.0 * beta * cross.y;
-    if (along_j) {
-      *lower = -ws;
-      *upper = -wn;
-      rest->x += we * e.x + ww * w.x;
-      rest->y += we * e.y + ww * w.y;
-    } else {
-      *lower = -ww;
-      *upper = -we;
-      rest->x += wn * n.x + ws * s.x;
-      rest->y += wn * n.y + ws * s.y;
-    }
-  };
-  double largest = 0.0;
-  // Moves point (i, j) by omega towards (x, y), tracking the largest move relative to the
-  // point's smallest spacing to its neighbours.
-  const auto relax = [&](int i, int j, double x, double y) {
-    double* p = g.Point(i, j, 0);
-    const double dx = omega * (x - p[0]), dy = omega * (y - p[1]);
-    if (!std::isfinite(dx) || !std::isfinite(dy)) {
-      largest = std::numeric_limits<double>::infinity();
-      return;
-    }
-    const Vec b = {p[0], p[1]}, e = At(g, i + 1, j), n = At(g, i, j + 1), s = At(g, i, j - 1);
-    const double h = std::min({std::hypot(e.x - b.x, e.y - b.y), std::hypot(n.x - b.x, n.y - b.y),
-                               std::hypot(s.x - b.x, s.y - b.y)});
-    p[0] += dx;
-    p[1] += dy;
-    if (h > 0.0) largest = std::max(largest, std::hypot(dx, dy) / h);
-    if (i == 0) std::copy(p, p + 2, g.Point(ni - 1, j, 0));
-  };
-  for (result.sweeps = 0; result.sweeps < options.max_sweeps && rows > 0;) {
+  LineRelaxation relaxation(result.grid, control, first, options.relaxation);
+  for (result.sweeps = 0; result.sweeps < options.max_sweeps && relaxation.rows() > 0;) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     ++result.sweeps;
-    largest = 0.0;
-    line.Resize(rows);
-    for (int i = 0; i < cols; ++i) {
-      for (int r = 0; r < rows; ++r) {
-        Vec rest;
-        stencil(i, first + r, true, &line.lower[r], &line.diag[r], &line.upper[r], &rest);
-        line.bx[r] = rest.x;
-        line.by[r] = rest.y;
-      }
-      // The held layer below and the outer loop above are fixed: move them to the right.
-      line.bx[0] -= line.lower[0] * At(g, i, first - 1).x;
-      line.by[0] -= line.lower[0] * At(g, i, first - 1).y;
-      line.bx[rows - 1] -= line.upper[rows - 1] * At(g, i, nj - 1).x;
-      line.by[rows - 1] -= line.upper[rows - 1] * At(g, i, nj - 1).y;
-      line.Solve();
-      for (int r = 0; r < rows; ++r) relax(i, first + r, line.bx[r], line.by[r]);
-    }
-    line.Resize(cols);
-    for (int j = first; j + 1 < nj; ++j) {
-      for (int i = 0; i < cols; ++i) {
-        Vec rest;
-        stencil(i, j, false, &line.lower[i], &line.diag[i], &line.upper[i], &rest);
-        line.bx[i] = rest.x;
-        line.by[i] = rest.y;
-      }
-      line.SolveCyclic();
-      for (int i = 0; i < cols; ++i) relax(i, j, line.bx[i], line.by[i]);
-    }
+    const double largest = relaxation.Sweep();
     if (!std::isfinite(largest)) {
       return absl::FailedPreconditionError(
           absl::StrCat("elliptic smoothing diverged in sweep ", result.sweeps));

@@ -112,6 +112,115 @@ absl::Status RefitPiece(std::vector<Point2>& q, int a, int b, double lambda, dou
   return absl::OkStatus();
 }
 
+// The checks of MarchOffsets' wall loop: 5 points at least, closed, finite, not crossing itself.
+absl::Status CheckWallLoop(const WallLoop& wall) {
+  const int n = static_cast<int>(wall.points.size());
+  if (n < 5)
+    return absl::InvalidArgumentError(absl::StrCat("the wall has ", n, " points; 5 at least"));
+  if (wall.points.front() != wall.points.back()) {
+    return absl::InvalidArgumentError(
+        "the wall loop is not closed: its last point is not its first");
+  }
+  for (double v : Flat(wall.points)) {
+    if (!std::isfinite(v))
+      return absl::InvalidArgumentError("the wall has a non-finite coordinate");
+  }
+  if (const auto crossing = FindPolylineCrossing(Flat(wall.points), true)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the wall crosses itself: segment ", crossing->first, " meets segment ", crossing->second));
+  }
+  return absl::OkStatus();
+}
+
+// The wall's corner indices with the loop's ends added, sorted and unique.
+absl::StatusOr<std::vector<int>> SortedCorners(const WallLoop& wall) {
+  const int n = static_cast<int>(wall.points.size());
+  std::vector<int> corners = wall.corners;
+  corners.push_back(0);
+  corners.push_back(n - 1);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  if (corners.front() < 0 || corners.back() > n - 1) {
+    return absl::InvalidArgumentError("a wall corner index is outside the loop");
+  }
+  return corners;
+}
+
+// The corners still sharp on a layer, and the pieces they split its refit into.
+struct LayerCorners {
+  std::vector<bool> is_corner;  // per point
+  std::vector<int> pieces;      // piece ends, from 0 to n - 1
+};
+
+// Corners still sharp on layer p keep their normal (the bisector) and split the refit; once a
+// corner has opened up below kCornerDegrees it is smoothed like any point (the seam at the
+// loop's ends always splits the refit).
+LayerCorners SharpCorners(const std::vector<Point2>& p, const std::vector<int>& corners) {
+  const int n = static_cast<int>(p.size());
+  LayerCorners out{std::vector<bool>(n, false), {0}};
+  for (int c : corners) {
+    if (c == 0 || c == n - 1) continue;
+    if (TurningDegrees(p, c) >= kCornerDegrees) {
+      out.is_corner[c] = true;
+      out.pieces.push_back(c);
+    }
+  }
+  out.pieces.push_back(n - 1);
+  if (TurningDegrees(p, 0) >= kCornerDegrees) out.is_corner[0] = out.is_corner[n - 1] = true;
+  return out;
+}
+
+// Layer k + 1 (step h) above p along `normals`, which get two more smoothing sweeps per retry
+// (counted in `*retries`) until the layer is valid (LayerValid); FAILED_PRECONDITION when
+// max_retries does not suffice.
+absl::StatusOr<std::vector<Point2>> OffsetWithRetries(const std::vector<Point2>& p,
+                                                      std::vector<Point2>& normals,
+                                                      const std::vector<bool>& is_corner, double h,
+                                                      double orientation, int k,
+                                                      const OffsetOptions& options, int* retries) {
+  const int n = static_cast<int>(p.size());
+  std::vector<Point2> q(n);
+  int where = 0;
+  for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
+    if (attempt > 0) {
+      for (int s = 0; s < 2 * attempt; ++s) SmoothNormals(normals, is_corner);
+      ++*retries;
+    }
+    for (int i = 0; i < n; ++i) q[i] = {p[i][0] + h * normals[i][0], p[i][1] + h * normals[i][1]};
+    q.back() = q.front();
+    if (LayerValid(p, q, orientation, options.min_segment_ratio, &where)) return q;
+  }
+  return absl::FailedPreconditionError(absl::StrCat(
+      "layer ", k + 1, " folds at wall segment ", where, " even with smoothed normals (step ", h,
+      "); use more layers, a smaller growth or a smoother wall"));
+}
+
+// Refit and fair layer q (above p, layer k + 1 of step h) between corners; slide towards even
+// spacing by the part of the remaining distance this layer covers (so the unevenness left is
+// the fraction of the distance still to go).
+absl::Status RefitLayer(const std::vector<Point2>& p, const std::vector<int>& pieces, double h,
+                        int k, double orientation, const OffsetOptions& options,
+                        std::vector<Point2>& q) {
+  const double fraction = static_cast<double>(k + 1) / options.layers;
+  const double lambda = options.fairing * fraction;
+  const double beta = options.uniformity / (options.layers - k);
+  const double tilt = (options.wall_tilt_degrees +
+                       (options.far_tilt_degrees - options.wall_tilt_degrees) * fraction) *
+                      3.14159265358979323846 / 180.0;
+  std::vector<Point2> refitted = q;
+  for (size_t c = 0; c + 1 < pieces.size(); ++c) {
+    SG_RETURN_IF_ERROR(
+        RefitPiece(refitted, pieces[c], pieces[c + 1], lambda, beta, std::tan(tilt) * h));
+  }
+  refitted.back() = refitted.front();
+  // The refit must not spoil the layer; if it does, keep the offsets as they are.
+  int where = 0;
+  if (LayerValid(p, refitted, orientation, options.min_segment_ratio, &where)) {
+    q = std::move(refitted);
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 double GrowthRatio(double first, double distance, int layers) {
@@ -164,29 +273,9 @@ absl::Status OffsetOptions::Validate() const {
 
 absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(CheckWallLoop(wall));
   const int n = static_cast<int>(wall.points.size());
-  if (n < 5)
-    return absl::InvalidArgumentError(absl::StrCat("the wall has ", n, " points; 5 at least"));
-  if (wall.points.front() != wall.points.back()) {
-    return absl::InvalidArgumentError(
-        "the wall loop is not closed: its last point is not its first");
-  }
-  for (double v : Flat(wall.points)) {
-    if (!std::isfinite(v))
-      return absl::InvalidArgumentError("the wall has a non-finite coordinate");
-  }
-  if (const auto crossing = FindPolylineCrossing(Flat(wall.points), true)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "the wall crosses itself: segment ", crossing->first, " meets segment ", crossing->second));
-  }
-  std::vector<int> corners = wall.corners;
-  corners.push_back(0);
-  corners.push_back(n - 1);
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  if (corners.front() < 0 || corners.back() > n - 1) {
-    return absl::InvalidArgumentError("a wall corner index is outside the loop");
-  }
+  SG_ASSIGN_OR_RETURN(const std::vector<int> corners, SortedCorners(wall));
   const double orientation = SignedArea2(wall.points) > 0.0 ? 1.0 : -1.0;
 
   OffsetGrid out;
@@ -197,7 +286,6 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
     for (int i = 0; i < n; ++i) std::copy(p[i].begin(), p[i].end(), out.block.Point(i, j, 0));
   };
   store(0);
-  double covered = 0.0;
   for (int k = 0; k < options.layers; ++k) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     const double h = options.first_height * std::pow(out.growth_ratio, k);
@@ -205,63 +293,15 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
     // Progress through the layers (not the distance: with geometric growth the last few
     // layers cover most of it).
     const double fraction = static_cast<double>(k + 1) / options.layers;
-    // Corners still sharp on this layer keep their normal (the bisector) and split the refit;
-    // once a corner has opened up below kCornerDegrees it is smoothed like any point (the seam
-    // at the loop's ends always splits the refit).
-    std::vector<bool> is_corner(n, false);
-    std::vector<int> pieces = {0};
-    for (int c : corners) {
-      if (c == 0 || c == n - 1) continue;
-      if (TurningDegrees(p, c) >= kCornerDegrees) {
-        is_corner[c] = true;
-        pieces.push_back(c);
-      }
-    }
-    pieces.push_back(n - 1);
-    if (TurningDegrees(p, 0) >= kCornerDegrees) is_corner[0] = is_corner[n - 1] = true;
+    const LayerCorners sharp = SharpCorners(p, corners);
     std::vector<Point2> normals = LoopNormals(p, orientation);
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
-    for (int s = 0; s < sweeps; ++s) SmoothNormals(normals, is_corner);
-    std::vector<Point2> q(n);
-    bool valid = false;
-    int where = 0;
-    for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
-      if (attempt > 0) {
-        for (int s = 0; s < 2 * attempt; ++s) SmoothNormals(normals, is_corner);
-        ++out.retries;
-      }
-      for (int i = 0; i < n; ++i) q[i] = {p[i][0] + h * normals[i][0], p[i][1] + h * normals[i][1]};
-      q.back() = q.front();
-      if (LayerValid(p, q, orientation, options.min_segment_ratio, &where)) {
-        valid = true;
-        break;
-      }
-    }
-    if (!valid) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "layer ", k + 1, " folds at wall segment ", where, " even with smoothed normals (step ",
-          h, "); use more layers, a smaller growth or a smoother wall"));
-    }
-    // Refit and fair between corners; slide towards even spacing by the part of the remaining
-    // distance this layer covers (so the unevenness left is the fraction of the distance still
-    // to go).
-    const double lambda = options.fairing * fraction;
-    const double beta = options.uniformity / (options.layers - k);
-    const double tilt = (options.wall_tilt_degrees +
-                         (options.far_tilt_degrees - options.wall_tilt_degrees) * fraction) *
-                        3.14159265358979323846 / 180.0;
-    std::vector<Point2> refitted = q;
-    for (size_t c = 0; c + 1 < pieces.size(); ++c) {
-      SG_RETURN_IF_ERROR(
-          RefitPiece(refitted, pieces[c], pieces[c + 1], lambda, beta, std::tan(tilt) * h));
-    }
-    refitted.back() = refitted.front();
-    // The refit must not spoil the layer; if it does, keep the offsets as they are.
-    if (LayerValid(p, refitted, orientation, options.min_segment_ratio, &where)) {
-      q = std::move(refitted);
-    }
+    for (int s = 0; s < sweeps; ++s) SmoothNormals(normals, sharp.is_corner);
+    SG_ASSIGN_OR_RETURN(
+        std::vector<Point2> q,
+        OffsetWithRetries(p, normals, sharp.is_corner, h, orientation, k, options, &out.retries));
+    SG_RETURN_IF_ERROR(RefitLayer(p, sharp.pieces, h, k, orientation, options, q));
     p = std::move(q);
-    covered += h;
     store(k + 1);
   }
   // Right-handed: with the layers outward, i must run clockwise for positive cell areas.

@@ -85,15 +85,13 @@ struct Geometry {
   std::vector<double> kappa;
 };
 
-absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
-                                       const std::array<std::vector<double>, 3>& params,
-                                       const Shape& s, int side, double scale,
-                                       const EdgeGroups& collapsed) {
+// The normals and curvatures of `g` at the regular points; at singular ones (X_u x X_v
+// vanishes) `known` is cleared and `lhopital` holds the l'Hopital normal direction.
+void RegularGeometry(const TensorSpline& spline, const std::array<std::vector<double>, 3>& params,
+                     const Shape& s, int side, double scale, Geometry& g, std::vector<char>& known,
+                     Layer& lhopital) {
   const std::vector<double>& u = params[0];
   const std::vector<double>& v = params[1];
-  Geometry g{Layer(s.size(), Vec::Zero()), std::vector<double>(s.size(), 0.0)};
-  std::vector<char> known(s.size(), 1);
-  Layer lhopital(s.size(), Vec::Zero());
   for (int j = 0; j < s.nj; ++j) {
     for (int i = 0; i < s.ni; ++i) {
       const int64_t q = s.At(i, j);
@@ -118,8 +116,12 @@ absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
       g.kappa[q] = h + std::sqrt(std::max(h * h - k, 0.0));
     }
   }
-  // Singular points: the l'Hopital normal oriented like the regular neighbours (or their mean
-  // normal when it vanishes too), their largest curvature; filled inwards from the regular ones.
+}
+
+// Singular points: the l'Hopital normal oriented like the regular neighbours (or their mean
+// normal when it vanishes too), their largest curvature; filled inwards from the regular ones
+// (`known`), as far as they reach.
+void FillSingular(const Shape& s, const Layer& lhopital, Geometry& g, std::vector<char>& known) {
   for (bool changed = true; changed;) {
     changed = false;
     const std::vector<char> before = known;
@@ -147,10 +149,11 @@ absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
       }
     }
   }
-  if (std::find(known.begin(), known.end(), 0) != known.end()) {
-    return absl::InvalidArgumentError(
-        "surface: the fitted surface has no regular point (X_u x X_v vanishes everywhere)");
-  }
+}
+
+// Every collapsed edge's points given one normal (the normalised mean, unless it vanishes) and
+// their largest curvature.
+void ShareOverCollapsedEdges(const EdgeGroups& collapsed, Geometry& g) {
   for (const auto& edge : collapsed) {
     Vec mean = Vec::Zero();
     double kappa = -HUGE_VAL;
@@ -163,6 +166,25 @@ absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
       g.kappa[q] = kappa;
     }
   }
+}
+
+// The Geometry of the layer `spline` at its data parameters `params`: regular points, then the
+// singular ones filled in, then the collapsed edges made to agree; INVALID_ARGUMENT when no
+// point is regular.
+absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
+                                       const std::array<std::vector<double>, 3>& params,
+                                       const Shape& s, int side, double scale,
+                                       const EdgeGroups& collapsed) {
+  Geometry g{Layer(s.size(), Vec::Zero()), std::vector<double>(s.size(), 0.0)};
+  std::vector<char> known(s.size(), 1);
+  Layer lhopital(s.size(), Vec::Zero());
+  RegularGeometry(spline, params, s, side, scale, g, known, lhopital);
+  FillSingular(s, lhopital, g, known);
+  if (std::find(known.begin(), known.end(), 0) != known.end()) {
+    return absl::InvalidArgumentError(
+        "surface: the fitted surface has no regular point (X_u x X_v vanishes everywhere)");
+  }
+  ShareOverCollapsedEdges(collapsed, g);
   return g;
 }
 
@@ -287,6 +309,182 @@ absl::StatusOr<TensorSpline> AddSplines(const TensorSpline& a, const TensorSplin
   return TensorSpline::Create(a.all_knots(), a.spatial_dim(), std::move(control));
 }
 
+// The size checks of OffsetSurface's input: a finite 3D surface block of at least 4 x 4 points.
+absl::Status CheckSurface(const StructuredBlock& surface) {
+  const Extents& n = surface.extents();
+  if (surface.spatial_dim() != 3) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("surface: spatial_dim = ", surface.spatial_dim(), "; a 3D surface is needed"));
+  }
+  if (n[2] != 1) {
+    return absl::InvalidArgumentError(absl::StrCat("surface: nk = ", n[2],
+                                                   "; a surface block has nk = 1 (", n[0], " x ",
+                                                   n[1], " x ", n[2], " given)"));
+  }
+  if (n[0] < 4 || n[1] < 4) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "surface: ", n[0], " x ", n[1], " points; at least 4 x 4 are needed for a cubic fit"));
+  }
+  return ValidateFinite(surface, "surface");
+}
+
+// The points of `surface` as a layer, and into `*scale` its size (the bounding-box diagonal).
+absl::StatusOr<Layer> SurfacePoints(const StructuredBlock& surface, const Shape& s, double* scale) {
+  Layer p(s.size());
+  Vec lo = Vec::Constant(HUGE_VAL), hi = Vec::Constant(-HUGE_VAL);
+  for (int64_t q = 0; q < s.size(); ++q) {
+    const double* x = surface.Point(q % s.ni, q / s.ni, 0);
+    p[q] = Vec(x[0], x[1], x[2]);
+    lo = lo.cwiseMin(p[q]);
+    hi = hi.cwiseMax(p[q]);
+  }
+  *scale = (hi - lo).norm();
+  if (!(*scale > 0.0)) {
+    return absl::InvalidArgumentError("surface: all points coincide; there is no surface");
+  }
+  return p;
+}
+
+// The points whose normals are not smoothed: corners (no neighbours on both sides along an
+// edge) and collapsed edges.
+std::vector<char> UnsmoothedPoints(const Shape& s, const EdgeGroups& collapsed) {
+  std::vector<char> fixed(s.size(), 0);
+  for (int64_t q : {s.At(0, 0), s.At(s.ni - 1, 0), s.At(0, s.nj - 1), s.At(s.ni - 1, s.nj - 1)}) {
+    fixed[q] = 1;
+  }
+  for (const auto& edge : collapsed) {
+    for (int64_t q : edge) fixed[q] = 1;
+  }
+  return fixed;
+}
+
+// What OffsetSurface's layers share: the options, the layer shape, the collapsed edges, the
+// points not smoothed and the surface spline's parameters.
+struct MarchContext {
+  const SurfaceOffsetOptions& options;
+  Shape s;
+  const EdgeGroups& collapsed;
+  const std::vector<char>& fixed;
+  const std::array<std::vector<double>, 3>& params;
+};
+
+// One layer's steps: wanted (h plus the height denied earlier), taken (curvature limited), and
+// the curvature that limited them.
+struct LayerSteps {
+  std::vector<double> want, step, kappa;
+};
+
+// The steps of the layer above p along `normals` (LimitingCurvature with the spline's `kappa`),
+// the points of a collapsed edge all taking the smallest of theirs.
+void LimitedSteps(const Layer& p, const Layer& normals, const std::vector<double>& kappa, double h,
+                  const std::vector<double>& deficit, const MarchContext& c, LayerSteps& steps) {
+  // Curvature limit, with the height denied earlier carried over.
+  steps.kappa = LimitingCurvature(p, normals, kappa, c.s);
+  for (int64_t i = 0; i < c.s.size(); ++i) {
+    steps.want[i] = h + deficit[i];
+    steps.step[i] = steps.kappa[i] > 0.0
+                        ? std::min(steps.want[i], c.options.max_curvature_step / steps.kappa[i])
+                        : steps.want[i];
+  }
+  for (const auto& edge : c.collapsed) {
+    double common = HUGE_VAL;
+    for (int64_t i : edge) common = std::min(common, steps.step[i]);
+    for (int64_t i : edge) steps.step[i] = common;
+  }
+}
+
+// The layer q above p, its normals smoothed two more sweeps per retry (counted in `*retries`)
+// until its cells do not fold or max_retries is spent; the check of the last attempt.
+CellCheck OffsetWithRetries(const Layer& p, Geometry& geometry, double h,
+                            const std::vector<double>& deficit, const MarchContext& c,
+                            LayerSteps& steps, Layer& q, int* retries) {
+  Layer& normals = geometry.normal;
+  CellCheck check;
+  for (int attempt = 0; attempt <= c.options.max_retries; ++attempt) {
+    if (attempt > 0) {
+      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(normals, c.s, c.fixed);
+      ++*retries;
+    }
+    LimitedSteps(p, normals, geometry.kappa, h, deficit, c, steps);
+    for (int64_t i = 0; i < c.s.size(); ++i) q[i] = p[i] + steps.step[i] * normals[i];
+    Unite(q, c.collapsed);
+    check = CheckCells(p, q, c.s, c.options.side);
+    if (!check.folded) break;
+  }
+  return check;
+}
+
+// The error for layer k + 1 (step h) folding at `check` after every retry: the curvature limit
+// is named when it held steps back.
+absl::Status FoldedLayerError(const CellCheck& check, int k, double h, const LayerSteps& steps,
+                              const SurfaceOffsetOptions& options) {
+  double held_back = 0.0;
+  for (size_t i = 0; i < steps.want.size(); ++i) {
+    held_back = std::max(held_back, steps.want[i] - steps.step[i]);
+  }
+  if (held_back > 0.0) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "distance = ", options.distance, " is not reachable on the concave side: layer ", k + 1,
+        " folds at cell (", check.i, ", ", check.j,
+        ") while the curvature limit (max_curvature_step = ", options.max_curvature_step,
+        ") holds its steps up to ", held_back, " short; lower the distance"));
+  }
+  return absl::FailedPreconditionError(absl::StrCat(
+      "layer ", k + 1, " folds at cell (", check.i, ", ", check.j,
+      ") even with smoothed normals (step ", h, ", max_retries = ", options.max_retries,
+      "); use more layers, a smaller growth or a smoother surface"));
+}
+
+// Fairs the displacement p -> q with weight `lambda` and adds its spline to `fit` (file
+// comment); q and `check` become the faired layer's unless it folds a cell, in which case the
+// interpolating displacement is added instead (counted in `*refits_dropped`).
+absl::Status FairLayer(const Layer& p, double lambda, const MarchContext& c, Layer& q,
+                       CellCheck& check, TensorSpline& fit, int* refits_dropped) {
+  const Shape& s = c.s;
+  Layer d(s.size());
+  for (int64_t i = 0; i < s.size(); ++i) d[i] = q[i] - p[i];
+  SG_ASSIGN_OR_RETURN(Displacement faired,
+                      FitDisplacement(d, s, c.params, fit.all_knots(), lambda, c.options.cancel));
+  for (int64_t i = 0; i < s.size(); ++i) faired.moved[i] += p[i];
+  Unite(faired.moved, c.collapsed);
+  if (const CellCheck faired_check = CheckCells(p, faired.moved, s, c.options.side);
+      !faired_check.folded) {
+    q = std::move(faired.moved);
+    check = faired_check;
+  } else {
+    ++*refits_dropped;
+    SG_ASSIGN_OR_RETURN(faired,
+                        FitDisplacement(d, s, c.params, fit.all_knots(), 0.0, c.options.cancel));
+  }
+  SG_ASSIGN_OR_RETURN(fit, AddSplines(fit, faired.spline));
+  return absl::OkStatus();
+}
+
+// Counts the limited steps and carries the height they held back into `deficit`; refused as
+// soon as the height held back anywhere exceeds what the last layer may miss: towards a centre
+// of curvature it is not given back, and marching on only distorts the layers there.
+absl::Status CarryDeficit(const LayerSteps& steps, int k, const MarchContext& c,
+                          std::vector<double>& deficit, SurfaceOffsetGrid& out) {
+  const SurfaceOffsetOptions& options = c.options;
+  for (int64_t i = 0; i < c.s.size(); ++i) {
+    if (steps.step[i] < steps.want[i]) ++out.limited_steps;
+  }
+  for (int64_t i = 0; i < c.s.size(); ++i) deficit[i] = steps.want[i] - steps.step[i];
+  const auto worst = std::max_element(deficit.begin(), deficit.end());
+  out.shortfall = *worst;
+  if (out.shortfall > options.max_shortfall * options.distance) {
+    const int64_t at = worst - deficit.begin();
+    return absl::FailedPreconditionError(absl::StrCat(
+        "distance = ", options.distance,
+        " cannot be reached on the concave side: at surface point (", at % c.s.ni, ", ",
+        at / c.s.ni, ") layer ", k + 1, " is ", out.shortfall,
+        " short, its steps limited to max_curvature_step = ", options.max_curvature_step,
+        " of the radius of curvature (", 1.0 / steps.kappa[at],
+        " there); allowed: max_shortfall = ", options.max_shortfall, " of the distance"));
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status SurfaceOffsetOptions::Validate() const {
@@ -323,43 +521,12 @@ absl::Status SurfaceOffsetOptions::Validate() const {
 absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
                                                 const SurfaceOffsetOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate());
-  const Extents& n = surface.extents();
-  if (surface.spatial_dim() != 3) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("surface: spatial_dim = ", surface.spatial_dim(), "; a 3D surface is needed"));
-  }
-  if (n[2] != 1) {
-    return absl::InvalidArgumentError(absl::StrCat("surface: nk = ", n[2],
-                                                   "; a surface block has nk = 1 (", n[0], " x ",
-                                                   n[1], " x ", n[2], " given)"));
-  }
-  if (n[0] < 4 || n[1] < 4) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "surface: ", n[0], " x ", n[1], " points; at least 4 x 4 are needed for a cubic fit"));
-  }
-  SG_RETURN_IF_ERROR(ValidateFinite(surface, "surface"));
-  const Shape s{n[0], n[1]};
-  Layer p(s.size());
-  Vec lo = Vec::Constant(HUGE_VAL), hi = Vec::Constant(-HUGE_VAL);
-  for (int64_t q = 0; q < s.size(); ++q) {
-    const double* x = surface.Point(q % s.ni, q / s.ni, 0);
-    p[q] = Vec(x[0], x[1], x[2]);
-    lo = lo.cwiseMin(p[q]);
-    hi = hi.cwiseMax(p[q]);
-  }
-  const double scale = (hi - lo).norm();
-  if (!(scale > 0.0)) {
-    return absl::InvalidArgumentError("surface: all points coincide; there is no surface");
-  }
+  SG_RETURN_IF_ERROR(CheckSurface(surface));
+  const Shape s{surface.extent(0), surface.extent(1)};
+  double scale = 0.0;
+  SG_ASSIGN_OR_RETURN(Layer p, SurfacePoints(surface, s, &scale));
   const EdgeGroups collapsed = CollapsedEdges(p, s, kCollapsed * scale);
-  // Not smoothed: corners (no neighbours on both sides along an edge) and collapsed edges.
-  std::vector<char> fixed(s.size(), 0);
-  for (int64_t q : {s.At(0, 0), s.At(s.ni - 1, 0), s.At(0, s.nj - 1), s.At(s.ni - 1, s.nj - 1)}) {
-    fixed[q] = 1;
-  }
-  for (const auto& edge : collapsed) {
-    for (int64_t q : edge) fixed[q] = 1;
-  }
+  const std::vector<char> fixed = UnsmoothedPoints(s, collapsed);
 
   SurfaceOffsetGrid out;
   out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
@@ -378,9 +545,11 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
   SG_ASSIGN_OR_RETURN(const FittedBlock surface_fit, FitBlock(surface, fit_options));
   const std::array<std::vector<double>, 3> params = {
       surface_fit.distribution.params(0), surface_fit.distribution.params(1), {0.0}};
+  const MarchContext c{options, s, collapsed, fixed, params};
   TensorSpline fit = surface_fit.spline;
-  std::vector<double> deficit(s.size(), 0.0), step(s.size()), want(s.size());
-  std::vector<double> last_kappa(s.size(), 0.0);
+  std::vector<double> deficit(s.size(), 0.0);
+  LayerSteps steps{std::vector<double>(s.size()), std::vector<double>(s.size()),
+                   std::vector<double>(s.size(), 0.0)};
   Layer q(s.size());
   for (int k = 0; k < options.layers; ++k) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
@@ -389,87 +558,16 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
     const double fraction = static_cast<double>(k + 1) / options.layers;
     SG_ASSIGN_OR_RETURN(Geometry geometry,
                         LayerGeometry(fit, params, s, options.side, scale, collapsed));
-    Layer& normals = geometry.normal;
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
-    for (int t = 0; t < sweeps; ++t) SmoothNormals(normals, s, fixed);
-    CellCheck check;
-    for (int attempt = 0; attempt <= options.max_retries; ++attempt) {
-      if (attempt > 0) {
-        for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(normals, s, fixed);
-        ++out.retries;
-      }
-      // Curvature limit, with the height denied earlier carried over.
-      last_kappa = LimitingCurvature(p, normals, geometry.kappa, s);
-      for (int64_t i = 0; i < s.size(); ++i) {
-        want[i] = h + deficit[i];
-        step[i] = last_kappa[i] > 0.0
-                      ? std::min(want[i], options.max_curvature_step / last_kappa[i])
-                      : want[i];
-      }
-      for (const auto& edge : collapsed) {
-        double common = HUGE_VAL;
-        for (int64_t i : edge) common = std::min(common, step[i]);
-        for (int64_t i : edge) step[i] = common;
-      }
-      for (int64_t i = 0; i < s.size(); ++i) q[i] = p[i] + step[i] * normals[i];
-      Unite(q, collapsed);
-      check = CheckCells(p, q, s, options.side);
-      if (!check.folded) break;
-    }
-    if (check.folded) {
-      double held_back = 0.0;
-      for (int64_t i = 0; i < s.size(); ++i) held_back = std::max(held_back, want[i] - step[i]);
-      if (held_back > 0.0) {
-        return absl::FailedPreconditionError(absl::StrCat(
-            "distance = ", options.distance, " is not reachable on the concave side: layer ", k + 1,
-            " folds at cell (", check.i, ", ", check.j,
-            ") while the curvature limit (max_curvature_step = ", options.max_curvature_step,
-            ") holds its steps up to ", held_back, " short; lower the distance"));
-      }
-      return absl::FailedPreconditionError(absl::StrCat(
-          "layer ", k + 1, " folds at cell (", check.i, ", ", check.j,
-          ") even with smoothed normals (step ", h, ", max_retries = ", options.max_retries,
-          "); use more layers, a smaller growth or a smoother surface"));
-    }
+    for (int t = 0; t < sweeps; ++t) SmoothNormals(geometry.normal, s, fixed);
+    CellCheck check = OffsetWithRetries(p, geometry, h, deficit, c, steps, q, &out.retries);
+    if (check.folded) return FoldedLayerError(check, k, h, steps, options);
     // Fair the displacement and add its spline to the layer's (file comment); a faired
     // displacement that folds a cell is dropped for the interpolating one.
-    Layer d(s.size());
-    for (int64_t i = 0; i < s.size(); ++i) d[i] = q[i] - p[i];
-    SG_ASSIGN_OR_RETURN(
-        Displacement faired,
-        FitDisplacement(d, s, params, fit.all_knots(), options.fairing * fraction, options.cancel));
-    for (int64_t i = 0; i < s.size(); ++i) faired.moved[i] += p[i];
-    Unite(faired.moved, collapsed);
-    if (const CellCheck faired_check = CheckCells(p, faired.moved, s, options.side);
-        !faired_check.folded) {
-      q = std::move(faired.moved);
-      check = faired_check;
-    } else {
-      ++out.refits_dropped;
-      SG_ASSIGN_OR_RETURN(faired,
-                          FitDisplacement(d, s, params, fit.all_knots(), 0.0, options.cancel));
-    }
-    SG_ASSIGN_OR_RETURN(fit, AddSplines(fit, faired.spline));
-    for (int64_t i = 0; i < s.size(); ++i) {
-      if (step[i] < want[i]) ++out.limited_steps;
-    }
+    SG_RETURN_IF_ERROR(
+        FairLayer(p, options.fairing * fraction, c, q, check, fit, &out.refits_dropped));
     out.min_scaled_jacobian = std::min(out.min_scaled_jacobian, check.min_scaled);
-    for (int64_t i = 0; i < s.size(); ++i) deficit[i] = want[i] - step[i];
-    // Refused as soon as the height held back anywhere exceeds what the last layer may miss:
-    // towards a centre of curvature it is not given back, and marching on only distorts the
-    // layers there.
-    const auto worst = std::max_element(deficit.begin(), deficit.end());
-    out.shortfall = *worst;
-    if (out.shortfall > options.max_shortfall * options.distance) {
-      const int64_t at = worst - deficit.begin();
-      return absl::FailedPreconditionError(absl::StrCat(
-          "distance = ", options.distance,
-          " cannot be reached on the concave side: at surface point (", at % s.ni, ", ", at / s.ni,
-          ") layer ", k + 1, " is ", out.shortfall,
-          " short, its steps limited to max_curvature_step = ", options.max_curvature_step,
-          " of the radius of curvature (", 1.0 / last_kappa[at],
-          " there); allowed: max_shortfall = ", options.max_shortfall, " of the distance"));
-    }
+    SG_RETURN_IF_ERROR(CarryDeficit(steps, k, c, deficit, out));
     std::swap(p, q);
     store(k + 1);
   }

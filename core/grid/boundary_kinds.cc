@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid {
 namespace {
@@ -152,20 +153,14 @@ std::vector<int> FaceDirections(const StructuredBlock& block, const Face& face) 
   return directions;
 }
 
-// Second pass of ClassifyBoundaries for planar and volume blocks: along every grid line of a face
-// classified outer by clustering, a run of unmatched points is a wall when a solid lies behind
-// the face at both ends of the run (WallSegments::SolidBehind), as at the blunt base of a nozzle
-// lip or a thick trailing edge: the run then joins two walls of one solid across the side of the
-// face away from the flow. A point is wall when a run along either direction of the face says
-// so (on the base of a 3D lip the lines across the base end on the lip's walls, those along the
-// span on the side planes); the face is a wall when all its unmatched points are. The clustering
-// test misses such bases when the grid is not clustered towards them. Overridden faces are left
-// as given. Cost: O(wall points log wall points) to sort the segments, O(log) per run end, and
-// O(points) per outer face.
-void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindOverride> overrides,
-                           const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
-  constexpr uint8_t kWallBit = static_cast<uint8_t>(BoundaryKind::kWall);
-  constexpr uint8_t kOuterBit = static_cast<uint8_t>(BoundaryKind::kOuter);
+// The kind bits of wall and outer points.
+constexpr uint8_t kWallBit = static_cast<uint8_t>(BoundaryKind::kWall);
+constexpr uint8_t kOuterBit = static_cast<uint8_t>(BoundaryKind::kOuter);
+
+// The wall segments along the wall faces of the planar and volume blocks, between neighbouring
+// points that both carry the wall kind; points coincide within 1e-9 of the diagonal of those
+// blocks' bounding box.
+WallSegments CollectWallSegments(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   int dim = 0;
   for (const StructuredBlock& block : grid.blocks) {
@@ -200,6 +195,134 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
       }
     }
   }
+  return walls;
+}
+
+// The wall-base pass over one outer face `faces[f]` of block b (WallBasesBetweenWalls).
+class FaceBaseScan {
+ public:
+  FaceBaseScan(const StructuredBlock& block, int b, const std::vector<Face>& faces, size_t f,
+               const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds)
+      : block_(block),
+        b_(b),
+        faces_(faces),
+        f_(f),
+        face_(faces[f]),
+        matched_(matched),
+        kinds_(kinds),
+        directions_(FaceDirections(block, faces[f])) {}
+
+  // Finds the bases on the face, makes them wall, and the face wall when all its unmatched
+  // points are on a base.
+  void Run(const WallSegments& walls) {
+    const std::vector<uint8_t> base = FindBases(walls);
+    bool any_unmatched = false, all_base = true;
+    ForEachFacePoint(block_, face_, [&](const Extents& x) {
+      if (Unmatched(x)) any_unmatched = true, all_base = all_base && base[Slot(x)];
+      if (!base[Slot(x)]) return;
+      uint8_t& k = kinds_.point_kinds[b_][Index(x)];
+      // The base and its contact points become wall: the outer kind they carry is this
+      // face's unless another outer face of the block passes through them.
+      if (!OuterElsewhere(x)) k &= static_cast<uint8_t>(~kOuterBit);
+      k |= kWallBit;
+    });
+    if (any_unmatched && all_base) kinds_.face_kinds[b_][f_] = BoundaryKind::kWall;
+  }
+
+ private:
+  // Point index of x in the block.
+  int64_t Index(const Extents& x) const { return block_.Index(x[0], x[1], x[2]); }
+  // Whether x has no match across this face.
+  bool Unmatched(const Extents& x) const { return !(matched_[b_][Index(x)] & FaceBit(face_)); }
+  // The neighbour of face point x into the block.
+  const double* Inward(Extents x) const {
+    x[face_.normal] += face_.upper ? -1 : 1;
+    return At(block_, x);
+  }
+  // Whether another face of the block through x gives x the outer kind (an unmatched point
+  // of an outer face): that kind stays when x becomes wall.
+  bool OuterElsewhere(const Extents& x) const {
+    for (int e : directions_) {
+      for (const bool upper : {false, true}) {
+        if (x[e] != (upper ? block_.extent(e) - 1 : 0)) continue;
+        const Face other{b_, e, upper};
+        const size_t g =
+            static_cast<size_t>(std::find(faces_.begin(), faces_.end(), other) - faces_.begin());
+        if (g < faces_.size() && kinds_.face_kinds[b_][g] == BoundaryKind::kOuter &&
+            !(matched_[b_][Index(x)] & FaceBit(other))) {
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+  // The place of face point x on the face (the directions' indices).
+  int64_t Slot(const Extents& x) const {
+    int64_t s = 0;
+    for (auto it = directions_.rbegin(); it != directions_.rend(); ++it) {
+      s = s * block_.extent(*it) + x[*it];
+    }
+    return s;
+  }
+
+  // Per slot, whether the point lies on a base: a run of unmatched points along a line of
+  // either direction with a solid behind the face at both its contact points.
+  std::vector<uint8_t> FindBases(const WallSegments& walls) const {
+    int64_t face_points = 1;
+    for (int e : directions_) face_points *= block_.extent(e);
+    std::vector<uint8_t> base(face_points, 0);
+    for (int e : directions_) {
+      const int n = block_.extent(e);
+      ForEachFacePoint(block_, face_, [&](const Extents& start) {
+        if (start[e] != 0) return;  // one line per start point
+        auto point = [&](int r) {
+          Extents x = start;
+          x[e] = r;
+          return x;
+        };
+        for (int r0 = 0; r0 < n;) {
+          if (!Unmatched(point(r0))) {
+            ++r0;
+            continue;
+          }
+          int r1 = r0;
+          while (r1 + 1 < n && Unmatched(point(r1 + 1))) ++r1;
+          // The contact points: the matched neighbours of the run, or its own ends at edges.
+          const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
+          if (walls.SolidBehind(At(block_, point(c0)), Inward(point(c0))) &&
+              walls.SolidBehind(At(block_, point(c1)), Inward(point(c1)))) {
+            for (int r = c0; r <= c1; ++r) base[Slot(point(r))] = 1;
+          }
+          r0 = r1 + 1;
+        }
+      });
+    }
+    return base;
+  }
+
+  const StructuredBlock& block_;
+  const int b_;
+  const std::vector<Face>& faces_;
+  const size_t f_;
+  const Face& face_;
+  const std::vector<std::vector<uint8_t>>& matched_;
+  BoundaryKinds& kinds_;
+  const std::vector<int> directions_;
+};
+
+// Second pass of ClassifyBoundaries for planar and volume blocks: along every grid line of a face
+// classified outer by clustering, a run of unmatched points is a wall when a solid lies behind
+// the face at both ends of the run (WallSegments::SolidBehind), as at the blunt base of a nozzle
+// lip or a thick trailing edge: the run then joins two walls of one solid across the side of the
+// face away from the flow. A point is wall when a run along either direction of the face says
+// so (on the base of a 3D lip the lines across the base end on the lip's walls, those along the
+// span on the side planes); the face is a wall when all its unmatched points are. The clustering
+// test misses such bases when the grid is not clustered towards them. Overridden faces are left
+// as given. Cost: O(wall points log wall points) to sort the segments, O(log) per run end, and
+// O(points) per outer face.
+void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindOverride> overrides,
+                           const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
+  WallSegments walls = CollectWallSegments(grid, kinds);
   if (walls.empty()) return;
   walls.Sort();
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
@@ -212,101 +335,14 @@ void WallBasesBetweenWalls(const MultiBlockGrid& grid, std::span<const FaceKindO
           std::any_of(overrides.begin(), overrides.end(),
                       [&](const FaceKindOverride& o) { return o.face == face; });
       if (overridden || kinds.face_kinds[b][f] != BoundaryKind::kOuter) continue;
-      const int d = face.normal;
-      const std::vector<int> directions = FaceDirections(block, face);
-      auto index = [&](const Extents& x) { return block.Index(x[0], x[1], x[2]); };
-      auto unmatched = [&](const Extents& x) { return !(matched[b][index(x)] & FaceBit(face)); };
-      auto inward = [&](Extents x) {
-        x[d] += face.upper ? -1 : 1;
-        return At(block, x);
-      };
-      // Whether another face of the block through x gives x the outer kind (an unmatched point
-      // of an outer face): that kind stays when x becomes wall.
-      auto outer_elsewhere = [&](const Extents& x) {
-        for (int e : directions) {
-          for (const bool upper : {false, true}) {
-            if (x[e] != (upper ? block.extent(e) - 1 : 0)) continue;
-            const Face other{b, e, upper};
-            const size_t g = static_cast<size_t>(
-                std::find(faces.begin(), faces.end(), other) - faces.begin());
-            if (g < faces.size() && kinds.face_kinds[b][g] == BoundaryKind::kOuter &&
-                !(matched[b][index(x)] & FaceBit(other))) {
-              return true;
-            }
-          }
-        }
-        return false;
-      };
-      // Points found on a base, by their place on the face (the directions' indices).
-      auto slot = [&](const Extents& x) {
-        int64_t s = 0;
-        for (auto it = directions.rbegin(); it != directions.rend(); ++it) {
-          s = s * block.extent(*it) + x[*it];
-        }
-        return s;
-      };
-      int64_t face_points = 1;
-      for (int e : directions) face_points *= block.extent(e);
-      std::vector<uint8_t> base(face_points, 0);
-      for (int e : directions) {
-        const int n = block.extent(e);
-        ForEachFacePoint(block, face, [&](const Extents& start) {
-          if (start[e] != 0) return;  // one line per start point
-          auto point = [&](int r) {
-            Extents x = start;
-            x[e] = r;
-            return x;
-          };
-          for (int r0 = 0; r0 < n;) {
-            if (!unmatched(point(r0))) {
-              ++r0;
-              continue;
-            }
-            int r1 = r0;
-            while (r1 + 1 < n && unmatched(point(r1 + 1))) ++r1;
-            // The contact points: the matched neighbours of the run, or its own ends at edges.
-            const int c0 = r0 > 0 ? r0 - 1 : r0, c1 = r1 + 1 < n ? r1 + 1 : r1;
-            if (walls.SolidBehind(At(block, point(c0)), inward(point(c0))) &&
-                walls.SolidBehind(At(block, point(c1)), inward(point(c1)))) {
-              for (int r = c0; r <= c1; ++r) base[slot(point(r))] = 1;
-            }
-            r0 = r1 + 1;
-          }
-        });
-      }
-      bool any_unmatched = false, all_base = true;
-      ForEachFacePoint(block, face, [&](const Extents& x) {
-        if (unmatched(x)) any_unmatched = true, all_base = all_base && base[slot(x)];
-        if (!base[slot(x)]) return;
-        uint8_t& k = kinds.point_kinds[b][index(x)];
-        // The base and its contact points become wall: the outer kind they carry is this
-        // face's unless another outer face of the block passes through them.
-        if (!outer_elsewhere(x)) k &= static_cast<uint8_t>(~kOuterBit);
-        k |= kWallBit;
-      });
-      if (any_unmatched && all_base) kinds.face_kinds[b][f] = BoundaryKind::kWall;
+      FaceBaseScan(block, b, faces, f, matched, kinds).Run(walls);
     }
   }
 }
 
-}  // namespace
-
-std::string_view BoundaryKindName(BoundaryKind kind) {
-  switch (kind) {
-    case BoundaryKind::kWall:
-      return "wall";
-    case BoundaryKind::kInterface:
-      return "interface";
-    case BoundaryKind::kOuter:
-      return "outer";
-  }
-  return "unknown";
-}
-
-absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
-                                                 const Connectivity& connectivity,
-                                                 std::span<const FaceKindOverride> overrides,
-                                                 const BoundaryKindOptions& options) {
+// INVALID_ARGUMENT for an override naming a face that `grid` does not have.
+absl::Status CheckOverrides(const MultiBlockGrid& grid,
+                            std::span<const FaceKindOverride> overrides) {
   const int num_blocks = static_cast<int>(grid.blocks.size());
   for (const FaceKindOverride& o : overrides) {
     if (o.face.block < 0 || o.face.block >= num_blocks || o.face.normal < 0 || o.face.normal > 2 ||
@@ -316,13 +352,16 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
           o.face.normal >= 0 && o.face.normal <= 2 ? FaceName(o.face) : "?", " does not exist"));
     }
   }
-  BoundaryKinds kinds;
-  kinds.point_kinds.resize(num_blocks);
-  kinds.face_kinds.resize(num_blocks);
-  // Matched points first: they are interface whatever their face is. `matched` holds, per
-  // point, a bit per face (FaceBit) on which a match covers it: a point at the end of a match
-  // (a corner, an edge of a volume face) also lies on the neighbouring face, whose kind it
-  // still carries.
+  return absl::OkStatus();
+}
+
+// Marks the matched points interface in `kinds` and returns, per point, a bit per face
+// (FaceBit) on which a match covers it: a point at the end of a match (a corner, an edge of a
+// volume face) also lies on the neighbouring face, whose kind it still carries.
+std::vector<std::vector<uint8_t>> MarkMatched(const MultiBlockGrid& grid,
+                                              const Connectivity& connectivity,
+                                              BoundaryKinds& kinds) {
+  const int num_blocks = static_cast<int>(grid.blocks.size());
   std::vector<std::vector<uint8_t>> matched(num_blocks);
   for (int b = 0; b < num_blocks; ++b) {
     kinds.point_kinds[b].assign(grid.blocks[b].num_points(), 0);
@@ -344,36 +383,71 @@ absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
     mark(m.a);
     mark(m.b);
   }
-  for (int b = 0; b < num_blocks; ++b) {
-    const StructuredBlock& block = grid.blocks[b];
-    const bool surface = block.spatial_dim() == 3 && ActiveDirections(block.extents()) == 2;
-    if (surface) {
-      for (uint8_t& k : kinds.point_kinds[b]) k |= static_cast<uint8_t>(BoundaryKind::kWall);
+  return matched;
+}
+
+// The kind of every face of block b (surface blocks: wall; else by clustering, or as
+// overridden), given to the face's points that are unmatched on it or border one.
+void ClassifyFaces(const StructuredBlock& block, int b, std::span<const FaceKindOverride> overrides,
+                   const BoundaryKindOptions& options,
+                   const std::vector<std::vector<uint8_t>>& matched, BoundaryKinds& kinds) {
+  const bool surface = block.spatial_dim() == 3 && ActiveDirections(block.extents()) == 2;
+  if (surface) {
+    for (uint8_t& k : kinds.point_kinds[b]) k |= static_cast<uint8_t>(BoundaryKind::kWall);
+  }
+  for (const Face& face : BlockFaces(block, b)) {
+    BoundaryKind kind = surface ? BoundaryKind::kWall : GeometricKind(block, face, options);
+    for (const FaceKindOverride& o : overrides) {
+      if (o.face == face) kind = o.kind;
     }
-    for (const Face& face : BlockFaces(block, b)) {
-      BoundaryKind kind = surface ? BoundaryKind::kWall : GeometricKind(block, face, options);
-      for (const FaceKindOverride& o : overrides) {
-        if (o.face == face) kind = o.kind;
-      }
-      kinds.face_kinds[b].push_back(kind);
-      // A point matched on this face still carries the face's kind where it borders an unmatched
-      // point of the face: the end of a C-grid's wake cut is also the airfoil's trailing edge.
-      auto unmatched = [&](const Extents& x) {
-        return !(matched[b][block.Index(x[0], x[1], x[2])] & FaceBit(face));
-      };
-      ForEachFacePoint(block, face, [&](const Extents& x) {
-        bool own = unmatched(x);
-        for (int d = 0; d < 3 && !own; ++d) {
-          if (d == face.normal) continue;
-          for (int step : {-1, 1}) {
-            Extents y = x;
-            y[d] += step;
-            if (y[d] >= 0 && y[d] < block.extent(d) && unmatched(y)) own = true;
-          }
+    kinds.face_kinds[b].push_back(kind);
+    // A point matched on this face still carries the face's kind where it borders an unmatched
+    // point of the face: the end of a C-grid's wake cut is also the airfoil's trailing edge.
+    auto unmatched = [&](const Extents& x) {
+      return !(matched[b][block.Index(x[0], x[1], x[2])] & FaceBit(face));
+    };
+    ForEachFacePoint(block, face, [&](const Extents& x) {
+      bool own = unmatched(x);
+      for (int d = 0; d < 3 && !own; ++d) {
+        if (d == face.normal) continue;
+        for (int step : {-1, 1}) {
+          Extents y = x;
+          y[d] += step;
+          if (y[d] >= 0 && y[d] < block.extent(d) && unmatched(y)) own = true;
         }
-        if (own) kinds.point_kinds[b][block.Index(x[0], x[1], x[2])] |= static_cast<uint8_t>(kind);
-      });
-    }
+      }
+      if (own) kinds.point_kinds[b][block.Index(x[0], x[1], x[2])] |= static_cast<uint8_t>(kind);
+    });
+  }
+}
+
+}  // namespace
+
+std::string_view BoundaryKindName(BoundaryKind kind) {
+  switch (kind) {
+    case BoundaryKind::kWall:
+      return "wall";
+    case BoundaryKind::kInterface:
+      return "interface";
+    case BoundaryKind::kOuter:
+      return "outer";
+  }
+  return "unknown";
+}
+
+absl::StatusOr<BoundaryKinds> ClassifyBoundaries(const MultiBlockGrid& grid,
+                                                 const Connectivity& connectivity,
+                                                 std::span<const FaceKindOverride> overrides,
+                                                 const BoundaryKindOptions& options) {
+  SG_RETURN_IF_ERROR(CheckOverrides(grid, overrides));
+  const int num_blocks = static_cast<int>(grid.blocks.size());
+  BoundaryKinds kinds;
+  kinds.point_kinds.resize(num_blocks);
+  kinds.face_kinds.resize(num_blocks);
+  // Matched points first: they are interface whatever their face is.
+  const std::vector<std::vector<uint8_t>> matched = MarkMatched(grid, connectivity, kinds);
+  for (int b = 0; b < num_blocks; ++b) {
+    ClassifyFaces(grid.blocks[b], b, overrides, options, matched, kinds);
   }
   WallBasesBetweenWalls(grid, overrides, matched, kinds);
   return kinds;

@@ -86,61 +86,49 @@ std::string FormatPoint(const Point3& p, int dim) {
                   : absl::StrFormat("(%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
 }
 
-}  // namespace
-
-std::string_view ReferenceLengthSourceName(ReferenceLengthSource source) {
-  switch (source) {
-    case ReferenceLengthSource::kGiven:
-      return "given";
-    case ReferenceLengthSource::kWall:
-      return "wall";
-    case ReferenceLengthSource::kBoundingBox:
-      return "bounding box";
-  }
-  return "unknown";
-}
-
-ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
-  // Every wall point, with its block, and the bounding box of the grid.
+// Every wall point of a grid, with its block, and the bounding box of the grid.
+struct WallPoints {
   std::vector<Point3> points;
   std::vector<int> point_block;
   Point3 lo, hi;
-  lo.fill(std::numeric_limits<double>::infinity());
-  hi.fill(-std::numeric_limits<double>::infinity());
   int dim = 2;
   // Per block, the wall id of each point (-1: not a wall point).
-  std::vector<std::vector<int>> ids(grid.blocks.size());
+  std::vector<std::vector<int>> ids;
+};
+
+// The wall points of `grid` by `kinds` (blocks or points without kinds have none), and its
+// bounding box.
+WallPoints CollectWallPoints(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
+  WallPoints w;
+  w.lo.fill(std::numeric_limits<double>::infinity());
+  w.hi.fill(-std::numeric_limits<double>::infinity());
+  w.ids.resize(grid.blocks.size());
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     const StructuredBlock& block = grid.blocks[b];
-    dim = std::max(dim, block.spatial_dim());
+    w.dim = std::max(w.dim, block.spatial_dim());
     const std::vector<uint8_t>* mask =
         b < kinds.point_kinds.size() ? &kinds.point_kinds[b] : nullptr;
-    ids[b].assign(block.num_points(), -1);
+    w.ids[b].assign(block.num_points(), -1);
     for (int64_t p = 0; p < block.num_points(); ++p) {
       Point3 x{0.0, 0.0, 0.0};
       for (int c = 0; c < block.spatial_dim(); ++c)
         x[c] = block.coords()[block.spatial_dim() * p + c];
-      for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], x[c]), hi[c] = std::max(hi[c], x[c]);
+      for (int c = 0; c < 3; ++c) {
+        w.lo[c] = std::min(w.lo[c], x[c]), w.hi[c] = std::max(w.hi[c], x[c]);
+      }
       if (mask == nullptr || static_cast<size_t>(p) >= mask->size()) continue;
       if (((*mask)[p] & static_cast<uint8_t>(BoundaryKind::kWall)) == 0) continue;
-      ids[b][p] = static_cast<int>(points.size());
-      points.push_back(x);
-      point_block.push_back(static_cast<int>(b));
+      w.ids[b][p] = static_cast<int>(w.points.size());
+      w.points.push_back(x);
+      w.point_block.push_back(static_cast<int>(b));
     }
   }
-  const double diagonal =
-      points.empty() && grid.blocks.empty() ? 0.0 : std::sqrt(Distance2(lo, hi));
-  if (points.empty()) {
-    ReferenceLength r;
-    r.length = diagonal;
-    r.source = ReferenceLengthSource::kBoundingBox;
-    r.description =
-        absl::StrFormat("no wall point: the diagonal of the grid's bounding box, from %s to %s",
-                        FormatPoint(lo, dim), FormatPoint(hi, dim));
-    return r;
-  }
-  UnionFind walls(points.size());
-  // Neighbours along the index directions of a block.
+  return w;
+}
+
+// Joins the wall points that are neighbours along the index directions of a block.
+void JoinIndexNeighbours(const MultiBlockGrid& grid, const std::vector<std::vector<int>>& ids,
+                         UnionFind& walls) {
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     const StructuredBlock& block = grid.blocks[b];
     const Extents n = block.extents();
@@ -162,9 +150,13 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
       }
     }
   }
-  // Coinciding points (across blocks, or across a cut of one block): a hash grid of cells of
-  // the coincidence distance, each point compared with the points of its 27 neighbour cells.
-  const double eps = std::max(kCoincidence * diagonal, std::numeric_limits<double>::min());
+}
+
+// Joins the points within `eps` of each other (across blocks, or across a cut of one block): a
+// hash grid of cells of the coincidence distance from `lo`, each point compared with the points
+// of its 27 neighbour cells.
+void JoinCoinciding(const std::vector<Point3>& points, const Point3& lo, double eps,
+                    UnionFind& walls) {
   std::map<std::array<int64_t, 3>, std::vector<int>> cells;
   auto cell_of = [&](const Point3& x) {
     std::array<int64_t, 3> key;
@@ -181,19 +173,24 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
           const auto it = cells.find({key[0] + dx, key[1] + dy, key[2] + dz});
           if (it == cells.end()) continue;
           for (int q : it->second) {
-            if (Distance2(points[p], points[q]) <= eps * eps) walls.Join(static_cast<int64_t>(p), q);
+            if (Distance2(points[p], points[q]) <= eps * eps)
+              walls.Join(static_cast<int64_t>(p), q);
           }
         }
       }
     }
   }
-  // The walls, their diameters, the largest.
+}
+
+// The walls (the sets of `joined`), their diameters, the largest; the bounding-box `diagonal`
+// when every wall is a single point.
+ReferenceLength LargestWall(const WallPoints& w, UnionFind& joined, double diagonal) {
   std::map<int, std::vector<Point3>> members;
   std::map<int, int> first_block;
-  for (size_t p = 0; p < points.size(); ++p) {
-    const int root = static_cast<int>(walls.Find(static_cast<int64_t>(p)));
-    members[root].push_back(points[p]);
-    first_block.try_emplace(root, point_block[p]);
+  for (size_t p = 0; p < w.points.size(); ++p) {
+    const int root = static_cast<int>(joined.Find(static_cast<int64_t>(p)));
+    members[root].push_back(w.points[p]);
+    first_block.try_emplace(root, w.point_block[p]);
   }
   // In the order of the walls' first points, so that ties resolve the same way every time.
   std::vector<int> roots;
@@ -211,8 +208,8 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
   const size_t count = members[best_root].size();
   r.description = absl::StrFormat(
       "the largest extent of %d wall%s: %d points from block %d, from %s to %s%s", roots.size(),
-      roots.size() == 1 ? "" : "s", count, first_block[best_root], FormatPoint(best.from, dim),
-      FormatPoint(best.to, dim),
+      roots.size() == 1 ? "" : "s", count, first_block[best_root], FormatPoint(best.from, w.dim),
+      FormatPoint(best.to, w.dim),
       best.exact ? "" : " (farthest-point estimate: a lower bound of the diameter)");
   if (!(r.length > 0.0)) {
     // Every wall a single point: the bounding box.
@@ -221,6 +218,41 @@ ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const Boundary
     r.description = "the walls have no extent: the diagonal of the grid's bounding box";
   }
   return r;
+}
+
+}  // namespace
+
+std::string_view ReferenceLengthSourceName(ReferenceLengthSource source) {
+  switch (source) {
+    case ReferenceLengthSource::kGiven:
+      return "given";
+    case ReferenceLengthSource::kWall:
+      return "wall";
+    case ReferenceLengthSource::kBoundingBox:
+      return "bounding box";
+  }
+  return "unknown";
+}
+
+ReferenceLength DetectReferenceLength(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
+  const WallPoints w = CollectWallPoints(grid, kinds);
+  const double diagonal =
+      w.points.empty() && grid.blocks.empty() ? 0.0 : std::sqrt(Distance2(w.lo, w.hi));
+  if (w.points.empty()) {
+    ReferenceLength r;
+    r.length = diagonal;
+    r.source = ReferenceLengthSource::kBoundingBox;
+    r.description =
+        absl::StrFormat("no wall point: the diagonal of the grid's bounding box, from %s to %s",
+                        FormatPoint(w.lo, w.dim), FormatPoint(w.hi, w.dim));
+    return r;
+  }
+  // The walls: wall points joined when they are neighbours in a block or coincide.
+  UnionFind walls(w.points.size());
+  JoinIndexNeighbours(grid, w.ids, walls);
+  const double eps = std::max(kCoincidence * diagonal, std::numeric_limits<double>::min());
+  JoinCoinciding(w.points, w.lo, eps, walls);
+  return LargestWall(w, walls, diagonal);
 }
 
 BoundaryTolerances ScaleTolerances(const BoundaryTolerances& tolerances, uint8_t relative_kinds,

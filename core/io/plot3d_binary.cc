@@ -87,46 +87,67 @@ std::string BlockAt(int64_t block, const Record& record) {
                       ")");
 }
 
-// Parses `bytes` as records in byte order `big_endian` (see plot3d.h).
-absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::string_view source,
-                                                  bool big_endian, const Plot3dReadOptions& options,
-                                                  Plot3dFormat* detected) {
-  const std::string prefix = ErrorPrefix(source);
-  const ByteOrder order(big_endian);
-  RecordReader reader(bytes, order);
-  auto missing = [&](const std::string& what) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        prefix, what, ": ",
-        reader.error().empty() ? absl::StrCat("the file ends after ", reader.records_read(),
-                                              " records (byte offset ", reader.position(), ")")
-                               : reader.error()));
-  };
-  Record first;
-  if (!reader.Next(&first)) return missing("the first record");
-  const bool has_block_count = first.length == 4;
+// The error for a record that is missing or malformed where `what` was expected: the reader's
+// error, or where the file ended.
+absl::Status MissingRecord(const std::string& prefix, const std::string& what,
+                           const RecordReader& reader) {
+  return absl::InvalidArgumentError(absl::StrCat(
+      prefix, what, ": ",
+      reader.error().empty() ? absl::StrCat("the file ends after ", reader.records_read(),
+                                            " records (byte offset ", reader.position(), ")")
+                             : reader.error()));
+}
+
+// What the records before the blocks say: the block count and the dimensions record.
+struct Header {
+  bool has_block_count = false;
   int64_t num_blocks = 1;
-  Record dims = first;
-  if (has_block_count) {
-    num_blocks = order.Int32(bytes.data() + first.payload());
+  Record dims;  // the dimensions record
+  int dim = 0;  // 2 or 3
+};
+
+// Reads the optional block-count record and the dimensions record, and the spatial dimension
+// their lengths imply.
+absl::StatusOr<Header> ReadHeader(std::string_view bytes, const ByteOrder& order,
+                                  const std::string& prefix, RecordReader& reader) {
+  Header header;
+  Record first;
+  if (!reader.Next(&first)) return MissingRecord(prefix, "the first record", reader);
+  header.has_block_count = first.length == 4;
+  header.dims = first;
+  const int64_t num_blocks =
+      header.has_block_count ? int64_t{order.Int32(bytes.data() + first.payload())} : int64_t{1};
+  header.num_blocks = num_blocks;
+  if (header.has_block_count) {
     if (num_blocks < 1 || num_blocks > kMaxBlocks) {
       return absl::InvalidArgumentError(absl::StrCat(prefix, "the block count ", num_blocks,
                                                      " (record 0 at byte offset 0) must be from 1 "
                                                      "to ",
                                                      kMaxBlocks));
     }
-    if (!reader.Next(&dims)) return missing("the dimensions record");
+    if (!reader.Next(&header.dims)) return MissingRecord(prefix, "the dimensions record", reader);
   }
-  int dim = 0;
-  if (dims.length == 12 * num_blocks) dim = 3;
-  if (dims.length == 8 * num_blocks) dim = 2;
-  if (dim == 0) {
+  const Record& dims = header.dims;
+  if (dims.length == 12 * num_blocks) header.dim = 3;
+  if (dims.length == 8 * num_blocks) header.dim = 2;
+  if (header.dim == 0) {
     return absl::InvalidArgumentError(
         absl::StrCat(prefix, "the dimensions record (record ", dims.index, " at byte offset ",
                      dims.offset, ") holds ", dims.length, " bytes; ", num_blocks, " blocks need ",
                      8 * num_blocks, " (2D) or ", 12 * num_blocks, " (3D)"));
   }
-  std::vector<Extents> extents(static_cast<size_t>(num_blocks), Extents{1, 1, 1});
-  std::vector<int64_t> points(static_cast<size_t>(num_blocks));
+  return header;
+}
+
+// The extents and point counts of every block, from the dimensions record.
+absl::Status ReadExtents(std::string_view bytes, const ByteOrder& order, const Header& header,
+                         const std::string& prefix, std::vector<Extents>& extents,
+                         std::vector<int64_t>& points) {
+  const int64_t num_blocks = header.num_blocks;
+  const int dim = header.dim;
+  const Record& dims = header.dims;
+  extents.assign(static_cast<size_t>(num_blocks), Extents{1, 1, 1});
+  points.assign(static_cast<size_t>(num_blocks), 0);
   for (int64_t b = 0; b < num_blocks; ++b) {
     for (int d = 0; d < dim; ++d) {
       const int64_t at = dims.payload() + 4 * (b * dim + d);
@@ -144,63 +165,84 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
           absl::StrCat(prefix, "block ", b, ": ", TooManyPointsMessage(extents[b])));
     }
   }
-  // Validate every block record against the file before allocating anything. The first block
-  // record fixes precision, iblank and the layout: a record of one k-plane (nk > 1) means the
-  // planes layout, one record per plane.
-  BinaryValues values{order, /*bytes_per_real=*/0, /*has_iblank=*/false};  // 0: no match yet
+  return absl::OkStatus();
+}
+
+// Precision, iblank and layout of the block records.
+struct BlockEncoding {
+  BinaryValues values;
   Plot3dLayout layout = Plot3dLayout::kWhole;
-  {
-    Record first_block;
-    RecordReader probe = reader;
-    if (!probe.Next(&first_block)) {
-      const std::string what =
-          absl::StrCat("block 0 of ", num_blocks, " (record ", reader.records_read(), ")");
-      reader = probe;  // its position and error describe the failure
-      return missing(what);
+};
+
+// The encoding the first block record fixes, probed from a copy of `reader` (which stays where
+// it is): precision, iblank and the layout (a record of one k-plane, nk > 1, means the planes
+// layout, one record per plane).
+absl::StatusOr<BlockEncoding> DetectBlockEncoding(const RecordReader& reader,
+                                                  const ByteOrder& order, const Header& header,
+                                                  const std::vector<Extents>& extents,
+                                                  const std::vector<int64_t>& points,
+                                                  const std::string& prefix) {
+  const int64_t num_blocks = header.num_blocks;
+  const int dim = header.dim;
+  BlockEncoding found{BinaryValues{order, /*bytes_per_real=*/0, /*has_iblank=*/false},
+                      Plot3dLayout::kWhole};  // 0: no match yet
+  BinaryValues& values = found.values;
+  Record first_block;
+  RecordReader probe = reader;
+  if (!probe.Next(&first_block)) {
+    const std::string what =
+        absl::StrCat("block 0 of ", num_blocks, " (record ", reader.records_read(), ")");
+    return MissingRecord(prefix, what, probe);  // its position and error describe the failure
+  }
+  // Whole single precision and planes double precision agree in length for nk = 2: the
+  // number of records that follow decides (one per block, or one per k-plane).
+  int64_t records_left = 1;
+  for (Record skip; probe.Next(&skip);) ++records_left;
+  const int64_t plane = int64_t{extents[0][0]} * extents[0][1];
+  bool count_matches = false;
+  for (Plot3dLayout candidate : {Plot3dLayout::kWhole, Plot3dLayout::kPlanes}) {
+    if (candidate == Plot3dLayout::kPlanes && (dim == 2 || extents[0][2] == 1)) continue;
+    const int64_t n = candidate == Plot3dLayout::kWhole ? points[0] : plane;
+    int64_t slabs = 0;
+    for (int64_t b = 0; b < num_blocks; ++b) {
+      slabs += candidate == Plot3dLayout::kWhole ? 1 : extents[b][2];
     }
-    // Whole single precision and planes double precision agree in length for nk = 2: the
-    // number of records that follow decides (one per block, or one per k-plane).
-    int64_t records_left = 1;
-    for (Record skip; probe.Next(&skip);) ++records_left;
-    const int64_t plane = int64_t{extents[0][0]} * extents[0][1];
-    bool count_matches = false;
-    for (Plot3dLayout candidate : {Plot3dLayout::kWhole, Plot3dLayout::kPlanes}) {
-      if (candidate == Plot3dLayout::kPlanes && (dim == 2 || extents[0][2] == 1)) continue;
-      const int64_t n = candidate == Plot3dLayout::kWhole ? points[0] : plane;
-      int64_t slabs = 0;
-      for (int64_t b = 0; b < num_blocks; ++b) {
-        slabs += candidate == Plot3dLayout::kWhole ? 1 : extents[b][2];
-      }
-      for (int real : {4, 8}) {
-        for (bool iblank : {false, true}) {
-          const BinaryValues v{order, real, iblank};
-          if (first_block.length != v.SlabBytes(n, dim)) continue;
-          // The first match, or a later one whose record count fits where the first's did not.
-          if (values.bytes_per_real == 0 || (!count_matches && slabs == records_left)) {
-            values = v;
-            layout = candidate;
-            count_matches = slabs == records_left;
-          }
+    for (int real : {4, 8}) {
+      for (bool iblank : {false, true}) {
+        const BinaryValues v{order, real, iblank};
+        if (first_block.length != v.SlabBytes(n, dim)) continue;
+        // The first match, or a later one whose record count fits where the first's did not.
+        if (values.bytes_per_real == 0 || (!count_matches && slabs == records_left)) {
+          values = v;
+          found.layout = candidate;
+          count_matches = slabs == records_left;
         }
       }
     }
-    if (values.bytes_per_real == 0) {
-      const int64_t p = points[0];
-      return absl::InvalidArgumentError(absl::StrCat(
-          prefix, BlockAt(0, first_block), " holds ", first_block.length, " bytes; its ", p,
-          " points need ", p * dim * 4, " (single precision), ", p * dim * 8, " (double), ",
-          p * (dim * 4 + 4), " (single + iblank) or ", p * (dim * 8 + 4), " (double + iblank)",
-          dim == 3 && extents[0][2] > 1
-              ? absl::StrCat(", or a record per k-plane of ", plane, " points (planes layout)")
-              : std::string()));
-    }
   }
-  if (options.layout.has_value() && *options.layout != layout && dim == 3 && extents[0][2] > 1) {
+  if (values.bytes_per_real == 0) {
+    const int64_t p = points[0];
     return absl::InvalidArgumentError(absl::StrCat(
-        prefix, "the records hold the ", LayoutName(layout), " layout (block 0 record of ",
-        values.SlabBytes(SlabPoints(extents[0], layout), dim), " bytes), but the ",
-        LayoutName(*options.layout), " layout was requested"));
+        prefix, BlockAt(0, first_block), " holds ", first_block.length, " bytes; its ", p,
+        " points need ", p * dim * 4, " (single precision), ", p * dim * 8, " (double), ",
+        p * (dim * 4 + 4), " (single + iblank) or ", p * (dim * 8 + 4), " (double + iblank)",
+        dim == 3 && extents[0][2] > 1
+            ? absl::StrCat(", or a record per k-plane of ", plane, " points (planes layout)")
+            : std::string()));
   }
+  return found;
+}
+
+// The records of every block (one per block, or one per k-plane), each checked to hold the
+// bytes `encoding` gives it; then that nothing follows the last.
+absl::StatusOr<std::vector<std::vector<Record>>> LocateBlockRecords(
+    std::string_view bytes, const Header& header, const std::vector<Extents>& extents,
+    const std::vector<int64_t>& points, const BlockEncoding& encoding, const std::string& prefix,
+    RecordReader& reader) {
+  const int64_t num_blocks = header.num_blocks;
+  const int dim = header.dim;
+  const BinaryValues& values = encoding.values;
+  const Plot3dLayout layout = encoding.layout;
   std::vector<std::vector<Record>> records(static_cast<size_t>(num_blocks));
   for (int64_t b = 0; b < num_blocks; ++b) {
     const int64_t n = SlabPoints(extents[b], layout);
@@ -212,7 +254,8 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
                                    ? absl::StrCat("block ", b, " of ", num_blocks)
                                    : absl::StrCat("block ", b, " plane k = ", k);
       if (!reader.Next(&record)) {
-        return missing(absl::StrCat(what, " (record ", reader.records_read(), ")"));
+        return MissingRecord(prefix, absl::StrCat(what, " (record ", reader.records_read(), ")"),
+                             reader);
       }
       if (const int64_t need = values.SlabBytes(n, dim); record.length != need) {
         return absl::InvalidArgumentError(absl::StrCat(
@@ -228,12 +271,23 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
         prefix, static_cast<int64_t>(bytes.size()) - reader.position(),
         " unexpected bytes after the last block, from byte offset ", reader.position()));
   }
+  return records;
+}
+
+// The blocks read from their located records.
+absl::StatusOr<MultiBlockGrid> ReadBlocks(std::string_view bytes, std::string_view source, int dim,
+                                          const std::vector<Extents>& extents,
+                                          const std::vector<int64_t>& points,
+                                          const BlockEncoding& encoding,
+                                          const std::vector<std::vector<Record>>& records) {
+  const int64_t num_blocks = static_cast<int64_t>(extents.size());
+  const BinaryValues& values = encoding.values;
   MultiBlockGrid grid;
   grid.blocks.reserve(static_cast<size_t>(num_blocks));
   for (int64_t b = 0; b < num_blocks; ++b) {
     StructuredBlock block(extents[b], dim);
     if (values.has_iblank) block.iblank().resize(static_cast<size_t>(points[b]));
-    const int64_t n = SlabPoints(extents[b], layout);
+    const int64_t n = SlabPoints(extents[b], encoding.layout);
     for (size_t k = 0; k < records[b].size(); ++k) {
       const Record& record = records[b][k];
       SG_RETURN_IF_ERROR(ReadBinarySlab(bytes, bytes.data() + record.payload(), values, b,
@@ -242,18 +296,50 @@ absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::s
     }
     grid.blocks.push_back(std::move(block));
   }
-  if (detected != nullptr) {
-    Plot3dFormat format;
-    format.encoding =
-        big_endian ? Plot3dEncoding::kBinaryBigEndian : Plot3dEncoding::kBinaryLittleEndian;
-    format.spatial_dim = dim;
-    format.has_block_count = has_block_count;
-    format.has_iblank = values.has_iblank;
-    format.bytes_per_real = values.bytes_per_real;
-    format.framing = Plot3dFraming::kFortranRecords;
-    format.layout = layout;
-    *detected = format;
+  return grid;
+}
+
+// The format a Fortran-record file was found in.
+Plot3dFormat DetectedFormat(bool big_endian, const Header& header, const BlockEncoding& encoding) {
+  Plot3dFormat format;
+  format.encoding =
+      big_endian ? Plot3dEncoding::kBinaryBigEndian : Plot3dEncoding::kBinaryLittleEndian;
+  format.spatial_dim = header.dim;
+  format.has_block_count = header.has_block_count;
+  format.has_iblank = encoding.values.has_iblank;
+  format.bytes_per_real = encoding.values.bytes_per_real;
+  format.framing = Plot3dFraming::kFortranRecords;
+  format.layout = encoding.layout;
+  return format;
+}
+
+// Parses `bytes` as records in byte order `big_endian` (see plot3d.h).
+absl::StatusOr<MultiBlockGrid> ParseWithByteOrder(std::string_view bytes, std::string_view source,
+                                                  bool big_endian, const Plot3dReadOptions& options,
+                                                  Plot3dFormat* detected) {
+  const std::string prefix = ErrorPrefix(source);
+  const ByteOrder order(big_endian);
+  RecordReader reader(bytes, order);
+  SG_ASSIGN_OR_RETURN(const Header header, ReadHeader(bytes, order, prefix, reader));
+  std::vector<Extents> extents;
+  std::vector<int64_t> points;
+  SG_RETURN_IF_ERROR(ReadExtents(bytes, order, header, prefix, extents, points));
+  // Validate every block record against the file before allocating anything.
+  SG_ASSIGN_OR_RETURN(const BlockEncoding encoding,
+                      DetectBlockEncoding(reader, order, header, extents, points, prefix));
+  const int dim = header.dim;
+  if (options.layout.has_value() && *options.layout != encoding.layout && dim == 3 &&
+      extents[0][2] > 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        prefix, "the records hold the ", LayoutName(encoding.layout), " layout (block 0 record of ",
+        encoding.values.SlabBytes(SlabPoints(extents[0], encoding.layout), dim),
+        " bytes), but the ", LayoutName(*options.layout), " layout was requested"));
   }
+  SG_ASSIGN_OR_RETURN(const std::vector<std::vector<Record>> records,
+                      LocateBlockRecords(bytes, header, extents, points, encoding, prefix, reader));
+  SG_ASSIGN_OR_RETURN(MultiBlockGrid grid,
+                      ReadBlocks(bytes, source, dim, extents, points, encoding, records));
+  if (detected != nullptr) *detected = DetectedFormat(big_endian, header, encoding);
   return grid;
 }
 
