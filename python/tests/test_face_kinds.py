@@ -7,7 +7,7 @@ import grpc
 import pytest
 
 from splinegrid import Client
-from splinegrid.client import _face_kinds
+from splinegrid._args import _face_kinds
 from splinegrid.v1 import grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc

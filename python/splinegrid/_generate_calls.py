@@ -1,0 +1,128 @@
+"""Generation of an O-grid around a profile (GenerateGrid): the request built from the Client's
+arguments (the profile, the layers, the fit of revision 1; checked before any call), and the
+call."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from splinegrid._args import (_LAYER_METHODS, Triple, _airfoil_text, _fit_spec, _grid_id,
+                              _integer, _non_negative_int, grid_name)
+from splinegrid._calls import _Calls
+from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
+
+
+def _profile(request: service_pb2.GenerateGridRequest,
+             airfoil: Union[None, str, bytes, "os.PathLike[str]"],
+             points: Optional[npt.ArrayLike],
+             stored_wall: Union[None, str, tuple[Any, ...]]) -> None:
+    """Sets the request's profile from exactly one of ``airfoil``, ``points`` and
+    ``stored_wall`` (see Client.generate); ValueError naming the argument otherwise."""
+    given = [airfoil is not None, points is not None, stored_wall is not None]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of airfoil, points and stored_wall")
+    if airfoil is not None:
+        request.airfoil_file = _airfoil_text(airfoil)
+    elif points is not None:
+        xy = np.ascontiguousarray(points, dtype=np.float64)
+        if xy.ndim != 2 or xy.shape[1] != 2:
+            raise ValueError(f"points has shape {xy.shape}; give an (n, 2) array")
+        request.points.xy.extend(xy.reshape(-1).tolist())
+    else:
+        wall: tuple[Any, ...] = ((stored_wall,) if isinstance(stored_wall, str)
+                                 else tuple(stored_wall or ()))
+        if not 1 <= len(wall) <= 3:
+            raise ValueError(f"stored_wall = {stored_wall!r}; give name, (name, block) or "
+                             "(name, block, revision)")
+        request.stored_wall.name = grid_name(wall[0])
+        if len(wall) > 1:
+            request.stored_wall.block = _non_negative_int(wall[1], "stored_wall block")
+        if len(wall) > 2:
+            request.stored_wall.revision = _non_negative_int(wall[2], "stored_wall revision")
+
+
+def _layers(request: service_pb2.GenerateGridRequest, method: Optional[str],
+            wall_points: Optional[int], layers: Optional[int],
+            first_height: Optional[float], distance: Optional[float],
+            orthogonalize: Optional[bool], fit_tolerance: Optional[float]) -> None:
+    """Sets the layer parameters given (None: the server's default); ValueError for an unknown
+    ``method`` or a count that is not an integer."""
+    if method is not None:
+        if method not in _LAYER_METHODS:
+            raise ValueError(f"method = {method!r}; give one of {sorted(_LAYER_METHODS)}")
+        request.method = _LAYER_METHODS[method]
+    for field, value in (("wall_points", wall_points), ("layers", layers)):
+        if value is not None:
+            setattr(request, field, _integer(value, field))
+    for field, number in (("first_height", first_height), ("distance", distance),
+                          ("fit_tolerance", fit_tolerance)):
+        if number is not None:  # NaN and non-positive values: the server names them
+            setattr(request, field, float(number))
+    if orthogonalize is not None:
+        request.orthogonalize = bool(orthogonalize)
+
+
+class _GenerateCalls(_Calls):
+    """The Client's grid generation (GenerateGrid)."""
+
+    def generate(self, name: str = "", airfoil: Union[None, str, bytes,
+                                                      "os.PathLike[str]"] = None,
+                 points: Optional[npt.ArrayLike] = None,
+                 stored_wall: Union[None, str, tuple[Any, ...]] = None,
+                 display_name: str = "", method: Optional[str] = None,
+                 wall_points: Optional[int] = None, layers: Optional[int] = None,
+                 first_height: Optional[float] = None, distance: Optional[float] = None,
+                 orthogonalize: Optional[bool] = None,
+                 fit_tolerance: Optional[float] = None,
+                 control_counts: Optional[Triple] = None, tolerance: Optional[float] = None,
+                 order: int = 4, max_controls: int = 0,
+                 boundary_tolerances: Optional[dict[str, float]] = None,
+                 fairing: Union[None, str, float] = None, allow_folds: bool = False
+                 ) -> service_pb2.GenerateGridResponse:
+        """Generates an O-grid around a profile, stores it as the new grid ``name`` ("" lets the
+        server pick an id; ALREADY_EXISTS if taken) and fits it as revision 1. Nothing is
+        stored on an error.
+
+        The profile is one of ``airfoil`` (a Selig or Lednicer file: its path, or its text as a
+        str with line breaks, or bytes), ``points`` (an ``(n, 2)`` array in Selig order:
+        trailing edge, upper surface, leading edge, lower surface, trailing edge) or
+        ``stored_wall``: a grid's name, or ``(name, block)`` or ``(name, block, revision)``
+        (the wall points of that 2-D block's j = 0 edge, revision 0 = latest).
+
+        Layers (None: the server's defaults, core/generate/profile_grid.h): ``method``
+        ``"offsets"`` (curvature-controlled offsets, default), ``"transfinite"`` or
+        ``"elliptic"`` (transfinite, smoothed by the elliptic equations coarse to fine; odd
+        ``wall_points``, even ``layers``),
+        ``wall_points`` (257; the first repeated as the last), ``layers`` (128 cells outward),
+        ``first_height`` (1e-5, the profile's unit), ``distance`` (50, of the outer boundary
+        from the wall), ``orthogonalize`` (transfinite: lines leave the wall normally; True),
+        ``fit_tolerance`` (1e-4, of the profile spline to the points).
+
+        The fit of revision 1 takes :meth:`fit`'s arguments; with none of ``control_counts``,
+        ``tolerance``, ``boundary_tolerances`` and ``fairing`` the server interpolates the grid
+        (exact; wall j = 0, outer j = max, the seam an interface). A fit that folds cells is
+        refused (nothing stored) unless ``allow_folds``.
+
+        Returns the GenerateGridResponse proto: ``grid`` (BASIC view, revision 1), ``report``
+        (GenerationReport: ``parameters`` used, ``extents``, ``profile`` fit, ``growth_ratio``,
+        ``retries``, ``quality`` with ``negative_cells``, ``first_height_min``/``max``,
+        ``wall_orthogonality_degrees``, ...; stage seconds) and ``fit`` (as :meth:`fit`
+        returns it).
+        """
+        request = service_pb2.GenerateGridRequest(grid_id=_grid_id(name),
+                                                  display_name=display_name,
+                                                  allow_folds=bool(allow_folds))
+        _profile(request, airfoil, points, stored_wall)
+        _layers(request, method, wall_points, layers, first_height, distance, orthogonalize,
+                fit_tolerance)
+        if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
+            request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
+                                            boundary_tolerances, fairing))
+            if not request.spec.HasField("resolution"):
+                request.spec.boundary_tolerances.SetInParent()
+        return self._unary(self.stub.GenerateGrid, request,
+                           service_pb2.GenerateGridResponse)
