@@ -16,6 +16,9 @@
 
 namespace splinegrid::server {
 
+// The prefix of every DeformerCache key of grid `id` (server/ops/deform.cc makes the keys).
+inline std::string DeformerKeyPrefix(const std::string& id) { return id + "#"; }
+
 class DeformerCache {
  public:
   explicit DeformerCache(int capacity = 16) : capacity_(capacity) {}

@@ -16,6 +16,7 @@
 #include "proto/convert/convert.h"
 #include "proto/convert/generate_convert.h"
 #include "server/grid_encoding.h"
+#include "server/ops/fit.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
@@ -187,8 +188,8 @@ absl::Status SplineGridService::Generate(const v1::GenerateGridRequest& request,
   source->grid.blocks.push_back(std::move(generated.block));
   SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
 
-  SG_ASSIGN_OR_RETURN(GridRevision revision,
-                      FitRevision(*source, fit_options, RevisionOrigin::kFit, 0, cancel));
+  SG_ASSIGN_OR_RETURN(GridRevision revision, ops::FitRevision(Ops(), *source, fit_options,
+                                                              RevisionOrigin::kFit, 0, cancel));
   revision.number = 1;
   auto grid = std::make_shared<StoredGrid>();
   grid->display_name = request.display_name().empty() ? profile.name : request.display_name();

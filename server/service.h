@@ -19,6 +19,7 @@
 #include "server/grid_id.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
+#include "server/ops/ops_context.h"
 #include "server/scheduler.h"
 #include "server/server_options.h"
 #include "server/stream_limits.h"
@@ -80,9 +81,6 @@ absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::st
 // requested id.
 absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
                         const std::shared_ptr<StoredGrid>& grid);
-
-// The prefix of every DeformerCache key of grid `id`.
-inline std::string DeformerKeyPrefix(const std::string& id) { return id + "#"; }
 
 // The optional `step` field of a request that selects a revision.
 template <typename Request>
@@ -162,21 +160,12 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, const Work& work);
 
-  // Fits `source` with `options` into a revision of `origin` (and `parent`), not yet numbered
-  // or stored; its memory is reserved.
-  absl::StatusOr<GridRevision> FitRevision(const SourcePoints& source,
-                                           const GridFitOptions& options, RevisionOrigin origin,
-                                           int64_t parent, const CancelCheck& cancel);
-
   // GenerateGrid's work, on the pool; the new grid belongs to `owner` (Caller::owner()).
   absl::Status Generate(const v1::GenerateGridRequest& request, const std::string& owner,
                         const CancelCheck& cancel, v1::GenerateGridResponse* response);
 
-  // Fits `grid`'s source with `options`, stores the result as a new revision (origin, parent)
-  // and fills `response`.
-  absl::Status FitAndStore(const StoredGrid& grid, const GridFitOptions& options,
-                           RevisionOrigin origin, int64_t parent, const CancelCheck& cancel,
-                           v1::FitGridResponse* response);
+  // The operations' view of the state (server/ops).
+  ops::OpsContext Ops() const { return {*state_->store, state_->budget, state_->deformers}; }
 
   ServiceState* state_;
 };

@@ -31,36 +31,13 @@ absl::StatusOr<DeformOptions> ParseDeformOptions(const v1::DeformGridRequest& re
   return options;
 }
 
-absl::StatusOr<std::vector<double>> ParseControlDisplacements(const Deformer& deformer,
-                                                              const v1::ControlMotion& motion) {
-  const int s = deformer.reference().front().spline.spatial_dim();
-  std::map<std::pair<int, int64_t>, size_t> index;
-  for (size_t q = 0; q < deformer.moved_controls().size(); ++q) {
-    index[deformer.moved_controls()[q]] = q;
-  }
-  std::vector<double> out(deformer.moved_controls().size() * s, 0.0);
-  const int num_blocks = static_cast<int>(deformer.reference().size());
-  for (int e = 0; e < motion.blocks_size(); ++e) {
-    const v1::ControlDisplacements& given = motion.blocks(e);
-    const std::string field = absl::StrCat("controls.blocks[", e, "]");
-    if (given.block() < 0 || given.block() >= num_blocks) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".block = ", given.block(), " is outside [0, ", num_blocks - 1, "]"));
-    }
-    if (given.values_size() != s * given.controls_size()) {
-      return absl::InvalidArgumentError(absl::StrCat(field, ": ", given.values_size(),
-                                                     " values for ", given.controls_size(),
-                                                     " controls of ", s, " coordinates"));
-    }
-    for (int q = 0; q < given.controls_size(); ++q) {
-      const auto it = index.find({given.block(), given.controls(q)});
-      if (it == index.end()) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            field, ".controls[", q, "] = ", given.controls(q),
-            " does not carry the moved boundary (or is no control of block ", given.block(), ")"));
-      }
-      for (int c = 0; c < s; ++c) out[s * it->second + c] = given.values(s * q + c);
-    }
+std::vector<BlockControlDisplacements> ParseControlMotion(const v1::ControlMotion& motion) {
+  std::vector<BlockControlDisplacements> out;
+  out.reserve(motion.blocks_size());
+  for (const v1::ControlDisplacements& given : motion.blocks()) {
+    out.push_back({given.block(),
+                   std::vector<int64_t>(given.controls().begin(), given.controls().end()),
+                   std::vector<double>(given.values().begin(), given.values().end())});
   }
   return out;
 }
@@ -79,6 +56,25 @@ absl::StatusOr<std::vector<BoundaryPoints>> ParseBoundaryPoints(const v1::Bounda
     out.push_back(std::move(points));
   }
   return out;
+}
+
+absl::StatusOr<DeformMotion> ParseDeformMotion(const v1::DeformGridRequest& request) {
+  switch (request.motion_case()) {
+    case v1::DeformGridRequest::kRigid: {
+      SG_ASSIGN_OR_RETURN(RigidMotion rigid, ParseRigidMotion(request.rigid()));
+      return rigid;
+    }
+    case v1::DeformGridRequest::kControls:
+      return ParseControlMotion(request.controls());
+    case v1::DeformGridRequest::kBoundaryPoints: {
+      SG_ASSIGN_OR_RETURN(std::vector<BoundaryPoints> points,
+                          ParseBoundaryPoints(request.boundary_points()));
+      return points;
+    }
+    case v1::DeformGridRequest::MOTION_NOT_SET:
+      break;
+  }
+  return absl::InvalidArgumentError("motion is unset: give rigid, controls or boundary_points");
 }
 
 }  // namespace splinegrid

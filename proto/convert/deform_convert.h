@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/deform/deform_motion.h"
 #include "core/deform/deformer.h"
 #include "splinegrid/v1/splinegrid_service.pb.h"
 
@@ -15,10 +16,13 @@ namespace splinegrid {
 // DeformOptions::Validate (INVALID_ARGUMENT naming the field).
 absl::StatusOr<DeformOptions> ParseDeformOptions(const v1::DeformGridRequest& request);
 
-// The moved controls' displacements of a ControlMotion, in `deformer`'s order (controls not
-// given stay); INVALID_ARGUMENT naming controls.blocks[e] for a bad block, count or control.
-absl::StatusOr<std::vector<double>> ParseControlDisplacements(const Deformer& deformer,
-                                                              const v1::ControlMotion& motion);
+// The displacements of a ControlMotion as given, block by block (checked against a deformer by
+// DisplacementsInDeformerOrder, core/deform/control_motion.h).
+std::vector<BlockControlDisplacements> ParseControlMotion(const v1::ControlMotion& motion);
+
+// The request's motion (rigid, controls or boundary_points); INVALID_ARGUMENT when it is unset
+// or a part is malformed (naming the field).
+absl::StatusOr<DeformMotion> ParseDeformMotion(const v1::DeformGridRequest& request);
 
 // The ranges of a BoundaryPointsMotion (positions or displacements at a refinement level).
 absl::StatusOr<std::vector<BoundaryPoints>> ParseBoundaryPoints(const v1::BoundaryPointsMotion& m);

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/deform/deform_motion.h"
 #include "core/deform/deformer.h"
 #include "proto/convert/convert.h"
 #include "proto/convert/deform_convert.h"
@@ -24,7 +25,7 @@
 namespace {
 
 // The reference revision and the deformer with the default options (every wall point moves),
-// which maps control indices for ParseControlDisplacements and applies the motions.
+// which maps control indices (DisplacementsInDeformerOrder) and applies the motions.
 std::vector<splinegrid::FittedBlock> g_blocks;
 splinegrid::BoundaryKinds g_kinds;
 std::unique_ptr<splinegrid::Deformer> g_deformer;
@@ -59,44 +60,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         splinegrid::Deformer::Create(g_blocks, g_kinds, *options);
     if (!deformer.ok()) CheckKernelError(deformer.status());
   }
-  switch (request.motion_case()) {
-    case splinegrid::v1::DeformGridRequest::kRigid: {
-      absl::StatusOr<splinegrid::RigidMotion> motion =
-          splinegrid::ParseRigidMotion(request.rigid());
-      if (!motion.ok()) {
-        splinegrid::fuzz::CheckRejection(motion.status());
-        break;
-      }
-      absl::StatusOr<std::vector<splinegrid::FittedBlock>> moved = g_deformer->Rigid(*motion);
-      if (!moved.ok()) CheckKernelError(moved.status());
-      break;
-    }
-    case splinegrid::v1::DeformGridRequest::kControls: {
-      absl::StatusOr<std::vector<double>> displacements =
-          splinegrid::ParseControlDisplacements(*g_deformer, request.controls());
-      if (!displacements.ok()) {
-        splinegrid::fuzz::CheckRejection(displacements.status());
-        break;
-      }
-      absl::StatusOr<std::vector<splinegrid::FittedBlock>> moved =
-          g_deformer->DisplaceControls(*displacements);
-      if (!moved.ok()) CheckKernelError(moved.status());
-      break;
-    }
-    case splinegrid::v1::DeformGridRequest::kBoundaryPoints: {
-      absl::StatusOr<std::vector<splinegrid::BoundaryPoints>> points =
-          splinegrid::ParseBoundaryPoints(request.boundary_points());
-      if (!points.ok()) {
-        splinegrid::fuzz::CheckRejection(points.status());
-        break;
-      }
-      absl::StatusOr<std::vector<splinegrid::FittedBlock>> moved =
-          g_deformer->MoveBoundaryPoints(*points);
-      if (!moved.ok()) CheckKernelError(moved.status());
-      break;
-    }
-    case splinegrid::v1::DeformGridRequest::MOTION_NOT_SET:
-      break;
+  // The motion as DeformGrid converts it (ParseDeformMotion) and applies it (ApplyMotion:
+  // control displacements are mapped to the deformer's order there).
+  absl::StatusOr<splinegrid::DeformMotion> motion = splinegrid::ParseDeformMotion(request);
+  if (!motion.ok()) {
+    splinegrid::fuzz::CheckRejection(motion.status());
+    return 0;
   }
+  absl::StatusOr<std::vector<splinegrid::FittedBlock>> moved =
+      splinegrid::ApplyMotion(*g_deformer, *motion);
+  if (!moved.ok()) CheckKernelError(moved.status());
   return 0;
 }

@@ -1,0 +1,143 @@
+#include "server/ops/deform.h"
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/deform/deform_quality.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid::server::ops {
+namespace {
+
+// Everything a deformer is built from, exactly (doubles by their bits), in a form where no
+// encoding is the prefix of another's: the moved boundary, propagation, radii and smoothing.
+std::string OptionsKey(const DeformOptions& o) {
+  std::string key = absl::StrCat(static_cast<int>(o.moved.kinds), "/", o.moved.ranges.size());
+  for (const FaceRange& r : o.moved.ranges) {
+    absl::StrAppend(&key, "/", r.face.block, ",", r.face.normal, ",", r.face.upper ? 1 : 0);
+    for (int d = 0; d < 3; ++d) absl::StrAppend(&key, ",", r.begin[d], ",", r.end[d]);
+  }
+  absl::StrAppend(&key, "/", static_cast<int>(o.propagation), "/",
+                  std::bit_cast<uint64_t>(o.rigid_radius), "/",
+                  std::bit_cast<uint64_t>(o.decay_radius), "/", o.smoothing_iterations);
+  return key;
+}
+
+// The start of a deformer's cache key: the grid, the reference revision and the options.
+std::string ShapeKey(const std::string& id, int64_t reference, const DeformOptions& options) {
+  return absl::StrCat(DeformerKeyPrefix(id), reference, "#", OptionsKey(options), "#");
+}
+
+// The whole key: the shape key and the grid's creation (an id may be used again).
+std::string DeformerKey(const StoredGrid& grid, int64_t reference, const DeformOptions& options) {
+  return absl::StrCat(ShapeKey(grid.id, reference, options), absl::ToUnixNanos(grid.create_time));
+}
+
+absl::Status Validate(const DeformRequest& request) {
+  // The base is compared with the latest, not looked up: a stale one is ABORTED.
+  if (request.base_revision < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("base_revision = ", request.base_revision, " is negative"));
+  }
+  if (request.check_level < 0 || request.check_level > kMaxDeformCheckLevel) {
+    return absl::InvalidArgumentError(absl::StrCat("check_level = ", request.check_level,
+                                                   " is outside [0, ", kMaxDeformCheckLevel, "]"));
+  }
+  if (!std::isfinite(request.time)) {
+    return absl::InvalidArgumentError(absl::StrCat("time = ", request.time, " is not finite"));
+  }
+  return absl::OkStatus();
+}
+
+// The refusal of a deformation that folds cells.
+absl::Status Folds(const DeformationCheck& check) {
+  const Extents& c = check.worst_cell;
+  return absl::FailedPreconditionError(
+      absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",
+                   check.level, "; the worst in block ", check.worst_block, " at cell (", c[0],
+                   ", ", c[1], ", ", c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
+                   "; nothing was stored (move less per step, or widen decay_radius)"));
+}
+
+// The deformed revision: the reference's blocks with the moved splines, stamped.
+GridRevision DeformedRevision(const GridRevision& reference, const Deformer& deformer,
+                              std::vector<FittedBlock> moved, const DeformationCheck& check,
+                              const DeformRequest& request) {
+  GridRevision revision;
+  revision.create_time = absl::Now();
+  revision.origin = RevisionOrigin::kDeform;
+  revision.parent = reference.number;
+  revision.time = request.time;
+  revision.step = request.step;
+  revision.fit_options = reference.fit_options;
+  revision.kinds = reference.kinds;
+  revision.blocks = reference.blocks;
+  for (size_t b = 0; b < moved.size(); ++b) {
+    revision.blocks[b].fitted.spline = std::move(moved[b].spline);
+  }
+  revision.deform.check = check;
+  revision.deform.moved_controls = static_cast<int>(deformer.moved_controls().size());
+  revision.deform.decay_radius = deformer.decay_radius();
+  return revision;
+}
+
+}  // namespace
+
+bool HasKeptDeformer(const OpsContext& context, const DeformRequest& request) {
+  return request.reference_revision > 0 &&
+         context.deformers.HasAny(
+             ShapeKey(request.grid_id, request.reference_revision, request.options));
+}
+
+absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& context,
+                                                           const DeformRequest& request,
+                                                           const CancelCheck& cancel) {
+  const auto start = std::chrono::steady_clock::now();
+  // The base is checked again, atomically, when the revision is added.
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                      context.store.GetHolding(
+                          request.grid_id, {request.base_revision, request.reference_revision}));
+  SG_RETURN_IF_ERROR(Validate(request));
+  const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
+  if (request.base_revision != 0 && request.base_revision != latest) {
+    return absl::AbortedError(absl::StrCat("grids/", request.grid_id, ": base_revision ",
+                                           request.base_revision,
+                                           " is stale; the latest revision is ", latest));
+  }
+  SG_ASSIGN_OR_RETURN(
+      const std::shared_ptr<const GridRevision> reference,
+      grid->ResolveRevision(request.reference_revision, std::nullopt, "reference_revision"));
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const Deformer> deformer,
+                      context.deformers.Get(DeformerKey(*grid, reference->number, request.options),
+                                            [&]() -> absl::StatusOr<Deformer> {
+                                              std::vector<FittedBlock> blocks;
+                                              for (const BlockFit& b : reference->blocks) {
+                                                blocks.push_back(b.fitted);
+                                              }
+                                              return Deformer::Create(std::move(blocks),
+                                                                      reference->kinds,
+                                                                      request.options);
+                                            }));
+  SG_ASSIGN_OR_RETURN(std::vector<FittedBlock> moved, ApplyMotion(*deformer, request.motion),
+                      std::holds_alternative<std::vector<BlockControlDisplacements>>(request.motion)
+                          ? "controls."
+                          : "");
+  SG_ASSIGN_OR_RETURN(const DeformationCheck check,
+                      CheckDeformation(deformer->reference(), moved, deformer->kinds(),
+                                       request.check_level, cancel));
+  if (!check.ok()) return Folds(check);
+  GridRevision revision = DeformedRevision(*reference, *deformer, std::move(moved), check, request);
+  revision.deform.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  SG_ASSIGN_OR_RETURN(revision.memory,
+                      context.budget.Reserve(RevisionBytes(revision), "the deformed revision"));
+  SG_ASSIGN_OR_RETURN(
+      const std::shared_ptr<const StoredGrid> stored,
+      context.store.AddRevision(request.grid_id, std::move(revision), request.base_revision));
+  return stored->revisions.back();
+}
+
+}  // namespace splinegrid::server::ops

@@ -1,0 +1,103 @@
+#include "server/ops/fit.h"
+
+#include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
+
+namespace splinegrid::server::ops {
+namespace {
+
+// The request field the options of a revision of `origin` came from, in front of the kernel's
+// field names: "spec." (FitGrid, GenerateGrid) or the fit spec of the refaired revision.
+std::string SpecField(RevisionOrigin origin, int64_t parent) {
+  return origin == RevisionOrigin::kFair ? absl::StrCat("revision ", parent, " fit_spec.")
+                                         : std::string("spec.");
+}
+
+// Fits grid `grid` and publishes the revision.
+absl::StatusOr<std::shared_ptr<const GridRevision>> FitAndPublish(
+    const OpsContext& context, const StoredGrid& grid, const GridFitOptions& options,
+    RevisionOrigin origin, int64_t parent, const CancelCheck& cancel) {
+  SG_ASSIGN_OR_RETURN(GridRevision revision,
+                      FitRevision(context, *grid.source, options, origin, parent, cancel));
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
+                      context.store.AddRevision(grid.id, std::move(revision)));
+  return stored->revisions.back();
+}
+
+// The options of refairing `parent` as `request` asks.
+absl::StatusOr<GridFitOptions> FairOptions(const GridRevision& parent, const FairRequest& request) {
+  GridFitOptions options = parent.fit_options;
+  if (request.fairing) {
+    options.fairing = *request.fairing;
+  } else if (options.tolerance_mode()) {
+    options.fairing = FairingOptions{FairingMode::kToTolerance};
+  } else {
+    return absl::InvalidArgumentError(
+        absl::StrCat("fairing is unset and revision ", parent.number,
+                     " was fitted with control counts: give a fairing weight (mode WEIGHT)"));
+  }
+  if (options.fairing.mode == FairingMode::kOff) {
+    return absl::InvalidArgumentError("fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
+  }
+  // Folds are accepted only when this request says so, not because the parent did.
+  options.allow_folds = request.allow_folds;
+  return options;
+}
+
+}  // namespace
+
+absl::StatusOr<GridRevision> FitRevision(const OpsContext& context, const SourcePoints& source,
+                                         const GridFitOptions& options, RevisionOrigin origin,
+                                         int64_t parent, const CancelCheck& cancel) {
+  // Options that do not suit the grid are refused, naming the request's field, value and limit
+  // ("spec.control_counts[0] = 1000 exceeds the 113 points of block 0 in i"); nothing is
+  // clamped, and nothing is stored.
+  SG_RETURN_IF_ERROR(options.Validate(source.grid), SpecField(origin, parent));
+  // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
+  // evaluations of the deviation and quality checks, bounded by a few times the source size.
+  SG_ASSIGN_OR_RETURN(MemoryReservation work,
+                      context.budget.Reserve(2 * source.memory.bytes(), "the fit"));
+  // The connectivity found at import (kept with the source points), not found again.
+  absl::StatusOr<GridFit> fitted = FitGrid(source.grid, source.connectivity, options, cancel);
+  if (fitted.status().code() == absl::StatusCode::kFailedPrecondition) {
+    // A grid that cannot be fitted, or one whose fit folds without options.allow_folds.
+    return absl::FailedPreconditionError(
+        absl::StrCat(fitted.status().message(), "; nothing was stored"));
+  }
+  SG_ASSIGN_OR_RETURN(GridFit fit, std::move(fitted));
+  GridRevision revision;
+  revision.create_time = absl::Now();
+  revision.origin = origin;
+  revision.parent = parent;
+  revision.fit_options = options;
+  SG_ASSIGN_OR_RETURN(revision.memory,
+                      context.budget.Reserve(RevisionBytes(fit), "the fitted revision"));
+  revision.blocks = std::move(fit.blocks);
+  revision.kinds = std::move(fit.kinds);
+  revision.report = fit.report;
+  return revision;
+}
+
+absl::StatusOr<std::shared_ptr<const GridRevision>> Fit(const OpsContext& context,
+                                                        const std::string& id,
+                                                        GridFitOptions options,
+                                                        const CancelCheck& cancel) {
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, context.store.Get(id));
+  // The imported file's boundary conditions are the default kinds of their faces.
+  options.face_kinds =
+      WithDefaultFaceKinds(std::move(options.face_kinds), grid->source->boundaries.face_kinds);
+  return FitAndPublish(context, *grid, options, RevisionOrigin::kFit, 0, cancel);
+}
+
+absl::StatusOr<std::shared_ptr<const GridRevision>> Fair(const OpsContext& context,
+                                                         const FairRequest& request,
+                                                         const CancelCheck& cancel) {
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                      context.store.Get(request.grid_id));
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
+                      grid->ResolveRevision(request.revision));
+  SG_ASSIGN_OR_RETURN(const GridFitOptions options, FairOptions(*parent, request));
+  return FitAndPublish(context, *grid, options, RevisionOrigin::kFair, parent->number, cancel);
+}
+
+}  // namespace splinegrid::server::ops

@@ -1,0 +1,120 @@
+// The operations layer (server/ops) on its own: no gRPC, no protobuf; a real MemoryStore, budget
+// and deformer cache. Fit, fair and deform publish revisions; a deform's deformer is kept by its
+// reference and options; stale bases, folding motions and bad requests change nothing.
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/grid/connectivity.h"
+#include "core/io/plot3d.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/ops/deform.h"
+#include "server/ops/fit.h"
+#include "server/store/memory_store.h"
+#include "tests/core/test_data.h"
+
+namespace splinegrid::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+class OpsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto grid = std::make_shared<StoredGrid>();
+    grid->id = "naca";
+    grid->create_time = absl::Now();
+    auto source = std::make_shared<SourcePoints>();
+    source->grid = ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
+    source->connectivity = FindConnectivity(source->grid).value();
+    source->format = "plot3d";
+    grid->source = std::move(source);
+    ASSERT_TRUE(store_.Create(grid).ok());
+  }
+
+  int64_t Latest() { return store_.Get("naca").value()->revisions.back()->number; }
+
+  // A rigid pitch of `degrees` about the quarter chord, relative to revision 1.
+  ops::DeformRequest Pitch(double degrees, int64_t base = 0) {
+    ops::DeformRequest request;
+    request.grid_id = "naca";
+    request.base_revision = base;
+    request.reference_revision = 1;
+    RigidMotion pitch;
+    pitch.center = {0.25, 0.0, 0.0};
+    pitch.angle = degrees * std::numbers::pi / 180.0;
+    request.motion = pitch;
+    request.time = 0.5;
+    request.step = 7;
+    return request;
+  }
+
+  MemoryStore store_{/*max_deform_revisions=*/4};
+  MemoryBudget budget_{int64_t{1} << 30};
+  DeformerCache deformers_;
+  const ops::OpsContext ops_{store_, budget_, deformers_};
+};
+
+TEST_F(OpsTest, FitFairAndDeformPublishRevisions) {
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  const auto fit = ops::Fit(ops_, "naca", options, {});
+  ASSERT_TRUE(fit.ok()) << fit.status();
+  EXPECT_EQ((*fit)->number, 1);
+  EXPECT_EQ((*fit)->origin, RevisionOrigin::kFit);
+  EXPECT_TRUE((*fit)->report.tolerance_met);
+
+  const auto faired = ops::Fair(ops_, {"naca", 1, std::nullopt, false}, {});
+  ASSERT_TRUE(faired.ok()) << faired.status();
+  EXPECT_EQ((*faired)->origin, RevisionOrigin::kFair);
+  EXPECT_EQ((*faired)->parent, 1);
+  EXPECT_EQ((*faired)->fit_options.fairing.mode, FairingMode::kToTolerance);
+
+  EXPECT_FALSE(ops::HasKeptDeformer(ops_, Pitch(1.0)));
+  const auto deformed = ops::Deform(ops_, Pitch(1.0, /*base=*/2), {});
+  ASSERT_TRUE(deformed.ok()) << deformed.status();
+  EXPECT_EQ((*deformed)->number, 3);
+  EXPECT_EQ((*deformed)->origin, RevisionOrigin::kDeform);
+  EXPECT_EQ((*deformed)->parent, 1);
+  EXPECT_EQ((*deformed)->step, 7);
+  EXPECT_EQ((*deformed)->deform.check.folded, 0);
+  // The deformer is kept for the same reference and options; other options need their own.
+  EXPECT_TRUE(ops::HasKeptDeformer(ops_, Pitch(2.0)));
+  ops::DeformRequest wider = Pitch(2.0);
+  wider.options.decay_radius = 3.0;
+  EXPECT_FALSE(ops::HasKeptDeformer(ops_, wider));
+}
+
+TEST_F(OpsTest, RefusedDeformsStoreNothing) {
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  ASSERT_TRUE(ops::Fit(ops_, "naca", options, {}).ok());
+  ASSERT_TRUE(ops::Deform(ops_, Pitch(1.0), {}).ok());
+  const int64_t latest = Latest();
+
+  EXPECT_EQ(ops::Deform(ops_, Pitch(2.0, /*base=*/1), {}).status().code(),
+            absl::StatusCode::kAborted);  // stale base
+  ops::DeformRequest bad_level = Pitch(2.0);
+  bad_level.check_level = ops::kMaxDeformCheckLevel + 1;
+  EXPECT_THAT(ops::Deform(ops_, bad_level, {}).status().message(), HasSubstr("check_level = 5"));
+  ops::DeformRequest bad_time = Pitch(2.0);
+  bad_time.time = std::nan("");
+  EXPECT_THAT(ops::Deform(ops_, bad_time, {}).status().message(), HasSubstr("time = nan"));
+  ops::DeformRequest bad_control = Pitch(0.0);
+  bad_control.motion = std::vector<BlockControlDisplacements>{{0, {-1}, {0.0, 0.0}}};
+  EXPECT_THAT(ops::Deform(ops_, bad_control, {}).status().message(),
+              HasSubstr("controls.blocks[0].controls[0] = -1 does not carry the moved boundary"));
+  // Everything a third of a chord away stays while the nose turns by 60 degrees: it tears.
+  ops::DeformRequest tear = Pitch(60.0);
+  tear.options.decay_radius = 0.3;
+  const absl::Status folds = ops::Deform(ops_, tear, {}).status();
+  EXPECT_EQ(folds.code(), absl::StatusCode::kFailedPrecondition) << folds;
+  EXPECT_THAT(folds.message(), HasSubstr("nothing was stored"));
+  EXPECT_EQ(Latest(), latest);
+}
+
+}  // namespace
+}  // namespace splinegrid::server
