@@ -6,7 +6,7 @@
 #include "bench/grid_samples.h"
 #include "benchmark/benchmark.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 
 namespace splinegrid::bench {
 namespace {

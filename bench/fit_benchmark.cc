@@ -21,7 +21,7 @@
 #include "bench/peak_memory.h"
 #include "benchmark/benchmark.h"
 #include "core/bspline/basis.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 
 namespace splinegrid::bench {
 namespace {

@@ -1,6 +1,6 @@
 // GetWallCurvature: curvature samples along every wall grid line of a revision.
 #include "absl/strings/str_cat.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/report/wall_curvature.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"

@@ -30,7 +30,7 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 #include "core/fit/grid_fit.h"
 #include "core/io/airfoil.h"
 #include "core/io/planar_view.h"

@@ -52,7 +52,7 @@ absl::Status List(const Args& args);
 absl::Status Eval(const Args& args);
 absl::Status Fair(const Args& args);
 absl::Status Curvature(const Args& args);
-// Local (no server): fits an airfoil's coordinates (core/fit/airfoil_fit.h).
+// Local (no server): fits an airfoil's coordinates (core/fit/airfoil/airfoil_fit.h).
 absl::Status Airfoil(const Args& args);
 // Rigidly moves part of a grid's boundary (DeformGrid) and prints the new revision's report.
 absl::Status Deform(const Args& args);

@@ -11,7 +11,7 @@
 #include "client/cli/flags.h"
 #include "client/cli/output.h"
 #include "client/client.h"
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 #include "core/io/airfoil.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"

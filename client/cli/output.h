@@ -5,7 +5,7 @@
 #include <string>
 
 #include "client/client.h"
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 #include "google/protobuf/message.h"
 
 namespace splinegrid::cli {

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
 

@@ -4,8 +4,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/grid_quality.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/report/grid_quality.h"
+#include "core/fit/report/wall_curvature.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 

@@ -51,7 +51,7 @@
 #include "core/deform/boundary_controls.h"
 #include "core/deform/range_fit.h"
 #include "core/deform/rigid_motion.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 
 namespace splinegrid {

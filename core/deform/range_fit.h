@@ -18,7 +18,7 @@
 #include "absl/status/statusor.h"
 #include "core/bspline/basis.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/banded_qr.h"
+#include "core/fit/solve/banded_qr.h"
 
 namespace splinegrid {
 

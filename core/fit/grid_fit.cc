@@ -6,7 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "core/fit/segment_model.h"
+#include "core/fit/adaptive/segment_model.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {

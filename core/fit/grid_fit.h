@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/fit/fairing.h"
-#include "core/fit/grid_quality.h"
-#include "core/fit/multiblock_fit.h"
-#include "core/fit/tensor_fit.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/adaptive/multiblock_fit.h"
+#include "core/fit/report/grid_quality.h"
+#include "core/fit/report/wall_curvature.h"
+#include "core/fit/solve/fairing.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
 #include "core/grid/reference_length.h"

@@ -5,7 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/generate/loop_geometry.h"
 #include "core/grid/polyline.h"
 #include "core/util/status_macros.h"

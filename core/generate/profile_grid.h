@@ -22,7 +22,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 #include "core/generate/wall_loop.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"

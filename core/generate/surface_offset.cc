@@ -10,7 +10,7 @@
 #include "Eigen/Geometry"
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/generate/offset_march.h"
 #include "core/util/status_macros.h"
 

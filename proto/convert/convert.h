@@ -13,7 +13,7 @@
 #include "core/deform/boundary_controls.h"
 #include "core/deform/rigid_motion.h"
 #include "core/fit/grid_fit.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/sampling.h"
 #include "splinegrid/v1/grid.pb.h"
 #include "splinegrid/v1/splinegrid_service.pb.h"

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/fit/fairing.h"
 #include "core/fit/grid_fit.h"
+#include "core/fit/solve/fairing.h"
 #include "core/util/cancellation.h"
 #include "server/grid_store.h"
 #include "server/ops/ops_context.h"

@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/structured_grid.h"
 
 int main() {

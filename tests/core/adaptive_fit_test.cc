@@ -1,7 +1,7 @@
 // FitToTolerance: synthetic smooth, kinked and noisy data, the shared C-grids at the paper's
 // scale of tolerances, argument errors and cancellation. Every "met" is verified independently
 // with MeasureDeviation at the fitted block's own parameters.
-#include "core/fit/adaptive_fit.h"
+#include "core/fit/adaptive/adaptive_fit.h"
 
 #include <chrono>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Airfoil profile fits: the shared coordinate files within 1e-4 chord with few controls, sharp
 // and blunt trailing edges, feature points, fairing, and every error path.
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 
 #include <algorithm>
 #include <cmath>

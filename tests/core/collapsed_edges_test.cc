@@ -13,7 +13,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/multiblock_fit.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 #include "core/grid/poles.h"
 #include "core/io/plot3d.h"
 #include "gtest/gtest.h"

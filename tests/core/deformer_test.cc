@@ -6,8 +6,8 @@
 
 #include "core/bspline/evaluation.h"
 #include "core/deform/deform_quality.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 #include "core/fit/grid_fit.h"
-#include "core/fit/multiblock_fit.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"

@@ -1,7 +1,7 @@
 // DirectionFit: pinned controls at kinks, zero ends, penalty rows, rank deficiency, the
 // Schoenberg-Whitney predicate against the numerical rank check, and layout independence of
 // Apply. Dense least squares (Eigen) is the oracle.
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 
 #include <algorithm>
 #include <array>

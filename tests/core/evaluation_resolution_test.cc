@@ -10,7 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "gtest/gtest.h"

@@ -2,7 +2,7 @@
 // multiple knots, checked against the derivative jumps evaluated on both sides of a knot), the
 // trade-off lambda controls (a theorem of penalised least squares: the penalty falls and the
 // residual rises with lambda), and faired tensor fits of curves, surfaces and volumes.
-#include "core/fit/fairing.h"
+#include "core/fit/solve/fairing.h"
 
 #include <array>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 

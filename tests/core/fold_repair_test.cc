@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "core/fit/adaptive/refinement.h"
 #include "core/fit/grid_fit.h"
-#include "core/fit/refinement.h"
 #include "core/io/file_util.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"

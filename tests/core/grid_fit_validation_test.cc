@@ -6,7 +6,7 @@
 #include <numbers>
 #include <string>
 
-#include "core/fit/adaptive_fit.h"
+#include "core/fit/adaptive/adaptive_fit.h"
 #include "core/fit/grid_fit.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"

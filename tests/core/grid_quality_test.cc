@@ -1,7 +1,7 @@
 // CheckCellQuality: the cell measures against independent oracles, exact and smooth fits (ok),
 // deliberately folded, oversized and flipped fits (detected at the right cell), surfaces in any
 // two active directions, volumes, collapsed edges, the shared C-grid, errors and cancellation.
-#include "core/fit/grid_quality.h"
+#include "core/fit/report/grid_quality.h"
 
 #include <chrono>
 #include <cmath>
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"

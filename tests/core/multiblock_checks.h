@@ -14,7 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/bspline/basis.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/multiblock_fit.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 #include "gtest/gtest.h"
 
 namespace splinegrid {

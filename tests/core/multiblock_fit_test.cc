@@ -2,7 +2,7 @@
 // (re-measured independently, multiblock_checks.h), the report, fairing to tolerance, option
 // and data errors, cancellation and inconsistent touches, on small grids built here and on the
 // shared C-grid and surfaces.
-#include "core/fit/multiblock_fit.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 // shared (normalised) parameters and knots through full, partial, reversed and hanging-node
 // matches, feature splits, MatchedControls, and the errors for matches that cannot hold, and
 // the model's promise: blocks fitted with its knots have the same boundary controls.
-#include "core/fit/segment_model.h"
+#include "core/fit/adaptive/segment_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "core/bspline/basis.h"
 #include "core/bspline/parametrization.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/synthetic_grids.h"

@@ -24,7 +24,7 @@
 #include "core/bspline/basis.h"
 #include "core/bspline/evaluation.h"
 #include "core/bspline/parametrization.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "gtest/gtest.h"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/fit/grid_quality.h"
+#include "core/fit/report/grid_quality.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"

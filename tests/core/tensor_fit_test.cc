@@ -1,4 +1,4 @@
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 
 #include <random>
 

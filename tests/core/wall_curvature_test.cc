@@ -1,7 +1,7 @@
 // Wall lines of fitted blocks (runs of wall points, cut at distribution breaks), the curvature
 // of a fitted circle arc (1 / R, signed in the plane) and the extremum count and fairness sum
 // of known curvature sequences.
-#include "core/fit/wall_curvature.h"
+#include "core/fit/report/wall_curvature.h"
 
 #include <cmath>
 #include <numbers>

@@ -17,8 +17,8 @@
 // under), so with interpolated ends every block fits the shared boundary to the same curve or
 // surface; copying the boundary controls of one block into the others then makes them bitwise
 // identical (MatchedControls).
-#ifndef SPLINEGRID_CORE_FIT_SEGMENT_MODEL_H_
-#define SPLINEGRID_CORE_FIT_SEGMENT_MODEL_H_
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_SEGMENT_MODEL_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_SEGMENT_MODEL_H_
 
 #include <array>
 #include <utility>
@@ -26,7 +26,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 #include "core/grid/connectivity.h"
 #include "core/grid/structured_grid.h"
 
@@ -134,4 +134,4 @@ class SegmentModel {
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_SEGMENT_MODEL_H_
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_SEGMENT_MODEL_H_

@@ -1,11 +1,11 @@
-#include "core/fit/adaptive_fit.h"
+#include "core/fit/adaptive/adaptive_fit.h"
 
 #include <chrono>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
-#include "core/fit/adaptive_engine.h"
-#include "core/fit/segment_model.h"
+#include "core/fit/adaptive/adaptive_engine.h"
+#include "core/fit/adaptive/segment_model.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {

@@ -1,4 +1,4 @@
-#include "core/fit/multiblock_fit.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 
 #include <chrono>
 #include <cmath>
@@ -6,8 +6,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/adaptive_engine.h"
-#include "core/fit/segment_model.h"
+#include "core/fit/adaptive/adaptive_engine.h"
+#include "core/fit/adaptive/segment_model.h"
 #include "core/util/status_macros.h"
 #include "core/util/union_find.h"
 

@@ -22,15 +22,15 @@
 //
 // Knots of multiplicity > 1 (feature points, the splits of a multi-block model) are not
 // penalised: their kink is deliberate.
-#ifndef SPLINEGRID_CORE_FIT_FAIRING_H_
-#define SPLINEGRID_CORE_FIT_FAIRING_H_
+#ifndef SPLINEGRID_CORE_FIT_SOLVE_FAIRING_H_
+#define SPLINEGRID_CORE_FIT_SOLVE_FAIRING_H_
 
 #include <span>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 
 namespace splinegrid {
 
@@ -62,4 +62,4 @@ std::vector<double> ScaledDerivativeJumps(const KnotVector& knots,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_FAIRING_H_
+#endif  // SPLINEGRID_CORE_FIT_SOLVE_FAIRING_H_

@@ -50,8 +50,8 @@
 // the reference measures (one or three doubles and a state byte per original cell), the
 // evaluator's u-contracted net (at most options.evaluator_budget doubles, unless two points of
 // it exceed that), and two rows of a chunk.
-#ifndef SPLINEGRID_CORE_FIT_GRID_QUALITY_H_
-#define SPLINEGRID_CORE_FIT_GRID_QUALITY_H_
+#ifndef SPLINEGRID_CORE_FIT_REPORT_GRID_QUALITY_H_
+#define SPLINEGRID_CORE_FIT_REPORT_GRID_QUALITY_H_
 
 #include <array>
 #include <cstdint>
@@ -61,7 +61,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -147,4 +147,4 @@ double HexahedronVolume(const std::array<Point3, 8>& corners);
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_GRID_QUALITY_H_
+#endif  // SPLINEGRID_CORE_FIT_REPORT_GRID_QUALITY_H_

@@ -16,18 +16,18 @@
 //     match and no segment boundary; every line of controls along a pole's collapsed direction
 //     is given one value (the constrained least-squares fit: multiblock_fit.cc), shared by all
 //     blocks that meet there, so the pole stays exactly collapsed at every resolution.
-#ifndef SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
-#define SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_MULTIBLOCK_FIT_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_MULTIBLOCK_FIT_H_
 
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/fit/fairing.h"
-#include "core/fit/grid_quality.h"
-#include "core/fit/refinement.h"
-#include "core/fit/tensor_fit.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/adaptive/refinement.h"
+#include "core/fit/report/grid_quality.h"
+#include "core/fit/report/wall_curvature.h"
+#include "core/fit/solve/fairing.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
 #include "core/grid/poles.h"
@@ -147,4 +147,4 @@ absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_MULTIBLOCK_FIT_H_
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_MULTIBLOCK_FIT_H_

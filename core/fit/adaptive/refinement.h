@@ -1,7 +1,7 @@
 // Building blocks of knot refinement: where a direction's own line fits miss their tolerance,
 // where grid lines have kinks, and how knot spans are split.
-#ifndef SPLINEGRID_CORE_FIT_REFINEMENT_H_
-#define SPLINEGRID_CORE_FIT_REFINEMENT_H_
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_REFINEMENT_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_REFINEMENT_H_
 
 #include <functional>
 #include <span>
@@ -9,7 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -103,4 +103,4 @@ std::vector<double> BreakSingleDatumRuns(const std::vector<double>& params,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_REFINEMENT_H_
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_REFINEMENT_H_

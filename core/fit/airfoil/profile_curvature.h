@@ -17,17 +17,17 @@
 // spline's ripples between knots do not count, and a swing through zero always does). Per
 // piece, spurious = max(0, extrema - reference significant extrema).
 // Cost: O(k^2) per sample, 2^level samples per data interval.
-#ifndef SPLINEGRID_CORE_FIT_PROFILE_CURVATURE_H_
-#define SPLINEGRID_CORE_FIT_PROFILE_CURVATURE_H_
+#ifndef SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_CURVATURE_H_
+#define SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_CURVATURE_H_
 
 #include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
 
-#include "core/fit/airfoil_fit.h"
-#include "core/fit/profile_fitter.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/airfoil/airfoil_fit.h"
+#include "core/fit/airfoil/profile_fitter.h"
+#include "core/fit/report/wall_curvature.h"
 
 namespace splinegrid {
 
@@ -64,4 +64,4 @@ void CountSpurious(const ProfileCurvature& reference, ProfileCurvature& c);
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_PROFILE_CURVATURE_H_
+#endif  // SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_CURVATURE_H_

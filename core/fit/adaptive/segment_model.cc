@@ -1,4 +1,4 @@
-#include "core/fit/segment_model.h"
+#include "core/fit/adaptive/segment_model.h"
 
 #include <algorithm>
 #include <deque>

@@ -1,5 +1,5 @@
 // The curvature judgement of a fitted profile (profile_curvature.h).
-#include "core/fit/profile_curvature.h"
+#include "core/fit/airfoil/profile_curvature.h"
 
 #include <algorithm>
 #include <cmath>

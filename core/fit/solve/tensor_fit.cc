@@ -1,4 +1,4 @@
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 
 #include <algorithm>
 #include <chrono>
@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/fairing.h"
+#include "core/fit/solve/fairing.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {

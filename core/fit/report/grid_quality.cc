@@ -1,4 +1,4 @@
-#include "core/fit/grid_quality.h"
+#include "core/fit/report/grid_quality.h"
 
 #include <algorithm>
 #include <cmath>

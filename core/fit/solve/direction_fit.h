@@ -11,8 +11,8 @@
 // Interior controls can be pinned too: at a feature point (a knot of multiplicity order - 1 at
 // params[r]) only one basis function is nonzero, and pinning its control to x_r makes the fit
 // pass through the feature point exactly, each side fitted on its own.
-#ifndef SPLINEGRID_CORE_FIT_DIRECTION_FIT_H_
-#define SPLINEGRID_CORE_FIT_DIRECTION_FIT_H_
+#ifndef SPLINEGRID_CORE_FIT_SOLVE_DIRECTION_FIT_H_
+#define SPLINEGRID_CORE_FIT_SOLVE_DIRECTION_FIT_H_
 
 #include <cstdint>
 #include <memory>
@@ -21,7 +21,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/banded_qr.h"
+#include "core/fit/solve/banded_qr.h"
 #include "core/util/cancellation.h"
 
 namespace splinegrid {
@@ -110,4 +110,4 @@ class DirectionFit {
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_DIRECTION_FIT_H_
+#endif  // SPLINEGRID_CORE_FIT_SOLVE_DIRECTION_FIT_H_

@@ -1,4 +1,4 @@
-#include "core/fit/refinement.h"
+#include "core/fit/adaptive/refinement.h"
 
 #include <algorithm>
 #include <cmath>

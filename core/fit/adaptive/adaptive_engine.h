@@ -21,17 +21,17 @@
 //     a log scale). A fit that sits at its tolerance leaves fairing no room, so to fair to
 //     tolerance, steps 1-3 place the knots for half the tolerances and the fairing may use the
 //     other half; the unfaired fit with the same knots is returned too, to compare.
-#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_
-#define SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_ENGINE_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_ENGINE_H_
 
 #include <functional>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/fit/fairing.h"
-#include "core/fit/grid_quality.h"
-#include "core/fit/segment_model.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/adaptive/segment_model.h"
+#include "core/fit/report/grid_quality.h"
+#include "core/fit/solve/fairing.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/util/cancellation.h"
 
 namespace splinegrid {
@@ -82,4 +82,4 @@ absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentM
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_ENGINE_H_
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_ENGINE_H_

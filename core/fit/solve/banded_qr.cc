@@ -1,4 +1,4 @@
-#include "core/fit/banded_qr.h"
+#include "core/fit/solve/banded_qr.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "core/fit/adaptive_engine.h"
+#include "core/fit/adaptive/adaptive_engine.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include <tuple>
 
 #include "core/bspline/evaluation.h"
-#include "core/fit/refinement.h"
+#include "core/fit/adaptive/refinement.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {

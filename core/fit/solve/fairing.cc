@@ -1,4 +1,4 @@
-#include "core/fit/fairing.h"
+#include "core/fit/solve/fairing.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 // (insertion, then removal), fairing to tolerance and the assembly of the result. The fits
 // themselves are ProfileFitter's (profile_fitter.h), the curvature measures those of
 // profile_curvature.h, and the outline's simplicity check FindPolylineCrossing's (polyline.h).
-#include "core/fit/airfoil_fit.h"
+#include "core/fit/airfoil/airfoil_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/fit/profile_curvature.h"
-#include "core/fit/profile_fitter.h"
+#include "core/fit/airfoil/profile_curvature.h"
+#include "core/fit/airfoil/profile_fitter.h"
 #include "core/grid/polyline.h"
 #include "core/util/status_macros.h"
 

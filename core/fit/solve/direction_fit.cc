@@ -1,4 +1,4 @@
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 
 #include <algorithm>
 #include <cstring>

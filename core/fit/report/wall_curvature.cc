@@ -1,4 +1,4 @@
-#include "core/fit/wall_curvature.h"
+#include "core/fit/report/wall_curvature.h"
 
 #include <algorithm>
 #include <cmath>

@@ -75,8 +75,8 @@
 // Any fit whose curvature exceeds twice the reference's largest has a cusp or a tiny loop that
 // the distances cannot see (parameter correction can bunch parameters until |C'| nearly
 // vanishes): knot placement splits the span there, and removal and fairing reject it.
-#ifndef SPLINEGRID_CORE_FIT_AIRFOIL_FIT_H_
-#define SPLINEGRID_CORE_FIT_AIRFOIL_FIT_H_
+#ifndef SPLINEGRID_CORE_FIT_AIRFOIL_AIRFOIL_FIT_H_
+#define SPLINEGRID_CORE_FIT_AIRFOIL_AIRFOIL_FIT_H_
 
 #include <cstdint>
 #include <string>
@@ -86,9 +86,9 @@
 #include "absl/status/statusor.h"
 #include "core/bspline/parametrization.h"
 #include "core/bspline/tensor_spline.h"
-#include "core/fit/fairing.h"
-#include "core/fit/refinement.h"
-#include "core/fit/wall_curvature.h"
+#include "core/fit/adaptive/refinement.h"
+#include "core/fit/report/wall_curvature.h"
+#include "core/fit/solve/fairing.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -168,4 +168,4 @@ absl::StatusOr<AirfoilFit> FitAirfoil(const StructuredBlock& points,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_AIRFOIL_FIT_H_
+#endif  // SPLINEGRID_CORE_FIT_AIRFOIL_AIRFOIL_FIT_H_

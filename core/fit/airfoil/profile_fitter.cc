@@ -1,6 +1,6 @@
 // ProfileFitter and the curve evaluation it shares with the curvature judgement
 // (profile_fitter.h).
-#include "core/fit/profile_fitter.h"
+#include "core/fit/airfoil/profile_fitter.h"
 
 #include <algorithm>
 #include <array>
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/bspline/basis.h"
-#include "core/fit/fairing.h"
+#include "core/fit/solve/fairing.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {

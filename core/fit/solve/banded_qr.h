@@ -8,8 +8,8 @@
 // right-hand side to apply Q^T and O(n w) to back-substitute. The rotations are recorded,
 // which is what makes "factor once, solve many" cheap: a direction of a tensor grid is
 // factored once and replayed on every grid line and coordinate.
-#ifndef SPLINEGRID_CORE_FIT_BANDED_QR_H_
-#define SPLINEGRID_CORE_FIT_BANDED_QR_H_
+#ifndef SPLINEGRID_CORE_FIT_SOLVE_BANDED_QR_H_
+#define SPLINEGRID_CORE_FIT_SOLVE_BANDED_QR_H_
 
 #include <cstdint>
 #include <span>
@@ -67,4 +67,4 @@ class BandedQR {
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_BANDED_QR_H_
+#endif  // SPLINEGRID_CORE_FIT_SOLVE_BANDED_QR_H_

@@ -13,8 +13,8 @@
 // fitted block is the fit of that face's or edge's own data: two blocks that share boundary
 // data, knots and parameters share the boundary curve, which is what watertight multi-block
 // fits build on.
-#ifndef SPLINEGRID_CORE_FIT_TENSOR_FIT_H_
-#define SPLINEGRID_CORE_FIT_TENSOR_FIT_H_
+#ifndef SPLINEGRID_CORE_FIT_SOLVE_TENSOR_FIT_H_
+#define SPLINEGRID_CORE_FIT_SOLVE_TENSOR_FIT_H_
 
 #include <array>
 #include <string>
@@ -24,7 +24,7 @@
 #include "core/bspline/knot_vector.h"
 #include "core/bspline/parametrization.h"
 #include "core/bspline/tensor_spline.h"
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 #include "core/grid/point_distribution.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
@@ -116,4 +116,4 @@ absl::StatusOr<Deviation> MeasureDeviation(const TensorSpline& spline,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_TENSOR_FIT_H_
+#endif  // SPLINEGRID_CORE_FIT_SOLVE_TENSOR_FIT_H_

@@ -16,16 +16,16 @@
 // Feature points (kinks such as a C-grid's trailing edge on its wake cut, see refinement.h) get
 // a knot of multiplicity order - 1 and a pinned control, so the fit passes through them exactly
 // and each side is smooth on its own.
-#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_FIT_H_
-#define SPLINEGRID_CORE_FIT_ADAPTIVE_FIT_H_
+#ifndef SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_FIT_H_
+#define SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_FIT_H_
 
 #include <array>
 #include <span>
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/fit/refinement.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/adaptive/refinement.h"
+#include "core/fit/solve/tensor_fit.h"
 
 namespace splinegrid {
 
@@ -67,4 +67,4 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_FIT_H_
+#endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_FIT_H_

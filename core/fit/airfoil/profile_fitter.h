@@ -32,8 +32,8 @@
 // |kappa| d <= ratio; FitAirfoil uses it when the unrestricted placement fails (airfoil_fit.h).
 // A solve costs O(m k^2) (banded QR); a projection O(k^2 + log n) per point and Newton step,
 // 2-4 steps from the previous foot.
-#ifndef SPLINEGRID_CORE_FIT_PROFILE_FITTER_H_
-#define SPLINEGRID_CORE_FIT_PROFILE_FITTER_H_
+#ifndef SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_FITTER_H_
+#define SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_FITTER_H_
 
 #include <algorithm>
 #include <limits>
@@ -42,7 +42,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/bspline/knot_vector.h"
-#include "core/fit/direction_fit.h"
+#include "core/fit/solve/direction_fit.h"
 #include "core/util/cancellation.h"
 
 namespace splinegrid {
@@ -160,4 +160,4 @@ absl::StatusOr<Fitted> FitAndMeasure(ProfileFitter& fitter, const std::vector<do
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_PROFILE_FITTER_H_
+#endif  // SPLINEGRID_CORE_FIT_AIRFOIL_PROFILE_FITTER_H_

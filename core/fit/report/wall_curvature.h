@@ -16,15 +16,15 @@
 //    which grows with every wiggle (the fairness measure of Farin & Sapidis, "Curvature and the
 //    fairness of curves and surfaces", IEEE CG&A 9(2), 1989).
 // Cost O(k^2) per sample plus the contraction of the control net onto each line.
-#ifndef SPLINEGRID_CORE_FIT_WALL_CURVATURE_H_
-#define SPLINEGRID_CORE_FIT_WALL_CURVATURE_H_
+#ifndef SPLINEGRID_CORE_FIT_REPORT_WALL_CURVATURE_H_
+#define SPLINEGRID_CORE_FIT_REPORT_WALL_CURVATURE_H_
 
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "core/bspline/evaluation.h"
-#include "core/fit/tensor_fit.h"
+#include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 
 namespace splinegrid {
@@ -70,4 +70,4 @@ CurvatureMetrics WallCurvatureMetrics(const std::vector<FittedBlock>& blocks,
 
 }  // namespace splinegrid
 
-#endif  // SPLINEGRID_CORE_FIT_WALL_CURVATURE_H_
+#endif  // SPLINEGRID_CORE_FIT_REPORT_WALL_CURVATURE_H_
