@@ -2,7 +2,18 @@
 
 namespace splinegrid::server {
 
-absl::StatusOr<std::shared_ptr<const Deformer>> DeformerCache::Get(
+absl::StatusOr<std::shared_ptr<const DeformationGate>> KeptDeformer::Gate(int level) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (const auto it = gates_.find(level); it != gates_.end()) return it->second;
+  absl::StatusOr<DeformationGate> made =
+      DeformationGate::Create(deformer_.reference(), deformer_.kinds(), level);
+  if (!made.ok()) return made.status();
+  auto gate = std::make_shared<const DeformationGate>(*std::move(made));
+  if (gate->num_cells() <= kMaxKeptGateCells) gates_[level] = gate;
+  return gate;
+}
+
+absl::StatusOr<std::shared_ptr<const KeptDeformer>> DeformerCache::Get(
     const std::string& key, const std::function<absl::StatusOr<Deformer>()>& make) {
   {
     std::lock_guard<std::mutex> lock(mu_);
@@ -14,7 +25,7 @@ absl::StatusOr<std::shared_ptr<const Deformer>> DeformerCache::Get(
   }
   absl::StatusOr<Deformer> made = make();
   if (!made.ok()) return made.status();
-  auto deformer = std::make_shared<const Deformer>(*std::move(made));
+  auto deformer = std::make_shared<const KeptDeformer>(*std::move(made));
   std::lock_guard<std::mutex> lock(mu_);
   entries_.emplace_front(key, deformer);
   while (static_cast<int>(entries_.size()) > capacity_) entries_.pop_back();

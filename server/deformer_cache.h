@@ -6,12 +6,14 @@
 
 #include <functional>
 #include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 
 #include "absl/status/statusor.h"
+#include "core/deform/deform_quality.h"
 #include "core/deform/deformer.h"
 
 namespace splinegrid::server {
@@ -19,13 +21,33 @@ namespace splinegrid::server {
 // The prefix of every DeformerCache key of grid `id` (server/ops/deform.cc makes the keys).
 inline std::string DeformerKeyPrefix(const std::string& id) { return id + "#"; }
 
+// A kept deformer and the fold gates made for it, one per check level, made on first use: the
+// reference at that level, its cells and wall angles are the same for every step.
+class KeptDeformer {
+ public:
+  // Gates of more reference cells than this (about 8-24 MB) are made for each call, not kept.
+  static constexpr int64_t kMaxKeptGateCells = int64_t{1} << 20;
+
+  explicit KeptDeformer(Deformer deformer) : deformer_(std::move(deformer)) {}
+
+  const Deformer& deformer() const { return deformer_; }
+
+  // The fold gate of `level` for the deformer's reference (DeformationGate::Create).
+  absl::StatusOr<std::shared_ptr<const DeformationGate>> Gate(int level) const;
+
+ private:
+  const Deformer deformer_;
+  mutable std::mutex mu_;
+  mutable std::map<int, std::shared_ptr<const DeformationGate>> gates_;
+};
+
 class DeformerCache {
  public:
   explicit DeformerCache(int capacity = 16) : capacity_(capacity) {}
 
   // The deformer of `key`, made by `make` (outside the lock) when it is not kept; the least
   // recently used entry goes when more than `capacity` are kept.
-  absl::StatusOr<std::shared_ptr<const Deformer>> Get(
+  absl::StatusOr<std::shared_ptr<const KeptDeformer>> Get(
       const std::string& key, const std::function<absl::StatusOr<Deformer>()>& make);
 
   // Drops every entry whose key starts with `prefix` (a deleted grid's).
@@ -38,7 +60,7 @@ class DeformerCache {
  private:
   const int capacity_;
   std::mutex mu_;
-  std::list<std::pair<std::string, std::shared_ptr<const Deformer>>> entries_;  // newest first
+  std::list<std::pair<std::string, std::shared_ptr<const KeptDeformer>>> entries_;  // newest first
 };
 
 }  // namespace splinegrid::server

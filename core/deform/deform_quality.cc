@@ -30,47 +30,29 @@ double LineAngle(const TensorSpline& spline, const Point3& uvw, int d, int e) {
 
 }  // namespace
 
-absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>& reference,
-                                                  const std::vector<FittedBlock>& deformed,
-                                                  const BoundaryKinds& kinds, int level,
-                                                  const CancelCheck& cancel) {
-  if (reference.size() != deformed.size()) {
-    return absl::InvalidArgumentError(absl::StrCat("the deformed grid has ", deformed.size(),
-                                                   " blocks, the reference ", reference.size()));
-  }
+absl::StatusOr<DeformationGate> DeformationGate::Create(const std::vector<FittedBlock>& reference,
+                                                        const BoundaryKinds& kinds, int level) {
   if (level < 0 || level > kMaxRefinementLevel) {
     return absl::InvalidArgumentError(
         absl::StrCat("level = ", level, " is outside [0, ", kMaxRefinementLevel, "]"));
   }
-  DeformationCheck check;
-  check.level = level;
-  CellQualityOptions options;
-  options.max_level = 0;
-  options.max_size_ratio = 1e300;  // only folds count here
-  options.max_reported_cells = 0;
-  options.cancel = cancel;
+  DeformationGate gate;
+  gate.level_ = level;
+  // The reference at the level: deformed cells are compared with its cells.
   for (size_t b = 0; b < reference.size(); ++b) {
     std::array<std::vector<double>, 3> params;
     for (int d = 0; d < 3; ++d) {
       const int m = reference[b].distribution.num_points(d);
       params[d] = reference[b].distribution.Refined(d, 0, m - 1, level);
     }
-    const StructuredBlock was = EvaluateGrid(reference[b].spline, params);
     SG_ASSIGN_OR_RETURN(PointDistribution at_level, PointDistribution::Create(params));
-    const FittedBlock now{deformed[b].spline, std::move(at_level), {}};
-    SG_ASSIGN_OR_RETURN(const CellQuality q, CheckCellQuality(now, was, options), "block ", b,
-                        ": ");
-    check.cells_checked += q.cells_checked;
-    check.folded += q.folded;
-    check.max_jacobian_ratio = std::max(check.max_jacobian_ratio, q.max_ratio);
-    if (q.cells_checked > 0 && q.min_ratio < check.min_jacobian_ratio) {
-      check.min_jacobian_ratio = q.min_ratio;
-      check.worst_block = static_cast<int>(b);
-      check.worst_cell = q.worst_cell;
-    }
+    SG_ASSIGN_OR_RETURN(CellReference cells,
+                        CellReference::Build(EvaluateGrid(reference[b].spline, params)), "block ",
+                        b, ": ");
+    gate.blocks_.push_back({std::move(at_level), std::move(cells)});
   }
+  // The wall lines' samples at the level and the reference's angles there.
   for (const WallLine& line : FindWallLines(reference, kinds)) {
-    SG_RETURN_IF_ERROR(PollCancel(cancel));
     const FittedBlock& ref = reference[line.block];
     const int d = line.direction;
     // The direction leaving the wall: the other active one of a planar block, the normal of
@@ -92,14 +74,64 @@ absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>
     for (int x = 0; x < 3; ++x) uvw[x] = ref.distribution.params(x)[line.start[x]];
     for (double t : u) {
       uvw[d] = t;
-      const double before = LineAngle(ref.spline, uvw, d, e);
-      const double after = LineAngle(deformed[line.block].spline, uvw, d, e);
-      check.max_orthogonality_change_degrees =
-          std::max(check.max_orthogonality_change_degrees, std::abs(after - before));
-      ++check.wall_samples;
+      gate.samples_.push_back({line.block, uvw, d, e, LineAngle(ref.spline, uvw, d, e)});
     }
   }
+  return gate;
+}
+
+int64_t DeformationGate::num_cells() const {
+  int64_t cells = 0;
+  for (const Block& block : blocks_) cells += block.cells.num_cells();
+  return cells;
+}
+
+absl::StatusOr<DeformationCheck> DeformationGate::Check(const std::vector<FittedBlock>& deformed,
+                                                        const CancelCheck& cancel) const {
+  if (blocks_.size() != deformed.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("the deformed grid has ", deformed.size(),
+                                                   " blocks, the reference ", blocks_.size()));
+  }
+  DeformationCheck check;
+  check.level = level_;
+  CellQualityOptions options;
+  options.max_level = 0;
+  options.max_size_ratio = 1e300;  // only folds count here
+  options.max_reported_cells = 0;
+  options.cancel = cancel;
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    const FittedBlock now{deformed[b].spline, blocks_[b].at_level, {}};
+    SG_ASSIGN_OR_RETURN(const CellQuality q, CheckCellQuality(now, blocks_[b].cells, options),
+                        "block ", b, ": ");
+    check.cells_checked += q.cells_checked;
+    check.folded += q.folded;
+    check.max_jacobian_ratio = std::max(check.max_jacobian_ratio, q.max_ratio);
+    if (q.cells_checked > 0 && q.min_ratio < check.min_jacobian_ratio) {
+      check.min_jacobian_ratio = q.min_ratio;
+      check.worst_block = static_cast<int>(b);
+      check.worst_cell = q.worst_cell;
+    }
+  }
+  SG_RETURN_IF_ERROR(PollCancel(cancel));
+  for (const WallSample& sample : samples_) {
+    const double after = LineAngle(deformed[sample.block].spline, sample.uvw, sample.d, sample.e);
+    check.max_orthogonality_change_degrees =
+        std::max(check.max_orthogonality_change_degrees, std::abs(after - sample.before));
+    ++check.wall_samples;
+  }
   return check;
+}
+
+absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>& reference,
+                                                  const std::vector<FittedBlock>& deformed,
+                                                  const BoundaryKinds& kinds, int level,
+                                                  const CancelCheck& cancel) {
+  if (reference.size() != deformed.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("the deformed grid has ", deformed.size(),
+                                                   " blocks, the reference ", reference.size()));
+  }
+  SG_ASSIGN_OR_RETURN(const DeformationGate gate, DeformationGate::Create(reference, kinds, level));
+  return gate.Check(deformed, cancel);
 }
 
 }  // namespace splinegrid

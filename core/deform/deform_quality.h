@@ -21,8 +21,10 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/fit/report/grid_quality.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
+#include "core/grid/point_distribution.h"
 #include "core/util/cancellation.h"
 
 namespace splinegrid {
@@ -41,9 +43,51 @@ struct DeformationCheck {
   bool ok() const { return folded == 0; }
 };
 
-// Compares `deformed` with `reference` (same blocks, same distributions) at `level`.
-// Errors: INVALID_ARGUMENT for blocks that do not correspond or a level outside
-// [0, kMaxRefinementLevel]; CANCELLED.
+// The check of deformations of one reference at one level, with what depends on the reference
+// alone computed once: the reference grid at that level and its cells (grid_quality.h
+// CellReference), the wall lines and their angles. A coupled simulation checks every step
+// against the same reference; then each check only evaluates the deformed grid.
+class DeformationGate {
+ public:
+  // Errors: INVALID_ARGUMENT for a level outside [0, kMaxRefinementLevel] or a reference the
+  // cell check refuses (non-finite points).
+  static absl::StatusOr<DeformationGate> Create(const std::vector<FittedBlock>& reference,
+                                                const BoundaryKinds& kinds, int level);
+
+  // Compares `deformed` (the reference's blocks moved: same blocks and distributions) with the
+  // reference. Errors: INVALID_ARGUMENT for blocks that do not correspond; CANCELLED.
+  absl::StatusOr<DeformationCheck> Check(const std::vector<FittedBlock>& deformed,
+                                         const CancelCheck& cancel = {}) const;
+
+  int level() const { return level_; }
+  // The reference cells held (for memory accounting: about 8-24 bytes each).
+  int64_t num_cells() const;
+
+ private:
+  // A block at the gate's level: its point distribution and reference cells.
+  struct Block {
+    PointDistribution at_level;
+    CellReference cells;
+  };
+  // A sample of a wall line: where, the wall direction d, the direction e leaving the wall, and
+  // the reference's angle between them.
+  struct WallSample {
+    int block = 0;
+    Point3 uvw;
+    int d = 0, e = 0;
+    double before = 0.0;
+  };
+
+  DeformationGate() = default;
+
+  int level_ = 0;
+  std::vector<Block> blocks_;
+  std::vector<WallSample> samples_;
+};
+
+// Compares `deformed` with `reference` (same blocks, same distributions) at `level`:
+// DeformationGate::Create then Check. Errors: INVALID_ARGUMENT for blocks that do not
+// correspond or a level outside [0, kMaxRefinementLevel]; CANCELLED.
 absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>& reference,
                                                   const std::vector<FittedBlock>& deformed,
                                                   const BoundaryKinds& kinds, int level,

@@ -110,7 +110,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   SG_ASSIGN_OR_RETURN(
       const std::shared_ptr<const GridRevision> reference,
       grid->ResolveRevision(request.reference_revision, std::nullopt, "reference_revision"));
-  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const Deformer> deformer,
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const KeptDeformer> kept,
                       context.deformers.Get(DeformerKey(*grid, reference->number, request.options),
                                             [&]() -> absl::StatusOr<Deformer> {
                                               std::vector<FittedBlock> blocks;
@@ -121,15 +121,17 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
                                                                       reference->kinds,
                                                                       request.options);
                                             }));
-  SG_ASSIGN_OR_RETURN(std::vector<FittedBlock> moved, ApplyMotion(*deformer, request.motion),
+  const Deformer& deformer = kept->deformer();
+  SG_ASSIGN_OR_RETURN(std::vector<FittedBlock> moved, ApplyMotion(deformer, request.motion),
                       std::holds_alternative<std::vector<BlockControlDisplacements>>(request.motion)
                           ? "controls."
                           : "");
-  SG_ASSIGN_OR_RETURN(const DeformationCheck check,
-                      CheckDeformation(deformer->reference(), moved, deformer->kinds(),
-                                       request.check_level, cancel));
+  // The fold gate of the reference at the check level is kept with the deformer.
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationGate> gate,
+                      kept->Gate(request.check_level));
+  SG_ASSIGN_OR_RETURN(const DeformationCheck check, gate->Check(moved, cancel));
   if (!check.ok()) return Folds(check);
-  GridRevision revision = DeformedRevision(*reference, *deformer, std::move(moved), check, request);
+  GridRevision revision = DeformedRevision(*reference, deformer, std::move(moved), check, request);
   revision.deform.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SG_ASSIGN_OR_RETURN(revision.memory,

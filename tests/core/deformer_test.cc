@@ -9,6 +9,7 @@
 #include "core/fit/adaptive/multiblock_fit.h"
 #include "core/fit/grid_fit.h"
 #include "core/io/planar_view.h"
+#include "core/grid/sampling.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -93,6 +94,44 @@ TEST_P(PitchTest, WallTurnsExactlyOuterStaysNoCellFolds) {
     EXPECT_LT(check.max_orthogonality_change_degrees, 1.0);
     EXPECT_GT(check.wall_samples, 60);
   }
+}
+
+// A gate made once checks every step like CheckDeformation: the same figures, bitwise, for
+// motions that keep the grid valid and for one that tears it, at levels 0 and 1.
+TEST(DeformationGateTest, AKeptGateChecksEveryStepLikeAFreshCheck) {
+  const Fitted f = FitShared("grids/n0012_225-65.p2dfmt");
+  DeformOptions tearing;
+  tearing.decay_radius = 0.3;  // everything a third of a chord away stays
+  const Deformer blend = Deformer::Create(f.blocks, f.kinds, DeformOptions()).value();
+  const Deformer tear = Deformer::Create(f.blocks, f.kinds, tearing).value();
+  const std::vector<std::vector<FittedBlock>> steps = {blend.Rigid(Pitch(2.0)).value(),
+                                                       blend.Rigid(Pitch(-5.0)).value(),
+                                                       tear.Rigid(Pitch(60.0)).value()};
+  for (int level : {0, 1}) {
+    const DeformationGate gate = DeformationGate::Create(f.blocks, f.kinds, level).value();
+    EXPECT_EQ(gate.level(), level);
+    EXPECT_EQ(gate.num_cells(), int64_t{224 << level} * (64 << level));
+    for (size_t s = 0; s < steps.size(); ++s) {
+      const DeformationCheck kept = gate.Check(steps[s]).value();
+      const DeformationCheck fresh = CheckDeformation(f.blocks, steps[s], f.kinds, level).value();
+      SCOPED_TRACE(::testing::Message() << "level " << level << ", step " << s);
+      EXPECT_EQ(kept.cells_checked, fresh.cells_checked);
+      EXPECT_EQ(kept.folded, fresh.folded);
+      EXPECT_EQ(kept.min_jacobian_ratio, fresh.min_jacobian_ratio);
+      EXPECT_EQ(kept.max_jacobian_ratio, fresh.max_jacobian_ratio);
+      EXPECT_EQ(kept.worst_cell, fresh.worst_cell);
+      EXPECT_EQ(kept.max_orthogonality_change_degrees, fresh.max_orthogonality_change_degrees);
+      EXPECT_EQ(kept.wall_samples, fresh.wall_samples);
+    }
+    EXPECT_EQ(gate.Check(steps[0]).value().folded, 0);
+    EXPECT_GT(gate.Check(steps[2]).value().folded, 0);  // checks leave no trace in the gate
+    EXPECT_EQ(gate.Check(steps[0]).value().folded, 0);
+  }
+  EXPECT_THAT(
+      DeformationGate::Create(f.blocks, f.kinds, kMaxRefinementLevel + 1).status().message(),
+      HasSubstr("is outside [0, "));
+  const DeformationGate gate = DeformationGate::Create(f.blocks, f.kinds, 0).value();
+  EXPECT_THAT(gate.Check({}).status().message(), HasSubstr("the deformed grid has 0 blocks"));
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedGrids, PitchTest,

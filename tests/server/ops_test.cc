@@ -116,5 +116,24 @@ TEST_F(OpsTest, RefusedDeformsStoreNothing) {
   EXPECT_EQ(Latest(), latest);
 }
 
+// A kept deformer keeps its fold gate per check level, unless the gate's reference is larger
+// than the cap: level 4 of the 224 x 64 cells is 3.7M cells, made for each call.
+TEST_F(OpsTest, KeptDeformersKeepTheirGatesUpToTheCap) {
+  const std::shared_ptr<const StoredGrid> grid = store_.Get("naca").value();
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  const GridFit fit = FitGrid(grid->source->grid, options).value();
+  std::vector<FittedBlock> blocks;
+  for (const BlockFit& b : fit.blocks) blocks.push_back(b.fitted);
+  const KeptDeformer kept(Deformer::Create(blocks, fit.kinds, DeformOptions()).value());
+  const auto level0 = kept.Gate(0).value();
+  EXPECT_EQ(kept.Gate(0).value(), level0);
+  EXPECT_EQ(level0->num_cells(), 224 * 64);
+  const auto level4 = kept.Gate(4).value();
+  EXPECT_GT(level4->num_cells(), KeptDeformer::kMaxKeptGateCells);
+  EXPECT_NE(kept.Gate(4).value(), level4);
+  EXPECT_EQ(kept.Gate(0).value(), level0);
+}
+
 }  // namespace
 }  // namespace splinegrid::server

@@ -249,13 +249,14 @@ int ChunkPoints(int stride, int fast, int fast_points, const Extents& controls,
 template <CellKind K>
 class CellChecker {
  public:
-  CellChecker(const FittedBlock& fitted, const StructuredBlock& original,
-              const std::array<int, 3>& active, int num_active, const CellQualityOptions& options)
+  CellChecker(const FittedBlock& fitted, const Reference& ref, const std::array<int, 3>& active,
+              int num_active, const CellQualityOptions& options)
       : fitted_(fitted),
         active_(active),
         num_active_(num_active),
         options_(options),
-        ref_(BuildReference<K>(original, MakeLayout(original.extents(), active, num_active))),
+        ref_(ref),
+        state_(ref.state),
         low_(1.0 / options.max_size_ratio),
         high_(options.max_size_ratio) {
     q_.folded_by_level.assign(options.max_level + 1, 0);
@@ -284,9 +285,9 @@ class CellChecker {
   // The quality after the levels were checked: the worst cell and the bad and folded cells.
   CellQuality Finish() {
     if (q_.cells_checked > 0) q_.worst_cell = ToCell(worst_parent_);
-    for (int64_t parent = 0; parent < static_cast<int64_t>(ref_.state.size()); ++parent) {
-      if (ref_.state[parent] != kBad && ref_.state[parent] != kFolded) continue;
-      if (ref_.state[parent] == kFolded) {
+    for (int64_t parent = 0; parent < static_cast<int64_t>(state_.size()); ++parent) {
+      if (state_[parent] != kBad && state_[parent] != kFolded) continue;
+      if (state_[parent] == kFolded) {
         ++q_.num_folded_cells;
         if (static_cast<int64_t>(q_.folded_cells.size()) < options_.max_reported_cells) {
           q_.folded_cells.push_back(ToCell(parent));
@@ -320,7 +321,7 @@ class CellChecker {
       ForEachCell<K>(lo.data(), hi.data(), layout, [&](int I, int J, const Corners& x) {
         const int64_t parent =
             parent_row + ((first + I) >> level) + int64_t{ref_.fast_cells} * (J >> level);
-        uint8_t& state = ref_.state[parent];
+        uint8_t& state = state_[parent];
         if (state == kSkipped) {
           ++q_.cells_skipped;
           return;
@@ -375,18 +376,19 @@ class CellChecker {
   const std::array<int, 3> active_;
   const int num_active_;
   const CellQualityOptions& options_;
-  Reference ref_;
-  const double low_, high_;  // the size ratios allowed
+  const Reference& ref_;
+  std::vector<uint8_t> state_;  // ref_.state, then marked bad or folded by this check
+  const double low_, high_;     // the size ratios allowed
   CellQuality q_;
   int64_t worst_parent_ = 0;
 };
 
-// The cell quality of `fitted` against `original` (CheckCellQuality after its checks).
+// The cell quality of `fitted` against `ref` (CheckCellQuality after its checks).
 template <CellKind K>
-absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const StructuredBlock& original,
+absl::StatusOr<CellQuality> Check(const FittedBlock& fitted, const Reference& ref,
                                   const std::array<int, 3>& active, int num_active,
                                   const CellQualityOptions& options) {
-  CellChecker<K> checker(fitted, original, active, num_active, options);
+  CellChecker<K> checker(fitted, ref, active, num_active, options);
   for (int level = 0; level <= options.max_level; ++level) {
     SG_RETURN_IF_ERROR(checker.CheckLevel(level));
   }
@@ -441,41 +443,97 @@ absl::Status CellQualityOptions::Validate() const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
-                                             const StructuredBlock& original,
-                                             const CellQualityOptions& options) {
-  SG_RETURN_IF_ERROR(options.Validate());
+namespace {
+
+// OK if `fitted` is a fit of a block of `extents` and `spatial_dim`; INVALID_ARGUMENT naming both.
+absl::Status CheckFitOf(const FittedBlock& fitted, const Extents& extents, int spatial_dim) {
   Extents fitted_extents;
   for (int d = 0; d < 3; ++d) fitted_extents[d] = fitted.distribution.num_points(d);
-  if (fitted_extents != original.extents()) {
+  if (fitted_extents != extents) {
     return absl::InvalidArgumentError(
         absl::StrCat("fitted block has extents ", ExtentsString(fitted_extents),
-                     " but the original block has ", ExtentsString(original.extents())));
+                     " but the original block has ", ExtentsString(extents)));
   }
-  if (fitted.spline.spatial_dim() != original.spatial_dim()) {
+  if (fitted.spline.spatial_dim() != spatial_dim) {
     return absl::InvalidArgumentError(
         absl::StrCat("fitted block has spatial_dim ", fitted.spline.spatial_dim(),
-                     " but the original block has spatial_dim ", original.spatial_dim()));
+                     " but the original block has spatial_dim ", spatial_dim));
   }
-  SG_RETURN_IF_ERROR(ValidateFinite(original, "original block"));
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+// The reference cells and how a block's directions map onto them.
+struct CellReference::Cells {
+  Extents extents;
+  int spatial_dim = 0;
   std::array<int, 3> active = {0, 0, 0};
   int num_active = 0;
+  CellKind kind = CellKind::kPlanar;
+  Reference ref;  // empty for points and curves (no cells)
+};
+
+absl::StatusOr<CellReference> CellReference::Build(const StructuredBlock& original) {
+  SG_RETURN_IF_ERROR(ValidateFinite(original, "original block"));
+  auto cells = std::make_shared<Cells>();
+  cells->extents = original.extents();
+  cells->spatial_dim = original.spatial_dim();
   for (int d = 0; d < 3; ++d) {
-    if (original.extent(d) > 1) active[num_active++] = d;
+    if (original.extent(d) > 1) cells->active[cells->num_active++] = d;
   }
-  if (num_active < 2) return CellQuality{};  // points and curves have no cells
+  const std::array<int, 3>& active = cells->active;
+  const int num_active = cells->num_active;
+  if (num_active < 2) return CellReference(std::move(cells));  // points and curves: no cells
+  const RowLayout layout = MakeLayout(original.extents(), active, num_active);
   if (num_active == 3) {
     if (original.spatial_dim() != 3) {
       return absl::InvalidArgumentError(
           absl::StrCat("block of ", ExtentsString(original.extents()),
                        " points has three active directions but spatial_dim 2; volumes need 3"));
     }
-    return Check<CellKind::kVolume>(fitted, original, active, num_active, options);
+    cells->kind = CellKind::kVolume;
+    cells->ref = BuildReference<CellKind::kVolume>(original, layout);
+  } else if (original.spatial_dim() == 2) {
+    cells->kind = CellKind::kPlanar;
+    cells->ref = BuildReference<CellKind::kPlanar>(original, layout);
+  } else {
+    cells->kind = CellKind::kSurface;
+    cells->ref = BuildReference<CellKind::kSurface>(original, layout);
   }
-  if (original.spatial_dim() == 2) {
-    return Check<CellKind::kPlanar>(fitted, original, active, num_active, options);
+  return CellReference(std::move(cells));
+}
+
+const Extents& CellReference::extents() const { return cells_->extents; }
+int CellReference::spatial_dim() const { return cells_->spatial_dim; }
+int64_t CellReference::num_cells() const { return cells_->ref.state.size(); }
+
+absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
+                                             const CellReference& reference,
+                                             const CellQualityOptions& options) {
+  SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(CheckFitOf(fitted, reference.extents(), reference.spatial_dim()));
+  const CellReference::Cells& cells = *reference.cells_;
+  if (cells.num_active < 2) return CellQuality{};  // points and curves have no cells
+  switch (cells.kind) {
+    case CellKind::kVolume:
+      return Check<CellKind::kVolume>(fitted, cells.ref, cells.active, cells.num_active, options);
+    case CellKind::kPlanar:
+      return Check<CellKind::kPlanar>(fitted, cells.ref, cells.active, cells.num_active, options);
+    case CellKind::kSurface:
+      break;
   }
-  return Check<CellKind::kSurface>(fitted, original, active, num_active, options);
+  return Check<CellKind::kSurface>(fitted, cells.ref, cells.active, cells.num_active, options);
+}
+
+absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
+                                             const StructuredBlock& original,
+                                             const CellQualityOptions& options) {
+  // The checks of the options and shapes come first, as before the reference is built.
+  SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(CheckFitOf(fitted, original.extents(), original.spatial_dim()));
+  SG_ASSIGN_OR_RETURN(const CellReference reference, CellReference::Build(original));
+  return CheckCellQuality(fitted, reference, options);
 }
 
 double PlanarCellArea(const std::array<Point3, 4>& corners) {
