@@ -1,8 +1,10 @@
 #include "server/grid_store.h"
 
 #include <algorithm>
+#include <random>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 
 namespace splinegrid::server {
 
@@ -168,6 +170,17 @@ std::vector<int64_t> DeformRevisionsBeyond(
     }
   }
   return dropped;
+}
+
+absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
+                        const std::shared_ptr<StoredGrid>& grid) {
+  std::mt19937_64 random(std::random_device{}());
+  for (int attempt = 0;; ++attempt) {
+    grid->id = requested_id.empty() ? absl::StrFormat("grid-%08x", static_cast<uint32_t>(random()))
+                                    : requested_id;
+    const absl::Status created = store.Create(grid);
+    if (created.ok() || !requested_id.empty() || attempt == 8) return created;
+  }
 }
 
 }  // namespace splinegrid::server

@@ -261,6 +261,12 @@ class GridStore {
 std::vector<int64_t> DeformRevisionsBeyond(
     const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions);
 
+// Adds `grid` to `store` under `requested_id`, or, when that is empty, under a random id
+// "grid-xxxxxxxx" (retrying a few collisions); sets grid->id. ALREADY_EXISTS for a taken
+// requested id.
+absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
+                        const std::shared_ptr<StoredGrid>& grid);
+
 }  // namespace splinegrid::server
 
 #endif  // SPLINEGRID_SERVER_GRID_STORE_H_

@@ -1,12 +1,10 @@
 #include "server/service.h"
 
 #include <chrono>
-#include <random>
 #include <thread>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 #include "core/bspline/evaluation.h"
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
@@ -40,8 +38,8 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
   constexpr size_t kMaxMessage = 4096;
   std::string message(status.message());
   if (message.size() > kMaxMessage) {
-    message = absl::StrCat(message.substr(0, kMaxMessage), "... (", status.message().size(),
-                           " bytes)");
+    message =
+        absl::StrCat(message.substr(0, kMaxMessage), "... (", status.message().size(), " bytes)");
   }
   return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::move(message));
 }
@@ -65,17 +63,6 @@ absl::Status ExplainCancellation(const ServiceState& state, grpc::CallbackServer
                                  absl::Status status) {
   if (status.code() != absl::StatusCode::kCancelled) return status;
   return WhyCallEnded(state, context);
-}
-
-absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
-                        const std::shared_ptr<StoredGrid>& grid) {
-  std::mt19937_64 random(std::random_device{}());
-  for (int attempt = 0;; ++attempt) {
-    grid->id = requested_id.empty() ? absl::StrFormat("grid-%08x", static_cast<uint32_t>(random()))
-                                    : requested_id;
-    const absl::Status created = store.Create(grid);
-    if (created.ok() || !requested_id.empty() || attempt == 8) return created;
-  }
 }
 
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field) {
@@ -181,9 +168,9 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
     std::string after;
     if (!request->page_token().empty() &&
         (!absl::WebSafeBase64Unescape(request->page_token(), &after) || !IsValidGridId(after))) {
-      return absl::InvalidArgumentError(absl::StrCat("page_token = ",
-                                                     QuoteClientString(request->page_token()),
-                                                     " is not a token of ListGrids"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("page_token = ", QuoteClientString(request->page_token()),
+                       " is not a token of ListGrids"));
     }
     bool more = false;
     SG_ASSIGN_OR_RETURN(const auto page, state_->store->List(after, size == 0 ? 50 : size, &more));

@@ -76,12 +76,6 @@ absl::Status ExplainCancellation(const ServiceState& state, grpc::CallbackServer
 // "grids/{id}" -> id, or INVALID_ARGUMENT naming `field` and the value.
 absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::string& field);
 
-// Adds `grid` to `store` under `requested_id`, or, when that is empty, under a random id
-// "grid-xxxxxxxx" (retrying a few collisions); sets grid->id. ALREADY_EXISTS for a taken
-// requested id.
-absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
-                        const std::shared_ptr<StoredGrid>& grid);
-
 // The optional `step` field of a request that selects a revision.
 template <typename Request>
 std::optional<int64_t> OptionalStep(const Request& request) {
@@ -159,10 +153,6 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, const Work& work);
-
-  // GenerateGrid's work, on the pool; the new grid belongs to `owner` (Caller::owner()).
-  absl::Status Generate(const v1::GenerateGridRequest& request, const std::string& owner,
-                        const CancelCheck& cancel, v1::GenerateGridResponse* response);
 
   // The operations' view of the state (server/ops).
   ops::OpsContext Ops() const { return {*state_->store, state_->budget, state_->deformers}; }

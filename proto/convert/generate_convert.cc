@@ -78,9 +78,9 @@ absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& poin
   return block;
 }
 
-void EncodeGenerationReport(const ProfileGrid& grid, int64_t profile_points,
+void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int64_t profile_points,
                             v1::GenerationReport* out) {
-  EncodeExtents(grid.block.extents(), out->mutable_extents());
+  EncodeExtents(extents, out->mutable_extents());
   v1::ProfileFitReport* profile = out->mutable_profile();
   profile->set_num_points(static_cast<int32_t>(profile_points));
   profile->set_num_control_points(grid.profile.num_control_points);

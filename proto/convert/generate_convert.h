@@ -25,8 +25,9 @@ void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGri
 absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& points,
                                                    const std::string& field);
 
-// The report of a generated grid, apart from `parameters` and `seconds`.
-void EncodeGenerationReport(const ProfileGrid& grid, int64_t profile_points,
+// The report of a generated grid of `extents` (`grid`'s block, which may have been moved on),
+// apart from `parameters` and `seconds`.
+void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int64_t profile_points,
                             v1::GenerationReport* out);
 
 }  // namespace splinegrid
