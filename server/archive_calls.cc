@@ -124,10 +124,11 @@ absl::Status CheckConnectivity(const SourcePoints& source) {
   if (stored.SerializeAsString() != expected.SerializeAsString()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "header.connectivity does not match the archive's source points: it lists ",
-        source.connectivity.matches.size(), " block boundary match(es), the points have ",
+        source.connectivity.matches.size(), " block boundary match(es), this server finds ",
         found.matches.size(),
         source.connectivity.matches.size() == found.matches.size() ? " other ones" : "",
-        "; the archive was changed or damaged"));
+        " in the points; the archive was changed or damaged, or written by a release that "
+        "matched boundaries differently (export it again from that server)"));
   }
   return absl::OkStatus();
 }

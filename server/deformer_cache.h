@@ -15,6 +15,7 @@
 #include "absl/status/statusor.h"
 #include "core/deform/deform_quality.h"
 #include "core/deform/deformer.h"
+#include "server/memory_budget.h"
 
 namespace splinegrid::server {
 
@@ -32,8 +33,12 @@ class KeptDeformer {
 
   const Deformer& deformer() const { return deformer_; }
 
-  // The fold gate of `level` for the deformer's reference (DeformationGate::Create).
-  absl::StatusOr<std::shared_ptr<const DeformationGate>> Gate(int level) const;
+  // The fold gate of `level` for the deformer's reference (DeformationGate::Create, built
+  // without holding the lock and polling `cancel`). Its bytes are charged to `budget` for as
+  // long as it is held (RESOURCE_EXHAUSTED when the budget refuses them); a gate within
+  // kMaxKeptGateCells is kept, and so held, until the deformer goes.
+  absl::StatusOr<std::shared_ptr<const DeformationGate>> Gate(int level, MemoryBudget& budget,
+                                                              const CancelCheck& cancel = {}) const;
 
  private:
   const Deformer deformer_;

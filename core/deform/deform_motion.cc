@@ -1,5 +1,6 @@
 #include "core/deform/deform_motion.h"
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <utility>
@@ -37,7 +38,14 @@ absl::StatusOr<std::vector<double>> DisplacementsInDeformerOrder(
             field, ".controls[", q, "] = ", block.controls[q],
             " does not carry the moved boundary (or is no control of block ", block.block, ")"));
       }
-      for (int c = 0; c < s; ++c) out[s * it->second + c] = block.values[s * q + c];
+      for (int c = 0; c < s; ++c) {
+        const double value = block.values[s * q + c];
+        if (!std::isfinite(value)) {
+          return absl::InvalidArgumentError(
+              absl::StrCat(field, ".values[", s * q + c, "] = ", value, " is not finite"));
+        }
+        out[s * it->second + c] = value;
+      }
     }
   }
   return out;

@@ -33,7 +33,8 @@ absl::StatusOr<std::vector<FittedBlock>> ApplyMotion(const Deformer& deformer,
 
 // `given` in the order Deformer::DisplaceControls takes (deformer.moved_controls(); controls not
 // given stay). INVALID_ARGUMENT naming blocks[e] for a block outside the grid, a count of values
-// that does not match the controls, or a control that does not carry the moved boundary.
+// that does not match the controls, a control that does not carry the moved boundary, or a
+// non-finite value.
 absl::StatusOr<std::vector<double>> DisplacementsInDeformerOrder(
     const Deformer& deformer, std::span<const BlockControlDisplacements> given);
 

@@ -31,7 +31,8 @@ double LineAngle(const TensorSpline& spline, const Point3& uvw, int d, int e) {
 }  // namespace
 
 absl::StatusOr<DeformationGate> DeformationGate::Create(const std::vector<FittedBlock>& reference,
-                                                        const BoundaryKinds& kinds, int level) {
+                                                        const BoundaryKinds& kinds, int level,
+                                                        const CancelCheck& cancel) {
   if (level < 0 || level > kMaxRefinementLevel) {
     return absl::InvalidArgumentError(
         absl::StrCat("level = ", level, " is outside [0, ", kMaxRefinementLevel, "]"));
@@ -40,6 +41,7 @@ absl::StatusOr<DeformationGate> DeformationGate::Create(const std::vector<Fitted
   gate.level_ = level;
   // The reference at the level: deformed cells are compared with its cells.
   for (size_t b = 0; b < reference.size(); ++b) {
+    SG_RETURN_IF_ERROR(PollCancel(cancel));
     std::array<std::vector<double>, 3> params;
     for (int d = 0; d < 3; ++d) {
       const int m = reference[b].distribution.num_points(d);
@@ -53,6 +55,7 @@ absl::StatusOr<DeformationGate> DeformationGate::Create(const std::vector<Fitted
   }
   // The wall lines' samples at the level and the reference's angles there.
   for (const WallLine& line : FindWallLines(reference, kinds)) {
+    SG_RETURN_IF_ERROR(PollCancel(cancel));
     const FittedBlock& ref = reference[line.block];
     const int d = line.direction;
     // The direction leaving the wall: the other active one of a planar block, the normal of
@@ -84,6 +87,15 @@ int64_t DeformationGate::num_cells() const {
   int64_t cells = 0;
   for (const Block& block : blocks_) cells += block.cells.num_cells();
   return cells;
+}
+
+int64_t DeformationGate::bytes() const {
+  int64_t bytes = sizeof(DeformationGate) + samples_.size() * sizeof(WallSample);
+  for (const Block& block : blocks_) {
+    bytes += block.cells.bytes();
+    for (int d = 0; d < 3; ++d) bytes += block.at_level.num_points(d) * int64_t{sizeof(double)};
+  }
+  return bytes;
 }
 
 absl::StatusOr<DeformationCheck> DeformationGate::Check(const std::vector<FittedBlock>& deformed,
@@ -130,7 +142,8 @@ absl::StatusOr<DeformationCheck> CheckDeformation(const std::vector<FittedBlock>
     return absl::InvalidArgumentError(absl::StrCat("the deformed grid has ", deformed.size(),
                                                    " blocks, the reference ", reference.size()));
   }
-  SG_ASSIGN_OR_RETURN(const DeformationGate gate, DeformationGate::Create(reference, kinds, level));
+  SG_ASSIGN_OR_RETURN(const DeformationGate gate,
+                      DeformationGate::Create(reference, kinds, level, cancel));
   return gate.Check(deformed, cancel);
 }
 

@@ -50,9 +50,10 @@ struct DeformationCheck {
 class DeformationGate {
  public:
   // Errors: INVALID_ARGUMENT for a level outside [0, kMaxRefinementLevel] or a reference the
-  // cell check refuses (non-finite points).
+  // cell check refuses (non-finite points); CANCELLED (`cancel` is polled per block and line).
   static absl::StatusOr<DeformationGate> Create(const std::vector<FittedBlock>& reference,
-                                                const BoundaryKinds& kinds, int level);
+                                                const BoundaryKinds& kinds, int level,
+                                                const CancelCheck& cancel = {});
 
   // Compares `deformed` (the reference's blocks moved: same blocks and distributions) with the
   // reference. Errors: INVALID_ARGUMENT for blocks that do not correspond; CANCELLED.
@@ -60,8 +61,9 @@ class DeformationGate {
                                          const CancelCheck& cancel = {}) const;
 
   int level() const { return level_; }
-  // The reference cells held (for memory accounting: about 8-24 bytes each).
+  // The reference cells held, and the bytes of everything held (about 9-25 per cell).
   int64_t num_cells() const;
+  int64_t bytes() const;
 
  private:
   // A block at the gate's level: its point distribution and reference cells.

@@ -17,7 +17,7 @@ namespace splinegrid {
 absl::StatusOr<DeformOptions> ParseDeformOptions(const v1::DeformGridRequest& request);
 
 // The displacements of a ControlMotion as given, block by block (checked against a deformer by
-// DisplacementsInDeformerOrder, core/deform/control_motion.h).
+// DisplacementsInDeformerOrder, core/deform/deform_motion.h).
 std::vector<BlockControlDisplacements> ParseControlMotion(const v1::ControlMotion& motion);
 
 // The request's motion (rigid, controls or boundary_points); INVALID_ARGUMENT when it is unset

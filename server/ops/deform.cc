@@ -122,13 +122,15 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
                                                                       request.options);
                                             }));
   const Deformer& deformer = kept->deformer();
+  // A control motion's errors all name its entries (DisplacementsInDeformerOrder checks the
+  // values before the deformer sees them): prefixed with the request's field.
   SG_ASSIGN_OR_RETURN(std::vector<FittedBlock> moved, ApplyMotion(deformer, request.motion),
                       std::holds_alternative<std::vector<BlockControlDisplacements>>(request.motion)
                           ? "controls."
                           : "");
   // The fold gate of the reference at the check level is kept with the deformer.
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationGate> gate,
-                      kept->Gate(request.check_level));
+                      kept->Gate(request.check_level, context.budget, cancel));
   SG_ASSIGN_OR_RETURN(const DeformationCheck check, gate->Check(moved, cancel));
   if (!check.ok()) return Folds(check);
   GridRevision revision = DeformedRevision(*reference, deformer, std::move(moved), check, request);

@@ -96,6 +96,11 @@ absl::StatusOr<ProfilePoints> StoredWallProfile(GridStore& store, const StoredWa
   return out;
 }
 
+// The points of the generated block: wall_points * (layers + 1), in 64 bits.
+int64_t GeneratedPoints(const ProfileGridOptions& options) {
+  return int64_t{options.wall_points} * (int64_t{options.layers} + 1);
+}
+
 // The checks that need no work: the id, the name, the size.
 absl::Status CheckRequest(const OpsContext& context, const GenerateRequest& request) {
   const std::string& id = request.grid_id;
@@ -110,7 +115,7 @@ absl::Status CheckRequest(const OpsContext& context, const GenerateRequest& requ
   if (!id.empty() && context.store.Get(id).ok()) {  // fail early; Create decides in the end
     return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
   }
-  const int64_t points = int64_t{request.options.wall_points} * (request.options.layers + 1);
+  const int64_t points = GeneratedPoints(request.options);
   if (points > request.max_points) {
     return absl::OutOfRangeError(absl::StrCat("wall_points * (layers + 1) = ", points,
                                               " points, more than the server's cap of ",
@@ -137,7 +142,7 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
   // The generated block, as the source points of the new grid.
   GenerateResult result;
   auto source = std::make_shared<SourcePoints>();
-  const int64_t points = int64_t{request.options.wall_points} * (request.options.layers + 1);
+  const int64_t points = GeneratedPoints(request.options);
   SG_ASSIGN_OR_RETURN(source->memory, context.budget.Reserve(points * 2 * int64_t{sizeof(double)},
                                                              "the generated grid"));
   request.options.cancel = cancel;

@@ -5,11 +5,12 @@
 #include <cmath>
 
 #include "core/bspline/evaluation.h"
+#include "core/deform/deform_motion.h"
 #include "core/deform/deform_quality.h"
 #include "core/fit/adaptive/multiblock_fit.h"
 #include "core/fit/grid_fit.h"
-#include "core/io/planar_view.h"
 #include "core/grid/sampling.h"
+#include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -132,6 +133,28 @@ TEST(DeformationGateTest, AKeptGateChecksEveryStepLikeAFreshCheck) {
       HasSubstr("is outside [0, "));
   const DeformationGate gate = DeformationGate::Create(f.blocks, f.kinds, 0).value();
   EXPECT_THAT(gate.Check({}).status().message(), HasSubstr("the deformed grid has 0 blocks"));
+}
+
+// Control displacements named by block and control index reach the deformer in its order; a
+// non-finite value is refused naming its entry, not the deformer's internal index.
+TEST(DeformMotionTest, ControlDisplacementsAreMappedAndChecked) {
+  const Fitted f = FitShared("grids/n0012_225-65.p2dfmt");
+  const Deformer deformer = Deformer::Create(f.blocks, f.kinds, DeformOptions()).value();
+  ASSERT_GE(deformer.moved_controls().size(), 2u);
+  const auto [block, control] = deformer.moved_controls()[1];
+  const std::vector<BlockControlDisplacements> given = {{block, {control}, {0.5, -0.25}}};
+  const std::vector<double> ordered = DisplacementsInDeformerOrder(deformer, given).value();
+  ASSERT_EQ(ordered.size(), 2 * deformer.moved_controls().size());
+  EXPECT_EQ(ordered[2], 0.5);
+  EXPECT_EQ(ordered[3], -0.25);
+  EXPECT_EQ(ordered[0], 0.0);  // not given: stays
+  const std::vector<BlockControlDisplacements> nan = {{block, {control}, {0.5, std::nan("")}}};
+  EXPECT_THAT(DisplacementsInDeformerOrder(deformer, nan).status().message(),
+              HasSubstr("blocks[0].values[1] = nan is not finite"));
+  const std::vector<BlockControlDisplacements> odd = {{block, {control}, {0.5}}};
+  EXPECT_THAT(DisplacementsInDeformerOrder(deformer, odd).status().message(),
+              HasSubstr("blocks[0]: 1 values for 1 controls of 2 coordinates"));
+  EXPECT_TRUE(ApplyMotion(deformer, DeformMotion(given)).ok());
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedGrids, PitchTest,

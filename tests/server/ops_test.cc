@@ -116,23 +116,41 @@ TEST_F(OpsTest, RefusedDeformsStoreNothing) {
   EXPECT_EQ(Latest(), latest);
 }
 
-// A kept deformer keeps its fold gate per check level, unless the gate's reference is larger
-// than the cap: level 4 of the 224 x 64 cells is 3.7M cells, made for each call.
-TEST_F(OpsTest, KeptDeformersKeepTheirGatesUpToTheCap) {
+// A kept deformer keeps its fold gate per check level, charged to the memory budget until the
+// deformer goes, unless the gate's reference is larger than the cap (level 4 of the 224 x 64
+// cells is 3.7M cells): then it is made for each call and charged while the call holds it. A
+// budget that cannot hold the gate refuses the call, naming the gate.
+TEST_F(OpsTest, KeptDeformersKeepTheirGatesWithinTheCapAndChargeTheBudget) {
   const std::shared_ptr<const StoredGrid> grid = store_.Get("naca").value();
   GridFitOptions options;
   options.boundary_tolerances = BoundaryTolerances();
   const GridFit fit = FitGrid(grid->source->grid, options).value();
   std::vector<FittedBlock> blocks;
   for (const BlockFit& b : fit.blocks) blocks.push_back(b.fitted);
-  const KeptDeformer kept(Deformer::Create(blocks, fit.kinds, DeformOptions()).value());
-  const auto level0 = kept.Gate(0).value();
-  EXPECT_EQ(kept.Gate(0).value(), level0);
-  EXPECT_EQ(level0->num_cells(), 224 * 64);
-  const auto level4 = kept.Gate(4).value();
-  EXPECT_GT(level4->num_cells(), KeptDeformer::kMaxKeptGateCells);
-  EXPECT_NE(kept.Gate(4).value(), level4);
-  EXPECT_EQ(kept.Gate(0).value(), level0);
+  const Deformer deformer = Deformer::Create(blocks, fit.kinds, DeformOptions()).value();
+  const int64_t before = budget_.used();
+  {
+    const KeptDeformer kept(deformer);
+    const auto level0 = kept.Gate(0, budget_).value();
+    EXPECT_EQ(kept.Gate(0, budget_).value(), level0);
+    EXPECT_EQ(level0->num_cells(), 224 * 64);
+    EXPECT_GT(level0->bytes(), 224 * 64 * 9);
+    EXPECT_EQ(budget_.used() - before, level0->bytes());
+    {
+      const auto level4 = kept.Gate(4, budget_).value();
+      EXPECT_GT(level4->num_cells(), KeptDeformer::kMaxKeptGateCells);
+      EXPECT_EQ(budget_.used() - before, level0->bytes() + level4->bytes());
+      EXPECT_NE(kept.Gate(4, budget_).value(), level4);
+    }
+    EXPECT_EQ(budget_.used() - before, level0->bytes());  // the call's gate went with it
+  }
+  EXPECT_EQ(budget_.used(), before);  // the kept one went with the deformer
+  MemoryBudget tight(1000);
+  const KeptDeformer kept(deformer);
+  const absl::Status refused = kept.Gate(0, tight).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted) << refused;
+  EXPECT_THAT(refused.message(), HasSubstr("the fold gate of check_level 0"));
+  EXPECT_EQ(tight.used(), 0);
 }
 
 }  // namespace

@@ -507,6 +507,10 @@ absl::StatusOr<CellReference> CellReference::Build(const StructuredBlock& origin
 const Extents& CellReference::extents() const { return cells_->extents; }
 int CellReference::spatial_dim() const { return cells_->spatial_dim; }
 int64_t CellReference::num_cells() const { return cells_->ref.state.size(); }
+int64_t CellReference::bytes() const {
+  return static_cast<int64_t>(sizeof(Cells) + cells_->ref.weight.size() * sizeof(double) +
+                              cells_->ref.state.size());
+}
 
 absl::StatusOr<CellQuality> CheckCellQuality(const FittedBlock& fitted,
                                              const CellReference& reference,

@@ -143,6 +143,8 @@ class CellReference {
   const Extents& extents() const;
   int spatial_dim() const;
   int64_t num_cells() const;
+  // The bytes it holds.
+  int64_t bytes() const;
 
   struct Cells;  // defined in grid_quality.cc
 
