@@ -79,10 +79,15 @@ absl::StatusOr<std::shared_ptr<const KeptDeformer>> DeformerCache::Get(
   return deformer;
 }
 
-bool DeformerCache::HasAny(const std::string& prefix) {
+bool KeptDeformer::HasGate(int level) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return gates_.contains(level);
+}
+
+bool DeformerCache::HasReady(const std::string& prefix, int level) {
   std::lock_guard<std::mutex> lock(mu_);
   for (const auto& entry : entries_) {
-    if (entry.first.rfind(prefix, 0) == 0) return true;
+    if (entry.first.rfind(prefix, 0) == 0 && entry.second->HasGate(level)) return true;
   }
   return false;
 }

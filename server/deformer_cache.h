@@ -33,6 +33,9 @@ class KeptDeformer {
 
   const Deformer& deformer() const { return deformer_; }
 
+  // Whether the gate of `level` is kept.
+  bool HasGate(int level) const;
+
   // The fold gate of `level` for the deformer's reference (DeformationGate::Create, built
   // without holding the lock and polling `cancel`). Its bytes are charged to `budget` for as
   // long as it is held (RESOURCE_EXHAUSTED when the budget refuses them); a gate within
@@ -58,9 +61,9 @@ class DeformerCache {
   // Drops every entry whose key starts with `prefix` (a deleted grid's).
   void Forget(const std::string& prefix);
 
-  // Whether an entry whose key starts with `prefix` is kept (for the scheduler: a deform whose
-  // deformer is kept is cheap work).
-  bool HasAny(const std::string& prefix);
+  // Whether an entry whose key starts with `prefix` is kept with its fold gate of `level` (for
+  // the scheduler: a deform whose deformer and gate are kept is cheap work).
+  bool HasReady(const std::string& prefix, int level);
 
  private:
   const int capacity_;

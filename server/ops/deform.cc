@@ -88,8 +88,9 @@ GridRevision DeformedRevision(const GridRevision& reference, const Deformer& def
 
 bool HasKeptDeformer(const OpsContext& context, const DeformRequest& request) {
   return request.reference_revision > 0 &&
-         context.deformers.HasAny(
-             ShapeKey(request.grid_id, request.reference_revision, request.options));
+         context.deformers.HasReady(
+             ShapeKey(request.grid_id, request.reference_revision, request.options),
+             request.check_level);
 }
 
 absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& context,

@@ -33,9 +33,10 @@ struct DeformRequest {
   int64_t step = 0;
 };
 
-// Whether the deformer `request` needs is kept: its deform then costs about a millisecond
-// (cheap work), while building one factorises the boundary fits (up to seconds). False for
-// reference_revision 0 (the latest is only known once the grid is read).
+// Whether the deformer `request` needs is kept with the fold gate of its check level: its
+// deform then costs about half a millisecond (cheap work), while building them factorises the
+// boundary fits and evaluates the reference (up to seconds). False for reference_revision 0
+// (the latest is only known once the grid is read).
 bool HasKeptDeformer(const OpsContext& context, const DeformRequest& request);
 
 // Deforms and publishes; the published revision. Errors: NOT_FOUND for the grid or the

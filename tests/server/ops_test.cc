@@ -81,11 +81,17 @@ TEST_F(OpsTest, FitFairAndDeformPublishRevisions) {
   EXPECT_EQ((*deformed)->parent, 1);
   EXPECT_EQ((*deformed)->step, 7);
   EXPECT_EQ((*deformed)->deform.check.folded, 0);
-  // The deformer is kept for the same reference and options; other options need their own.
+  // The deformer is kept for the same reference and options with the gate of its check level;
+  // other options need their own, and so does another level's gate.
   EXPECT_TRUE(ops::HasKeptDeformer(ops_, Pitch(2.0)));
   ops::DeformRequest wider = Pitch(2.0);
   wider.options.decay_radius = 3.0;
   EXPECT_FALSE(ops::HasKeptDeformer(ops_, wider));
+  ops::DeformRequest finer = Pitch(2.0);
+  finer.check_level = 1;
+  EXPECT_FALSE(ops::HasKeptDeformer(ops_, finer));
+  ASSERT_TRUE(ops::Deform(ops_, finer, {}).ok());
+  EXPECT_TRUE(ops::HasKeptDeformer(ops_, finer));
 }
 
 TEST_F(OpsTest, RefusedDeformsStoreNothing) {
