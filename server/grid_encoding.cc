@@ -145,4 +145,24 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   return absl::OkStatus();
 }
 
+void EncodeWallCurvature(const ops::WallCurvatureResult& result,
+                         v1::GetWallCurvatureResponse* out) {
+  out->set_revision(result.revision);
+  out->set_spatial_dim(result.spatial_dim);
+  const int dim = result.spatial_dim;
+  for (const ops::WallCurvatureLine& line : result.lines) {
+    v1::WallCurvatureLine* encoded = out->add_lines();
+    encoded->set_block(line.line.block);
+    encoded->set_direction(line.line.direction);
+    EncodeExtents(line.line.start, encoded->mutable_start());
+    encoded->set_length(line.line.length);
+    for (const CurvatureSample& s : line.samples) {
+      encoded->add_arc_length(s.arc_length);
+      for (int c = 0; c < dim; ++c) encoded->add_points(s.point[c]);
+      encoded->add_curvature(s.curvature);
+    }
+  }
+  EncodeCurvature(result.metrics, out->mutable_metrics());
+}
+
 }  // namespace splinegrid::server

@@ -6,6 +6,7 @@
 
 #include "absl/status/status.h"
 #include "server/grid_store.h"
+#include "server/ops/wall_curvature.h"
 #include "splinegrid/v1/splinegrid_service.pb.h"
 
 namespace splinegrid::server {
@@ -21,6 +22,10 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
 
 // One entry of a grid's revision history (time and step for deformed revisions only).
 void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out);
+
+// GetWallCurvature's answer: every line's samples (arc length, point, curvature) and the
+// metrics over them.
+void EncodeWallCurvature(const ops::WallCurvatureResult& result, v1::GetWallCurvatureResponse* out);
 
 // A fitted revision as FitGrid reports it: number, per-block summaries, totals, report.
 void EncodeFitResponse(const GridRevision& revision, v1::FitGridResponse* out);

@@ -13,6 +13,7 @@
 #include "gtest/gtest.h"
 #include "server/ops/deform.h"
 #include "server/ops/fit.h"
+#include "server/ops/wall_curvature.h"
 #include "server/store/memory_store.h"
 #include "tests/core/test_data.h"
 
@@ -157,6 +158,34 @@ TEST_F(OpsTest, KeptDeformersKeepTheirGatesWithinTheCapAndChargeTheBudget) {
   EXPECT_EQ(refused.code(), absl::StatusCode::kResourceExhausted) << refused;
   EXPECT_THAT(refused.message(), HasSubstr("the fold gate of check_level 0"));
   EXPECT_EQ(tight.used(), 0);
+}
+
+TEST_F(OpsTest, WallCurvatureSamplesTheWallLinesWithinTheMessageLimit) {
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  ASSERT_TRUE(ops::Fit(ops_, "naca", options, {}).ok());
+  ops::WallCurvatureRequest request{"naca", 0, 1, {}, int64_t{4} << 20};
+  const ops::WallCurvatureResult result = ops::WallCurvature(ops_, request, {}).value();
+  EXPECT_EQ(result.revision, 1);
+  EXPECT_EQ(result.spatial_dim, 2);
+  ASSERT_FALSE(result.lines.empty());
+  int64_t samples = 0;
+  for (const ops::WallCurvatureLine& line : result.lines) {
+    EXPECT_EQ(static_cast<int64_t>(line.samples.size()), 2 * (line.line.length - 1) + 1);
+    samples += line.samples.size();
+  }
+  EXPECT_GT(samples, 200);
+  request.max_bytes = samples * 4 * 8 - 1;  // one byte short of (x, y, arc length, curvature)
+  EXPECT_EQ(ops::WallCurvature(ops_, request, {}).status().code(),
+            absl::StatusCode::kResourceExhausted);
+  request.max_bytes = int64_t{4} << 20;
+  request.level = ops::kMaxCurvatureLevel + 1;
+  EXPECT_THAT(ops::WallCurvature(ops_, request, {}).status().message(),
+              HasSubstr("refinement_level = 5 is outside [0, 4]"));
+  request.level = 0;
+  request.blocks = {1};
+  EXPECT_THAT(ops::WallCurvature(ops_, request, {}).status().message(),
+              HasSubstr("blocks: 1 is outside [0, 0]"));
 }
 
 }  // namespace
