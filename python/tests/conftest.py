@@ -1,12 +1,19 @@
-"""Shared fixtures: the real server binary on a loopback port, and paths of the shared data."""
+"""Shared fixtures: the real server binary on a loopback port, fake servers in this process,
+and paths of the shared data."""
 
+import contextlib
 import os
 import pathlib
 import socket
 import subprocess
 import time
+from concurrent import futures
 
+import grpc
 import pytest
+
+from splinegrid import Client, RetryPolicy
+from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 # The shared data set: $SPLINEGRID_SHARED_DATA, else ../shared/data beside the repository (as
@@ -17,6 +24,22 @@ DATA = pathlib.Path(os.environ.get("SPLINEGRID_SHARED_DATA", REPO.parent / "shar
 def server_binary() -> pathlib.Path:
     """``SPLINEGRID_SERVER`` (set by the CTest registration), else ``REPO/build/splinegrid``."""
     return pathlib.Path(os.environ.get("SPLINEGRID_SERVER", REPO / "build" / "splinegrid"))
+
+
+@contextlib.contextmanager
+def fake_client(servicer, workers: int = 2):
+    """A Client (no retries, 10 s deadline) of an in-process gRPC server on a free loopback port
+    that serves ``servicer`` (a ``SplineGridServicer``); the server stops on exit."""
+    server = grpc.server(futures.ThreadPoolExecutor(max_workers=workers))
+    service_grpc.add_SplineGridServicer_to_server(servicer, server)
+    port = server.add_insecure_port("127.0.0.1:0")
+    server.start()
+    try:
+        with Client(f"127.0.0.1:{port}", timeout=10,
+                    retry=RetryPolicy(max_attempts=1)) as client:
+            yield client
+    finally:
+        server.stop(0)
 
 
 def _free_port() -> int:

@@ -3,13 +3,11 @@ arguments, batches and joined results, wall curvature lines), and evaluate_point
 batches against an in-process fake server: every point once, in order, all batches pinned to
 the revision of the first."""
 
-from concurrent import futures
 
-import grpc
 import numpy as np
 import pytest
 
-from splinegrid import Client, EvaluatedPoints, RetryPolicy
+from splinegrid import EvaluatedPoints
 from splinegrid import _evaluation_calls
 from splinegrid._evaluation_calls import (POINTS_BATCH_BYTES, _evaluate_request,
                                           _joined_points, _points_arguments, _points_request,
@@ -17,6 +15,8 @@ from splinegrid._evaluation_calls import (POINTS_BATCH_BYTES, _evaluate_request,
 from splinegrid.v1 import grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
+
+from conftest import fake_client
 
 
 def evaluate(name="naca", level=None, counts=None, blocks=None, index_box=None,
@@ -133,17 +133,9 @@ class PointsServer(service_grpc.SplineGridServicer):
 def test_evaluate_points_in_batches_pinned_to_the_first_revision(monkeypatch):
     monkeypatch.setattr(_evaluation_calls, "POINTS_BATCH_BYTES", 29 * 4)  # 4 points a call
     fake = PointsServer()
-    server = grpc.server(futures.ThreadPoolExecutor(max_workers=2))
-    service_grpc.add_SplineGridServicer_to_server(fake, server)
-    port = server.add_insecure_port("127.0.0.1:0")
-    server.start()
-    try:
-        with Client(f"127.0.0.1:{port}", timeout=10,
-                    retry=RetryPolicy(max_attempts=1)) as client:
-            uvw = np.stack([np.linspace(0, 1, 10), np.linspace(0, 0.1, 10), np.zeros(10)], 1)
-            result = client.evaluate_points("naca", uvw, blocks=np.arange(10), step=3)
-    finally:
-        server.stop(0)
+    with fake_client(fake) as client:
+        uvw = np.stack([np.linspace(0, 1, 10), np.linspace(0, 0.1, 10), np.zeros(10)], 1)
+        result = client.evaluate_points("naca", uvw, blocks=np.arange(10), step=3)
     assert [len(r.blocks) for r in fake.requests] == [4, 4, 2]
     assert [(r.revision, r.HasField("step")) for r in fake.requests] == [
         (0, True), (5, False), (5, False)]

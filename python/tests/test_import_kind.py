@@ -8,17 +8,15 @@ import itertools
 import re
 
 import struct
-from concurrent import futures
 
-import grpc
 import numpy as np
 import pytest
 
-from splinegrid import Client, FileKind, RetryPolicy, detect_file_kind, records
+from splinegrid import Client, FileKind, detect_file_kind, records
 from splinegrid.v1 import archive_pb2, grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
 
-from conftest import DATA
+from conftest import DATA, fake_client
 
 RAE = DATA / "grids" / "rae2822_257x97.fmt"          # 2 x 257 x 97, planes y = 0 and y = -1
 PITCH = DATA / "grids" / "n0012_pitch_257x129.fmt"   # a two-plane grid as well
@@ -168,13 +166,8 @@ class CountingImports(service_grpc.SplineGridServicer):
 @pytest.fixture
 def counting():
     fake = CountingImports()
-    server = grpc.server(futures.ThreadPoolExecutor(max_workers=4))
-    service_grpc.add_SplineGridServicer_to_server(fake, server)
-    port = server.add_insecure_port("127.0.0.1:0")
-    server.start()
-    with Client(f"127.0.0.1:{port}", timeout=10, retry=RetryPolicy(max_attempts=1)) as client:
+    with fake_client(fake, workers=4) as client:
         yield fake, client
-    server.stop(0)
 
 
 class TestOneUpload:

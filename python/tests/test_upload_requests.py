@@ -2,19 +2,18 @@
 PointChunks, ImportArchive messages, the archive shape checks), and import_points and list
 against an in-process fake server that keeps what it was sent."""
 
-from concurrent import futures
 
-import grpc
 import numpy as np
 import pytest
 
-from splinegrid import Client, RetryPolicy
 from splinegrid._archive import _ArchiveShape, _export_record_bytes, _import_archive_request
 from splinegrid._upload_calls import (UPLOAD_CHUNK_BYTES, _cgns_header, _file_requests,
                                       _plot3d_header, _points_header, _points_requests)
 from splinegrid.v1 import archive_pb2, grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
+
+from conftest import fake_client
 
 
 def decoded(requests):
@@ -166,13 +165,8 @@ class KeepingServer(service_grpc.SplineGridServicer):
 @pytest.fixture
 def keeping():
     fake = KeepingServer(grids=["a", "b", "c", "d", "e"])
-    server = grpc.server(futures.ThreadPoolExecutor(max_workers=2))
-    service_grpc.add_SplineGridServicer_to_server(fake, server)
-    port = server.add_insecure_port("127.0.0.1:0")
-    server.start()
-    with Client(f"127.0.0.1:{port}", timeout=10, retry=RetryPolicy(max_attempts=1)) as client:
+    with fake_client(fake) as client:
         yield fake, client
-    server.stop(0)
 
 
 def test_import_points_sends_every_coordinate_in_order(keeping):
