@@ -3,7 +3,6 @@ arguments, batches and joined results, wall curvature lines), and evaluate_point
 batches against an in-process fake server: every point once, in order, all batches pinned to
 the revision of the first."""
 
-
 import numpy as np
 import pytest
 

@@ -2,7 +2,6 @@
 PointChunks, ImportArchive messages, the archive shape checks), and import_points and list
 against an in-process fake server that keeps what it was sent."""
 
-
 import numpy as np
 import pytest
 
