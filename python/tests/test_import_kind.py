@@ -6,7 +6,6 @@ iblank)."""
 
 import itertools
 import re
-
 import struct
 
 import numpy as np
