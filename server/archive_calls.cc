@@ -6,7 +6,6 @@
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "core/grid/connectivity.h"
-#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/archive_convert.h"
 #include "server/grid_encoding.h"
@@ -148,11 +147,7 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
   absl::Status Accept(const v1::ImportArchiveRequest& message) override {
     if (!assembler_) {
       const std::string& id = message.grid_id();
-      if (!id.empty() && !IsValidGridId(id)) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("grid_id = ", QuoteClientString(id),
-                         " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
-      }
+      SG_RETURN_IF_ERROR(CheckRequestedGridId(id, "grid_id"));
       assembler_.emplace(&state_->budget, id);
     } else if (!message.grid_id().empty()) {
       return absl::InvalidArgumentError("grid_id is set after the first message");

@@ -1,5 +1,8 @@
 #include "server/grid_id.h"
 
+#include "absl/strings/str_cat.h"
+#include "core/util/quote.h"
+
 namespace splinegrid::server {
 
 bool IsValidGridId(const std::string& id) {
@@ -8,6 +11,13 @@ bool IsValidGridId(const std::string& id) {
     if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-')) return false;
   }
   return true;
+}
+
+absl::Status CheckRequestedGridId(const std::string& id, const std::string& field) {
+  if (id.empty() || IsValidGridId(id)) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, " = ", QuoteClientString(id),
+                   " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
 }
 
 }  // namespace splinegrid::server

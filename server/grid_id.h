@@ -4,10 +4,16 @@
 
 #include <string>
 
+#include "absl/status/status.h"
+
 namespace splinegrid::server {
 
 // Whether `id` is a valid grid id: 1-63 characters of [a-z0-9-], starting with a letter.
 bool IsValidGridId(const std::string& id);
+
+// The id a request asks a new grid to get: OK when empty (the server picks one) or valid;
+// INVALID_ARGUMENT naming `field` and the (quoted) value otherwise.
+absl::Status CheckRequestedGridId(const std::string& id, const std::string& field);
 
 }  // namespace splinegrid::server
 

@@ -11,7 +11,6 @@
 #include "core/io/planar_view.h"
 #include "core/io/plot3d.h"
 #include "core/io/plot3d_memory.h"
-#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "proto/convert/plot3d_format_convert.h"
@@ -73,11 +72,7 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
 
   absl::Status AcceptHeader(const v1::ImportHeader& header) {
     header_ = header;
-    if (!header.grid_id().empty() && !IsValidGridId(header.grid_id())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("header.grid_id = ", QuoteClientString(header.grid_id()),
-                       " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
-    }
+    SG_RETURN_IF_ERROR(CheckRequestedGridId(header.grid_id(), "header.grid_id"));
     log_.set_grid(header.grid_id().empty() ? "" : absl::StrCat("grids/", header.grid_id()));
     if (header.display_name().size() > 1024) {
       return absl::InvalidArgumentError("header.display_name is longer than 1024 bytes");

@@ -17,6 +17,7 @@
 #include "client/cli/output.h"
 #include "client/client.h"
 #include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
 
 namespace splinegrid::cli {
 
@@ -97,7 +98,7 @@ absl::StatusOr<v1::BoundarySelection> ParseBoundaryFlag(
     for (int d = 0; d < 3; ++d) {
       if (d != normal) tangential[n++] = d;
     }
-    int begin[3] = {0, 0, 0}, end[3] = {0, 0, 0};
+    Extents begin = {0, 0, 0}, end = {0, 0, 0};
     const int given = (static_cast<int>(fields.size()) - 2) / 2;
     for (int t = 0; t < given; ++t) {
       const int d = tangential[t];
@@ -123,12 +124,8 @@ absl::StatusOr<v1::BoundarySelection> ParseBoundaryFlag(
     v1::FaceRange* range = selection.add_ranges();
     range->set_block(block);
     range->set_face(*face);
-    range->mutable_begin()->set_i(begin[0]);
-    range->mutable_begin()->set_j(begin[1]);
-    range->mutable_begin()->set_k(begin[2]);
-    range->mutable_end()->set_i(end[0]);
-    range->mutable_end()->set_j(end[1]);
-    range->mutable_end()->set_k(end[2]);
+    EncodeExtents(begin, range->mutable_begin());
+    EncodeExtents(end, range->mutable_end());
   }
   if (selection.kinds_size() > 0 && selection.ranges_size() > 0) {
     return Usage("--boundary: give boundary kinds or face ranges, not both");

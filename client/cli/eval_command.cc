@@ -18,6 +18,7 @@
 #include "client/cli/output.h"
 #include "client/client.h"
 #include "core/util/status_macros.h"
+#include "proto/convert/convert.h"
 
 namespace splinegrid::cli {
 
@@ -56,7 +57,7 @@ absl::Status Eval(const Args& args) {
   if (!absl::GetFlag(FLAGS_box).empty()) {
     const std::vector<std::string> ranges = absl::StrSplit(absl::GetFlag(FLAGS_box), ',');
     v1::IndexBox* box = request.mutable_index_box();
-    int begin[3] = {0, 0, 0}, end[3] = {0, 0, 0};
+    Extents begin = {0, 0, 0}, end = {0, 0, 0};
     if (ranges.size() > 3) return Usage("--box: at most three ranges i0:i1,j0:j1,k0:k1");
     for (size_t d = 0; d < ranges.size(); ++d) {
       const std::vector<std::string> ends = absl::StrSplit(ranges[d], ':');
@@ -65,12 +66,8 @@ absl::Status Eval(const Args& args) {
         return Usage(absl::StrCat("--box: '", ranges[d], "' is not a range a:b"));
       }
     }
-    box->mutable_begin()->set_i(begin[0]);
-    box->mutable_begin()->set_j(begin[1]);
-    box->mutable_begin()->set_k(begin[2]);
-    box->mutable_end()->set_i(end[0]);
-    box->mutable_end()->set_j(end[1]);
-    box->mutable_end()->set_k(end[2]);
+    EncodeExtents(begin, box->mutable_begin());
+    EncodeExtents(end, box->mutable_end());
   }
   request.set_derivatives(absl::GetFlag(FLAGS_derivs));
   request.set_precision(absl::GetFlag(FLAGS_float32) ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);

@@ -8,7 +8,6 @@
 #include "core/bspline/evaluation.h"
 #include "core/grid/connectivity.h"
 #include "core/grid/sampling.h"
-#include "core/util/quote.h"
 #include "core/util/status_macros.h"
 #include "server/grid_id.h"
 #include "server/ops/fit.h"
@@ -104,11 +103,7 @@ int64_t GeneratedPoints(const ProfileGridOptions& options) {
 // The checks that need no work: the id, the name, the size.
 absl::Status CheckRequest(const OpsContext& context, const GenerateRequest& request) {
   const std::string& id = request.grid_id;
-  if (!id.empty() && !IsValidGridId(id)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("grid_id = ", QuoteClientString(id),
-                     " is not valid: 1-63 characters of [a-z0-9-], starting with a letter"));
-  }
+  SG_RETURN_IF_ERROR(CheckRequestedGridId(id, "grid_id"));
   if (request.display_name.size() > 1024) {
     return absl::InvalidArgumentError("display_name is longer than 1024 bytes");
   }
