@@ -6,14 +6,13 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "core/fit/adaptive/multiblock_fit.h"
 #include "core/fit/adaptive/segment_model.h"
+#include "core/fit/report/fit_report.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
 namespace {
-
-// Refinement level of the wall curvature report (three samples between grid points).
-constexpr int kCurvatureLevel = 2;
 
 // The index in options.block_control_counts of block b's override, or -1.
 int OverrideOf(const GridFitOptions& options, int b) {
@@ -36,7 +35,7 @@ FitOptions BlockOptions(const GridFitOptions& options, int b) {
   return fit_options;
 }
 
-// Control-count mode: every block on its own.
+// Control-count mode: every block on its own (`result` holds the kinds already).
 absl::Status FitBlocks(const MultiBlockGrid& grid, const Connectivity& connectivity,
                        const GridFitOptions& options, const CancelCheck& cancel, GridFit& result) {
   for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
@@ -50,47 +49,6 @@ absl::Status FitBlocks(const MultiBlockGrid& grid, const Connectivity& connectiv
     result.report.fairing_weight = options.fairing.weight;
   }
   result.connectivity = connectivity;
-  SG_ASSIGN_OR_RETURN(result.kinds,
-                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
-  return absl::OkStatus();
-}
-
-// Tolerance mode: the watertight multi-block fit.
-absl::Status FitToTolerances(const MultiBlockGrid& grid, const Connectivity& connectivity,
-                             const GridFitOptions& options, double reference_length,
-                             const CancelCheck& cancel, GridFit& result) {
-  MultiBlockFitOptions mb;
-  mb.order = options.order;
-  mb.parametrization = options.parametrization;
-  mb.tolerances = options.Tolerances(reference_length);
-  result.report.tolerances = mb.tolerances;
-  mb.face_kinds = options.face_kinds;
-  mb.max_controls_per_direction = options.max_controls_per_direction;
-  mb.check_quality = options.check_quality;
-  mb.fairing = options.fairing;
-  mb.cancel = cancel;
-  SG_ASSIGN_OR_RETURN(MultiBlockFit fit, FitMultiBlock(grid, connectivity, mb));
-  for (size_t b = 0; b < fit.blocks.size(); ++b) {
-    BlockFit block;
-    block.fitted = std::move(fit.blocks[b]);
-    block.tolerance_met = fit.reports[b].tolerance_met;
-    block.unmet_reason = std::move(fit.reports[b].unmet_reason);
-    block.deviation_by_kind = fit.reports[b].max_deviation;
-    block.quality = std::move(fit.reports[b].quality);
-    result.blocks.push_back(std::move(block));
-  }
-  result.report.max_gap = fit.max_gap;
-  result.report.wall_curvature = fit.wall_curvature;
-  result.connectivity = std::move(fit.connectivity);
-  result.kinds = std::move(fit.kinds);
-  result.report.tolerance_met = fit.met;
-  result.report.unmet_reason = std::move(fit.unmet_reason);
-  result.report.fairing_weight = fit.fairing_weight;
-  result.report.unfaired_wall_curvature = fit.unfaired_wall_curvature;
-  result.report.iterations = fit.iterations;
-  result.report.knots_inserted = fit.knots_inserted;
-  result.report.knots_removed = fit.knots_removed;
-  result.report.quality_rounds = fit.quality_rounds;
   return absl::OkStatus();
 }
 
@@ -113,6 +71,13 @@ absl::Status GridFitOptions::Validate(const MultiBlockGrid& grid) const {
   }
   SG_RETURN_IF_ERROR(fairing.Validate());
   SG_RETURN_IF_ERROR(ValidateParametrization(parametrization));
+  if (max_iterations < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_iterations = ", max_iterations, " is negative"));
+  }
+  SG_RETURN_IF_ERROR(features.Validate());
+  SG_RETURN_IF_ERROR(quality.Validate());
+  SG_RETURN_IF_ERROR(connectivity.Validate());
   const int num_blocks = static_cast<int>(grid.blocks.size());
   for (const FaceKindOverride& o : face_kinds) {
     if (o.face.block < 0 || o.face.block >= num_blocks) {
@@ -197,61 +162,27 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
                                      const GridFitOptions& options, const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
   GridFit result;
-  // The reference length: given, or, when tolerances by kind are relative to it, detected before
-  // the fit from the kinds FitMultiBlock will find (the same connectivity and overrides); else
-  // detected after the fit, for the report.
-  std::optional<ReferenceLength> reference;
-  if (options.reference_length) {
-    reference =
-        ReferenceLength{*options.reference_length, ReferenceLengthSource::kGiven,
-                        absl::StrCat("given: reference_length = ", *options.reference_length)};
-  } else if (options.boundary_tolerances && options.relative_kinds != 0) {
-    SG_ASSIGN_OR_RETURN(const BoundaryKinds kinds,
-                        ClassifyBoundaries(grid, connectivity, options.face_kinds));
-    reference = DetectReferenceLength(grid, kinds);
-  }
+  // The kinds of every boundary point (both modes), then the reference length: given, or
+  // detected from the walls.
+  SG_ASSIGN_OR_RETURN(result.kinds, ClassifyBoundaries(grid, connectivity, options.face_kinds));
+  const ReferenceLength reference =
+      options.reference_length
+          ? ReferenceLength{*options.reference_length, ReferenceLengthSource::kGiven,
+                            absl::StrCat("given: reference_length = ", *options.reference_length)}
+          : DetectReferenceLength(grid, result.kinds);
+  CellQualityOptions quality = options.quality;
+  quality.cancel = cancel;
   if (options.tolerance_mode()) {
-    SG_RETURN_IF_ERROR(FitToTolerances(grid, connectivity, options,
-                                       reference ? reference->length : 1.0, cancel, result));
+    SG_ASSIGN_OR_RETURN(internal::MultiBlockRun run,
+                        internal::FitMultiBlock(grid, connectivity, result.kinds, options,
+                                                options.Tolerances(reference.length), cancel));
+    result = std::move(run.fit);
   } else {
     SG_RETURN_IF_ERROR(FitBlocks(grid, connectivity, options, cancel, result));
-    // Nothing was measured against a tolerance: the report must not say one was met.
-    result.report.tolerance_met = false;
-    result.report.unmet_reason =
-        "no tolerance was given (a fit to control counts): see max_deviation";
-  }
-  // The report (FitMultiBlock makes its own): deviations by kind, cell quality, gaps, walls.
-  const bool report = !options.tolerance_mode();
-  const bool quality = report;
-  CellQualityOptions quality_options;
-  quality_options.cancel = cancel;
-  std::vector<FittedBlock> fitted;
-  result.report.quality_met = true;
-  for (size_t b = 0; b < result.blocks.size(); ++b) {
-    BlockFit& block = result.blocks[b];
-    if (report) {
-      SG_ASSIGN_OR_RETURN(block.deviation_by_kind, DeviationByKind(block.fitted, grid.blocks[b],
-                                                                   result.kinds.point_kinds[b]));
-    }
-    if (quality) {
-      SG_ASSIGN_OR_RETURN(block.quality,
-                          CheckCellQuality(block.fitted, grid.blocks[b], quality_options), "block ",
-                          b, ": ");
-    }
-    result.report.quality_met =
-        result.report.quality_met && block.quality.ok() && block.quality.measured();
-    result.report.num_points += block.fitted.summary.num_points;
-    result.report.num_control_points += block.fitted.summary.num_control_points;
-    result.report.max_deviation =
-        std::max(result.report.max_deviation, block.fitted.summary.deviation.max);
-    if (report) fitted.push_back(block.fitted);
-  }
-  if (report) {
-    result.report.max_gap = MaxBoundaryGap(result.connectivity, fitted, quality_options.max_level);
-    result.report.wall_curvature = WallCurvatureMetrics(fitted, result.kinds, kCurvatureLevel);
+    SG_RETURN_IF_ERROR(internal::ReportFit(grid, quality, nullptr, {}, result));
   }
   result.report.num_matches = static_cast<int>(result.connectivity.matches.size());
-  result.report.reference = reference ? *reference : DetectReferenceLength(grid, result.kinds);
+  result.report.reference = reference;
   for (size_t b = 0; b < result.blocks.size(); ++b) {
     const Extents points = grid.blocks[b].extents();
     for (int d = 0; d < 3; ++d) {
@@ -276,7 +207,7 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
     }
     if (!folds.empty()) {
       return absl::FailedPreconditionError(absl::StrCat(
-          "the fitted grid folds at refinement levels 0..", quality_options.max_level, ": ",
+          "the fitted grid folds at refinement levels 0..", quality.max_level, ": ",
           absl::StrJoin(folds, "; "),
           options.tolerance_mode()
               ? ". Local refinement and knot removal did not repair it; try a looser tolerance"
@@ -293,7 +224,8 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
                                 const CancelCheck& cancel) {
   SG_RETURN_IF_ERROR(ValidateGridFit(grid, options));
-  SG_ASSIGN_OR_RETURN(const Connectivity connectivity, FindConnectivity(grid));
+  SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
+                      FindConnectivity(grid, options.connectivity));
   return FitValidated(grid, connectivity, options, cancel);
 }
 

@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/fit/adaptive/multiblock_fit.h"
+#include "core/fit/adaptive/refinement.h"
+#include "core/fit/fit_defaults.h"
+#include "core/fit/report/fit_deviation.h"
 #include "core/fit/report/grid_quality.h"
 #include "core/fit/report/wall_curvature.h"
 #include "core/fit/solve/fairing.h"
@@ -29,11 +31,28 @@
 
 namespace splinegrid {
 
-// What to fit; plain data, so a revision can keep it as provenance.
+// Which grid lines give a direction its parameters (tolerance mode). A tensor-product spline has
+// one parameter per grid index of a direction, shared by all its lines; a wall fitted at
+// parameters averaged over all lines wriggles between its points, because its own spacing
+// differs from the average (on the NACA 0012 225 x 65 C-grid even an interpolating fit has 37
+// curvature extrema along the wall, where the wall's points have 5). Taking the parameters from
+// the wall lines alone gives smooth walls (RAE 2822: 10 extrema instead of 28, the squared
+// curvature differences 20x smaller), but on some grids the other lines then need many more
+// knots and cells suffer.
+enum class WallParametrization {
+  kAverage,  // every line of the direction
+  kWall,     // the lines holding at least three wall points, where the direction has any
+  kAuto,     // both; keep the better fit: tolerances met, fewer bad cells, smoother walls
+};
+
+// What to fit: the one options struct of FitGrid, every default stated here (the shared ones in
+// fit_defaults.h); the stages' own settings are built from it once, inside the fit. Plain data,
+// so a revision can keep it as provenance (the service stores the fields a request can set; the
+// tuning fields below `allow_folds` keep their defaults there).
 struct GridFitOptions {
   // Spline order (degree + 1).
-  int order = 4;
-  Parametrization parametrization = Parametrization::kChordLength;
+  int order = kDefaultOrder;
+  Parametrization parametrization = kDefaultParametrization;
   // Tolerance mode: one tolerance for every point (in the grid's length unit, absolute), or
   // tolerances by boundary kind. At most one of the two; with neither, control counts.
   std::optional<double> tolerance;
@@ -69,12 +88,30 @@ struct GridFitOptions {
   // is returned with quality_met = false instead of failing with FAILED_PRECONDITION.
   bool allow_folds = false;
 
+  // Tuning of the tolerance mode (adaptive_engine.h describes the steps):
+  WallParametrization wall_parameters = WallParametrization::kAuto;
+  // Share knots and boundary controls across matches (watertight). False fits every block on its
+  // own (boundaries are still classified by the connectivity).
+  bool watertight = true;
+  // Kink detection: feature points where every line of a direction becomes C0 (refinement.h).
+  FeatureOptions features;
+  // Knot refinement rounds before giving up.
+  int max_iterations = kDefaultMaxRefinementRounds;
+  // Try to drop every knot once the tolerances hold.
+  bool remove_unneeded_knots = true;
+  // Either mode: the cell check and its report (levels 0..quality.max_level, the accepted size
+  // change); its cancel is FitGrid's.
+  CellQualityOptions quality;
+  // FitGrid without a known connectivity: how it is found (connectivity.h).
+  ConnectivityOptions connectivity;
+
   bool tolerance_mode() const { return tolerance.has_value() || boundary_tolerances.has_value(); }
   // The per-kind tolerances of the tolerance mode in the grid's unit (one tolerance: every kind,
   // inside too), the relative kinds scaled by `reference_length`.
   BoundaryTolerances Tolerances(double reference_length) const;
 
-  // OK if the options suit `grid`; INVALID_ARGUMENT naming the field and value otherwise.
+  // OK if the options suit `grid`; INVALID_ARGUMENT naming the field and value otherwise
+  // (FitGrid checks this first; the stages do not check again).
   absl::Status Validate(const MultiBlockGrid& grid) const;
 };
 
@@ -106,6 +143,8 @@ struct GridFitReport {
   double fairing_weight = 0.0;
   CurvatureMetrics wall_curvature;           // at refinement level 2
   CurvatureMetrics unfaired_wall_curvature;  // faired to tolerance: the same knots unfaired
+  // Tolerance mode, filled by the adaptive engine (adaptive_engine.h): refinement rounds, knots
+  // inserted and removed, quality rounds.
   int iterations = 0;
   int knots_inserted = 0;
   int knots_removed = 0;
@@ -140,7 +179,8 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
                                 const CancelCheck& cancel = {});
 
 // The same for a grid whose connectivity is known: `connectivity` is FindConnectivity(grid)'s
-// (default options; the service finds it once, at import, and keeps it with the source points).
+// (the service finds it once, at import, and keeps it with the source points);
+// options.connectivity is not used.
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const Connectivity& connectivity,
                                 const GridFitOptions& options, const CancelCheck& cancel = {});
 

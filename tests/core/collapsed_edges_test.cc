@@ -4,7 +4,8 @@
 // the tolerance fit by kind succeeds with every point within its kind's tolerance (re-measured,
 // multiblock_checks.h), no sub-cell folds at levels 0-2 (signed areas computed here from
 // evaluated points, not by the quality code), matched boundaries coincide at levels 0-2, and the
-// pole stays one point at every level, bitwise shared by the blocks that meet there.
+// pole stays one point at every level, bitwise shared by the blocks that meet there. The fits go
+// through FitGrid (grid_fit.h); the poles are found here as the fit finds them (FindPoles).
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -13,7 +14,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/adaptive/multiblock_fit.h"
+#include "core/fit/grid_fit.h"
 #include "core/grid/poles.h"
 #include "core/io/plot3d.h"
 #include "gtest/gtest.h"
@@ -51,11 +52,12 @@ MultiBlockGrid PolarDisk(int blocks, int ni, int nj, double inner = 0.0) {
 
 // The rim (j = max) of every block is a wall, so each fit binds three kinds: wall on the rim,
 // interface on the radial edges, outer at the centre (the pole's unmatched edge).
-MultiBlockFitOptions DiskOptions(int blocks) {
-  MultiBlockFitOptions options;
-  options.tolerances.wall = 1e-5;
-  options.tolerances.interface = 1e-4;
-  options.tolerances.outer = 4e-4;
+GridFitOptions DiskOptions(int blocks) {
+  BoundaryTolerances tolerances;
+  tolerances.wall = 1e-5;
+  tolerances.interface = 1e-4;
+  tolerances.outer = 4e-4;
+  GridFitOptions options = KindToleranceOptions(tolerances);
   for (int b = 0; b < blocks; ++b)
     options.face_kinds.push_back({{b, 1, true}, BoundaryKind::kWall});
   return options;
@@ -136,12 +138,12 @@ FoldCount CountFolds(const FittedBlock& fitted, const StructuredBlock& original,
 }
 
 // No folded sub-cell at levels 0-2 in any block; returns the triangles checked.
-int64_t ExpectNoFolds(const MultiBlockGrid& grid, const MultiBlockFit& fit) {
+int64_t ExpectNoFolds(const MultiBlockGrid& grid, const GridFit& fit) {
   int64_t triangles = 0;
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     for (int level = 0; level <= 2; ++level) {
       SCOPED_TRACE(absl::StrCat("block ", b, " level ", level));
-      const FoldCount count = CountFolds(fit.blocks[b], grid.blocks[b], level);
+      const FoldCount count = CountFolds(fit.blocks[b].fitted, grid.blocks[b], level);
       EXPECT_EQ(count.folded, 0);
       EXPECT_EQ(count.skipped, 0);
       EXPECT_GT(count.checked, 0);
@@ -154,12 +156,18 @@ int64_t ExpectNoFolds(const MultiBlockGrid& grid, const MultiBlockFit& fit) {
   return triangles;
 }
 
-// Every pole of `fit` stays collapsed at levels 0-2: the evaluated points of every line along
-// its collapsed direction coincide within rounding (relative to `scale`).
-void ExpectPolesCollapsed(const MultiBlockFit& fit, double scale) {
-  for (const Pole& pole : fit.poles) {
+// The poles of `grid`, found as the fit finds them.
+std::vector<Pole> GridPoles(const MultiBlockGrid& grid) {
+  return FindPoles(grid, PoleTolerance(grid));
+}
+
+// Every pole of `grid` stays collapsed in `fit` at levels 0-2: the evaluated points of every line
+// along its collapsed direction coincide within rounding (relative to the coordinates).
+void ExpectPolesCollapsed(const MultiBlockGrid& grid, const GridFit& fit) {
+  const double scale = CoordinateScale(grid);
+  for (const Pole& pole : GridPoles(grid)) {
     SCOPED_TRACE(pole.Describe());
-    const FittedBlock& fitted = fit.blocks[pole.block];
+    const FittedBlock& fitted = fit.blocks[pole.block].fitted;
     for (int level = 0; level <= 2; ++level) {
       std::array<std::vector<double>, 3> params;
       for (int d = 0; d < 3; ++d) {
@@ -191,9 +199,10 @@ void ExpectPolesCollapsed(const MultiBlockFit& fit, double scale) {
 }
 
 // The controls of the j = 0 edge of every block are bitwise one point.
-void ExpectDiskPoleControlsShared(const MultiBlockFit& fit) {
-  const double* pole = fit.blocks[0].spline.ControlPoint(0, 0, 0);
-  for (const FittedBlock& fitted : fit.blocks) {
+void ExpectDiskPoleControlsShared(const GridFit& fit) {
+  const double* pole = fit.blocks[0].fitted.spline.ControlPoint(0, 0, 0);
+  for (const BlockFit& block : fit.blocks) {
+    const FittedBlock& fitted = block.fitted;
     for (int a = 0; a < fitted.spline.control_extents()[0]; ++a) {
       const double* p = fitted.spline.ControlPoint(a, 0, 0);
       EXPECT_TRUE(p[0] == pole[0] && p[1] == pole[1]) << "control " << a;
@@ -238,32 +247,32 @@ TEST(PolesTest, ConnectivityDropsThePoleSelfMatches) {
 // One block, the periodic seam i = 0 ~ i = max matched to itself, the j = 0 edge at the centre.
 TEST(CollapsedEdgeFitTest, PolarDiskOneBlock) {
   const MultiBlockGrid grid = PolarDisk(1, 65, 17);
-  const MultiBlockFitOptions options = DiskOptions(1);
-  const absl::StatusOr<MultiBlockFit> fit = FitMultiBlock(grid, options);
+  const GridFitOptions options = DiskOptions(1);
+  const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
   ASSERT_TRUE(fit.ok()) << fit.status();
-  ASSERT_EQ(fit->poles.size(), 1u);
+  ASSERT_EQ(GridPoles(grid).size(), 1u);
   ASSERT_EQ(fit->connectivity.matches.size(), 1u);
-  ExpectTolerancesMet(grid, *fit, options.tolerances);
-  EXPECT_GE(fit->reports[0].max_deviation.wall, 0.0);
-  EXPECT_GE(fit->reports[0].max_deviation.interface, 0.0);
-  EXPECT_GE(fit->reports[0].max_deviation.outer, 0.0);
-  EXPECT_LT(fit->num_control_points, fit->num_points);
+  ExpectTolerancesMet(grid, *fit, *options.boundary_tolerances);
+  const KindDeviation& dev = fit->blocks[0].deviation_by_kind;
+  EXPECT_GE(dev.wall, 0.0);
+  EXPECT_GE(dev.interface, 0.0);
+  EXPECT_GE(dev.outer, 0.0);
+  EXPECT_LT(fit->report.num_control_points, fit->report.num_points);
   EXPECT_GT(ExpectNoFolds(grid, *fit), 0);
   ExpectWatertight(grid, *fit);
-  ExpectPolesCollapsed(*fit, CoordinateScale(grid));
+  ExpectPolesCollapsed(grid, *fit);
   ExpectDiskPoleControlsShared(*fit);
-  EXPECT_TRUE(fit->quality_met);
-  const Extents n = fit->blocks[0].spline.control_extents();
+  EXPECT_TRUE(fit->report.quality_met);
+  const Extents n = fit->blocks[0].fitted.spline.control_extents();
   std::cout << "[figures] polar disk 1 block 65 x 17: " << n[0] << " x " << n[1] << " = "
-            << fit->num_control_points << " controls; wall " << fit->reports[0].max_deviation.wall
-            << ", interface " << fit->reports[0].max_deviation.interface << ", outer (pole) "
-            << fit->reports[0].max_deviation.outer << "\n";
+            << fit->report.num_control_points << " controls; wall " << dev.wall << ", interface "
+            << dev.interface << ", outer (pole) " << dev.outer << "\n";
   // The same grid as an annulus (the centre cut out) fits too, with the same kinds.
   const MultiBlockGrid annulus = PolarDisk(1, 65, 17, 0.2);
-  const absl::StatusOr<MultiBlockFit> ring = FitMultiBlock(annulus, options);
+  const absl::StatusOr<GridFit> ring = FitGrid(annulus, options);
   ASSERT_TRUE(ring.ok()) << ring.status();
-  EXPECT_TRUE(ring->poles.empty());
-  ExpectTolerancesMet(annulus, *ring, options.tolerances);
+  EXPECT_TRUE(GridPoles(annulus).empty());
+  ExpectTolerancesMet(annulus, *ring, *options.boundary_tolerances);
 }
 
 // 2, 3 and 4 blocks around the centre: the radial edges are interfaces, the pole is shared by all.
@@ -271,19 +280,20 @@ TEST(CollapsedEdgeFitTest, PolarDiskOfSeveralBlocks) {
   for (int blocks : {2, 3, 4}) {
     SCOPED_TRACE(absl::StrCat(blocks, " blocks"));
     const MultiBlockGrid grid = PolarDisk(blocks, 65 / blocks + 1, 17);
-    const MultiBlockFitOptions options = DiskOptions(blocks);
-    const absl::StatusOr<MultiBlockFit> fit = FitMultiBlock(grid, options);
+    const GridFitOptions options = DiskOptions(blocks);
+    const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
     ASSERT_TRUE(fit.ok()) << fit.status();
-    EXPECT_EQ(fit->poles.size(), static_cast<size_t>(blocks));
+    EXPECT_EQ(GridPoles(grid).size(), static_cast<size_t>(blocks));
     EXPECT_EQ(fit->connectivity.matches.size(), static_cast<size_t>(blocks));
-    ExpectTolerancesMet(grid, *fit, options.tolerances);
+    ExpectTolerancesMet(grid, *fit, *options.boundary_tolerances);
     EXPECT_GT(ExpectNoFolds(grid, *fit), 0);
     ExpectWatertight(grid, *fit);
-    ExpectPolesCollapsed(*fit, CoordinateScale(grid));
+    ExpectPolesCollapsed(grid, *fit);
     ExpectDiskPoleControlsShared(*fit);
-    EXPECT_TRUE(fit->quality_met);
-    std::cout << "[figures] polar disk " << blocks << " blocks: " << fit->num_control_points
-              << " controls for " << fit->num_points << " points, max gap " << fit->max_gap << "\n";
+    EXPECT_TRUE(fit->report.quality_met);
+    std::cout << "[figures] polar disk " << blocks << " blocks: " << fit->report.num_control_points
+              << " controls for " << fit->report.num_points << " points, max gap "
+              << fit->report.max_gap << "\n";
   }
 }
 
@@ -351,32 +361,33 @@ MultiBlockGrid M6WithTipCap(int nj, double height) {
 TEST(CollapsedEdgeFitTest, M6WingTipCap) {
   const MultiBlockGrid grid = M6WithTipCap(9, 0.02);
   ASSERT_EQ(grid.blocks.size(), 5u);
-  const MultiBlockFitOptions options;
-  const absl::StatusOr<MultiBlockFit> fit = FitMultiBlock(grid, options);
+  const GridFitOptions options = KindToleranceOptions();
+  const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
   ASSERT_TRUE(fit.ok()) << fit.status();
-  ASSERT_EQ(fit->poles.size(), 1u);
-  EXPECT_EQ(fit->poles[0].Describe(), "block 4 j=8 collapsed along i");
+  const std::vector<Pole> poles = GridPoles(grid);
+  ASSERT_EQ(poles.size(), 1u);
+  EXPECT_EQ(poles[0].Describe(), "block 4 j=8 collapsed along i");
   int cap_matches = 0;
   for (const BoundaryMatch& m : fit->connectivity.matches) {
     cap_matches += m.a.face.block == 4 || m.b.face.block == 4;
     EXPECT_FALSE(m.a.face.block == 4 && m.a.face.normal == 1 && m.a.face.upper) << m.Describe();
   }
   EXPECT_EQ(cap_matches, 5);  // four tip edges and the seam
-  ExpectTolerancesMet(grid, *fit, options.tolerances);
+  ExpectTolerancesMet(grid, *fit, *options.boundary_tolerances);
   EXPECT_GT(ExpectNoFolds(grid, *fit), 0);
   ExpectWatertight(grid, *fit);
-  ExpectPolesCollapsed(*fit, CoordinateScale(grid));
-  EXPECT_TRUE(fit->quality_met);
+  ExpectPolesCollapsed(grid, *fit);
+  EXPECT_TRUE(fit->report.quality_met);
   // Not an interpolation: the pole's rounding-sized edges must not drive refinement (without
   // switching their edge ratios off, every block was refined to one control per point).
-  EXPECT_LT(fit->num_control_points * 10, fit->num_points);
-  EXPECT_LT(fit->blocks[4].spline.num_control_points() * 4, grid.blocks[4].num_points());
-  const Extents n = fit->blocks[4].spline.control_extents();
-  std::cout << "[figures] M6 wing + tip cap: " << fit->num_control_points << " controls for "
-            << fit->num_points << " points; cap " << grid.blocks[4].extent(0) << " x "
+  EXPECT_LT(fit->report.num_control_points * 10, fit->report.num_points);
+  EXPECT_LT(fit->blocks[4].fitted.spline.num_control_points() * 4, grid.blocks[4].num_points());
+  const Extents n = fit->blocks[4].fitted.spline.control_extents();
+  std::cout << "[figures] M6 wing + tip cap: " << fit->report.num_control_points << " controls for "
+            << fit->report.num_points << " points; cap " << grid.blocks[4].extent(0) << " x "
             << grid.blocks[4].extent(1) << " points, " << n[0] << " x " << n[1]
-            << " controls, wall deviation " << fit->reports[4].max_deviation.wall << "; max gap "
-            << fit->max_gap << "\n";
+            << " controls, wall deviation " << fit->blocks[4].deviation_by_kind.wall << "; max gap "
+            << fit->report.max_gap << "\n";
 }
 
 // Volume of the trilinear hexahedron with corners x[a + 2b + 4c] (binary order), the integral
@@ -434,19 +445,20 @@ MultiBlockGrid AxisVolume(int ni, int nj, int nk) {
 
 TEST(CollapsedEdgeFitTest, VolumeAroundAPolarAxis) {
   const MultiBlockGrid grid = AxisVolume(9, 33, 9);
-  MultiBlockFitOptions options;
-  options.tolerances.wall = 1e-4;
-  options.tolerances.interface = 1e-3;
-  options.tolerances.outer = 1e-3;
-  const absl::StatusOr<MultiBlockFit> fit = FitMultiBlock(grid, options);
+  BoundaryTolerances tolerances;
+  tolerances.wall = 1e-4;
+  tolerances.interface = 1e-3;
+  tolerances.outer = 1e-3;
+  const GridFitOptions options = KindToleranceOptions(tolerances);
+  const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
   ASSERT_TRUE(fit.ok()) << fit.status();
   // The face k = 0, and the boundary lines k = 0 of the faces i = 0 and i = max.
-  EXPECT_EQ(fit->poles.size(), 3u);
+  EXPECT_EQ(GridPoles(grid).size(), 3u);
   ASSERT_EQ(fit->connectivity.matches.size(), 1u);  // the seam
-  ExpectTolerancesMet(grid, *fit, options.tolerances);
+  ExpectTolerancesMet(grid, *fit, tolerances);
   ExpectWatertight(grid, *fit);
-  ExpectPolesCollapsed(*fit, CoordinateScale(grid));
-  const FittedBlock& fitted = fit->blocks[0];
+  ExpectPolesCollapsed(grid, *fit);
+  const FittedBlock& fitted = fit->blocks[0].fitted;
   const StructuredBlock& data = grid.blocks[0];
   int64_t wedges = 0;
   for (int level = 0; level <= 2; ++level) {
@@ -476,8 +488,8 @@ TEST(CollapsedEdgeFitTest, VolumeAroundAPolarAxis) {
   EXPECT_GT(wedges, 0);
   const Extents n = fitted.spline.control_extents();
   std::cout << "[figures] axis volume 9 x 33 x 9: " << n[0] << " x " << n[1] << " x " << n[2]
-            << " controls, outer " << fit->reports[0].max_deviation.outer << ", interface "
-            << fit->reports[0].max_deviation.interface << "\n";
+            << " controls, outer " << fit->blocks[0].deviation_by_kind.outer << ", interface "
+            << fit->blocks[0].deviation_by_kind.interface << "\n";
 }
 
 }  // namespace

@@ -7,7 +7,6 @@
 #include "core/bspline/evaluation.h"
 #include "core/deform/deform_motion.h"
 #include "core/deform/deform_quality.h"
-#include "core/fit/adaptive/multiblock_fit.h"
 #include "core/fit/grid_fit.h"
 #include "core/grid/sampling.h"
 #include "core/io/planar_view.h"
@@ -268,13 +267,19 @@ TEST(DeformerTest, SharedFacesStayWatertight) {
     }
     two.blocks.push_back(std::move(part));
   }
-  MultiBlockFit fit = FitMultiBlock(two, MultiBlockFitOptions()).value();
-  ASSERT_TRUE(fit.met) << fit.unmet_reason;
-  ASSERT_LT(fit.max_gap, 1e-12);
-  const Deformer deformer = Deformer::Create(fit.blocks, fit.kinds, DeformOptions()).value();
+  // The tolerance mode by kind, the paper's tolerances as lengths in the grid's unit (chords).
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  options.relative_kinds = 0;
+  const GridFit grid_fit = FitGrid(two, options).value();
+  ASSERT_TRUE(grid_fit.report.tolerance_met) << grid_fit.report.unmet_reason;
+  ASSERT_LT(grid_fit.report.max_gap, 1e-12);
+  std::vector<FittedBlock> fitted;
+  for (const BlockFit& block : grid_fit.blocks) fitted.push_back(block.fitted);
+  const Deformer deformer = Deformer::Create(fitted, grid_fit.kinds, DeformOptions()).value();
   // The controls of the cut: column 56 of block 0 and column 0 of block 1, equal bitwise.
-  const Extents n0 = fit.blocks[0].spline.control_extents();
-  const Extents n1 = fit.blocks[1].spline.control_extents();
+  const Extents n0 = fitted[0].spline.control_extents();
+  const Extents n1 = fitted[1].spline.control_extents();
   ASSERT_EQ(n0[1], n1[1]);
   auto cut_equal = [&](const std::vector<FittedBlock>& blocks) {
     for (int j = 0; j < n0[1]; ++j) {
@@ -284,12 +289,12 @@ TEST(DeformerTest, SharedFacesStayWatertight) {
     }
     return true;
   };
-  ASSERT_TRUE(cut_equal(fit.blocks));
+  ASSERT_TRUE(cut_equal(fitted));
   for (double degrees : {15.0, -15.0}) {
     const std::vector<FittedBlock> moved = deformer.Rigid(Pitch(degrees)).value();
     EXPECT_TRUE(cut_equal(moved));
-    EXPECT_LT(MaxBoundaryGap(fit.connectivity, moved, 2), 1e-12);
-    EXPECT_EQ(CheckDeformation(fit.blocks, moved, fit.kinds, 1).value().folded, 0);
+    EXPECT_LT(MaxBoundaryGap(grid_fit.connectivity, moved, 2), 1e-12);
+    EXPECT_EQ(CheckDeformation(fitted, moved, grid_fit.kinds, 1).value().folded, 0);
   }
 }
 

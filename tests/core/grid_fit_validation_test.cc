@@ -115,11 +115,16 @@ TEST(GridFitValidationTest, MaxControlsBelowTheOrderIsRefused) {
 
 TEST(GridFitValidationTest, TheKernelsToleranceFitsRefuseACapBelowTheOrderToo) {
   const MultiBlockGrid grid = Curved(30, 12);
-  MultiBlockFitOptions multi;
-  multi.tolerances.wall = multi.tolerances.interface = multi.tolerances.outer = 1e-3;
+  // Tolerances by kind (the multi-block tolerance fit) refuse it as the one tolerance does.
+  GridFitOptions multi;
+  BoundaryTolerances tolerances;
+  tolerances.wall = tolerances.interface = tolerances.outer = 1e-3;
+  multi.boundary_tolerances = tolerances;
+  multi.relative_kinds = 0;
   multi.max_controls_per_direction = 2;
-  EXPECT_THAT(FitMultiBlock(grid, multi).status().message(),
-              HasSubstr("max_controls_per_direction = 2 is below order = 4"));
+  const absl::Status status = FitGrid(grid, multi).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("max_controls_per_direction = 2 is below order = 4"));
   ToleranceFitOptions single;
   single.max_controls_per_direction = 3;
   single.order = 5;

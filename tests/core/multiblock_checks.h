@@ -1,6 +1,6 @@
-// Independent checks of a multi-block fit (multiblock_fit.h), shared by its tests: every point
-// within its kind's tolerance, re-measured; the report's per-kind maxima; shared boundary
-// controls bitwise equal, found without the segment model through the control whose basis
+// Independent checks of a multi-block fit to tolerances (FitGrid, grid_fit.h), shared by its tests:
+// every point within its kind's tolerance, re-measured; the report's per-kind maxima; shared
+// boundary controls bitwise equal, found without the segment model through the control whose basis
 // function is exactly 1 at each end of a matched range; and the gaps between the two sides of
 // every match evaluated point by point at refinement levels 0..2.
 #ifndef SPLINEGRID_TESTS_CORE_MULTIBLOCK_CHECKS_H_
@@ -14,7 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/bspline/basis.h"
 #include "core/bspline/evaluation.h"
-#include "core/fit/adaptive/multiblock_fit.h"
+#include "core/fit/grid_fit.h"
 #include "gtest/gtest.h"
 
 namespace splinegrid {
@@ -26,6 +26,16 @@ inline constexpr double kToleranceRounding = 1e-12;
 // equal up to rounding, relative to the largest coordinate.
 inline constexpr double kGapRounding = 1e-14;
 
+// The tolerance mode of FitGrid held to `tolerances` by kind as absolute lengths in the grid's
+// unit (no kind relative to the reference length): the defaults are the QUADFLOW paper's
+// 0.15e-3, 2e-3 and 8e-3 in the grid's unit, none inside.
+inline GridFitOptions KindToleranceOptions(const BoundaryTolerances& tolerances = {}) {
+  GridFitOptions options;
+  options.boundary_tolerances = tolerances;
+  options.relative_kinds = 0;
+  return options;
+}
+
 inline double CoordinateScale(const MultiBlockGrid& grid) {
   double scale = 0.0;
   for (const StructuredBlock& b : grid.blocks) {
@@ -34,19 +44,25 @@ inline double CoordinateScale(const MultiBlockGrid& grid) {
   return scale;
 }
 
-// Every point within its kind's tolerance, and the report's per-kind maxima, re-measured.
-inline void ExpectTolerancesMet(const MultiBlockGrid& grid, const MultiBlockFit& fit,
+// Every point within its kind's tolerance, and the report's per-kind maxima, re-measured; the
+// report holds the tolerances (in the grid's unit) the fit was held to.
+inline void ExpectTolerancesMet(const MultiBlockGrid& grid, const GridFit& fit,
                                 const BoundaryTolerances& tolerances) {
-  EXPECT_TRUE(fit.met) << fit.unmet_reason;
+  EXPECT_TRUE(fit.report.tolerance_met) << fit.report.unmet_reason;
   ASSERT_EQ(fit.blocks.size(), grid.blocks.size());
-  ASSERT_EQ(fit.reports.size(), grid.blocks.size());
+  ASSERT_TRUE(fit.report.tolerances.has_value());
+  EXPECT_EQ(fit.report.tolerances->wall, tolerances.wall);
+  EXPECT_EQ(fit.report.tolerances->interface, tolerances.interface);
+  EXPECT_EQ(fit.report.tolerances->outer, tolerances.outer);
+  EXPECT_EQ(fit.report.tolerances->interior, tolerances.interior);
   int64_t points = 0, controls = 0;
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     SCOPED_TRACE(absl::StrCat("block ", b));
     const StructuredBlock& data = grid.blocks[b];
-    const PointDistribution& dist = fit.blocks[b].distribution;
+    const FittedBlock& fitted = fit.blocks[b].fitted;
+    const PointDistribution& dist = fitted.distribution;
     const StructuredBlock eval =
-        EvaluateGrid(fit.blocks[b].spline, {dist.params(0), dist.params(1), dist.params(2)});
+        EvaluateGrid(fitted.spline, {dist.params(0), dist.params(1), dist.params(2)});
     ASSERT_EQ(eval.extents(), data.extents());
     const std::vector<double> tol = PointTolerances(fit.kinds, static_cast<int>(b), tolerances);
     KindDeviation dev;
@@ -66,24 +82,27 @@ inline void ExpectTolerancesMet(const MultiBlockGrid& grid, const MultiBlockFit&
         dev.interface = std::max(dev.interface, d);
       if (k & static_cast<uint8_t>(BoundaryKind::kOuter)) dev.outer = std::max(dev.outer, d);
     }
-    const KindDeviation& reported = fit.reports[b].max_deviation;
+    const KindDeviation& reported = fit.blocks[b].deviation_by_kind;
     for (auto [mine, theirs] : {std::pair{dev.wall, reported.wall},
                                 {dev.interface, reported.interface},
                                 {dev.outer, reported.outer},
                                 {dev.interior, reported.interior}}) {
       EXPECT_NEAR(theirs, mine, kToleranceRounding * (1.0 + std::abs(mine)));
     }
-    EXPECT_TRUE(fit.reports[b].tolerance_met);
-    EXPECT_EQ(fit.blocks[b].summary.num_points, data.num_points());
-    EXPECT_EQ(fit.blocks[b].summary.num_control_points, fit.blocks[b].spline.num_control_points());
+    EXPECT_TRUE(fit.blocks[b].tolerance_met) << fit.blocks[b].unmet_reason;
+    EXPECT_EQ(fitted.summary.num_points, data.num_points());
+    EXPECT_EQ(fitted.summary.num_control_points, fitted.spline.num_control_points());
     points += data.num_points();
-    controls += fit.blocks[b].spline.num_control_points();
+    controls += fitted.spline.num_control_points();
   }
-  EXPECT_EQ(fit.num_points, points);
-  EXPECT_EQ(fit.num_control_points, controls);
+  EXPECT_EQ(fit.report.num_points, points);
+  EXPECT_EQ(fit.report.num_control_points, controls);
+  // Quality met: every block's cells measured and none folded or resized.
   bool quality = true;
-  for (const BlockFitReport& r : fit.reports) quality = quality && r.quality.ok();
-  EXPECT_EQ(fit.quality_met, quality);
+  for (const BlockFit& block : fit.blocks) {
+    quality = quality && block.quality.ok() && block.quality.measured();
+  }
+  EXPECT_EQ(fit.report.quality_met, quality);
 }
 
 // The control index of `knots` whose basis function is exactly 1 at u (a clamped end or a knot
@@ -98,12 +117,12 @@ inline int ControlAt(const KnotVector& knots, double u) {
 
 // The controls of both sides of every match (the box of controls between those at the range
 // ends, mapped with the match's orientation) are bitwise equal. Returns how many were compared.
-inline int ExpectSharedControlsBitwiseEqual(const MultiBlockFit& fit) {
+inline int ExpectSharedControlsBitwiseEqual(const GridFit& fit) {
   int compared = 0;
   for (const BoundaryMatch& m : fit.connectivity.matches) {
     SCOPED_TRACE(m.Describe());
-    const FittedBlock& fa = fit.blocks[m.a.face.block];
-    const FittedBlock& fb = fit.blocks[m.b.face.block];
+    const FittedBlock& fa = fit.blocks[m.a.face.block].fitted;
+    const FittedBlock& fb = fit.blocks[m.b.face.block].fitted;
     const Extents na = fa.spline.control_extents(), nb = fb.spline.control_extents();
     Extents lo = {0, 0, 0}, hi = {0, 0, 0}, blo = {0, 0, 0};
     std::array<int, 3> bhi = {0, 0, 0};
@@ -146,11 +165,11 @@ inline int ExpectSharedControlsBitwiseEqual(const MultiBlockFit& fit) {
 // The largest distance between the two sides of every match, each point evaluated on its own
 // (EvaluatePoint) at the refined parameters of level 0..max_level (hanging nodes: level 0, the
 // coarse side's points and every second point of the fine side).
-inline double PointwiseGap(const MultiBlockFit& fit, int max_level) {
+inline double PointwiseGap(const GridFit& fit, int max_level) {
   double gap = 0.0;
   for (const BoundaryMatch& m : fit.connectivity.matches) {
-    const FittedBlock& fa = fit.blocks[m.a.face.block];
-    const FittedBlock& fb = fit.blocks[m.b.face.block];
+    const FittedBlock& fa = fit.blocks[m.a.face.block].fitted;
+    const FittedBlock& fb = fit.blocks[m.b.face.block].fitted;
     for (int level = 0; level <= (m.step == 1 ? max_level : 0); ++level) {
       std::array<std::vector<double>, 3> pa, pb;
       for (int d = 0; d < 3; ++d) {
@@ -183,10 +202,10 @@ inline double PointwiseGap(const MultiBlockFit& fit, int max_level) {
 
 // Watertight: shared controls bitwise equal and no gap beyond rounding at levels 0..2, as the
 // fit reports it and measured point by point.
-inline void ExpectWatertight(const MultiBlockGrid& grid, const MultiBlockFit& fit) {
+inline void ExpectWatertight(const MultiBlockGrid& grid, const GridFit& fit) {
   EXPECT_GT(ExpectSharedControlsBitwiseEqual(fit), 0);
   const double rounding = kGapRounding * CoordinateScale(grid);
-  EXPECT_LE(fit.max_gap, rounding);
+  EXPECT_LE(fit.report.max_gap, rounding);
   EXPECT_LE(PointwiseGap(fit, 2), rounding);
 }
 

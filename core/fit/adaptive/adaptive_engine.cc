@@ -13,7 +13,7 @@
 #include "core/fit/adaptive/refinement.h"
 #include "core/util/status_macros.h"
 
-namespace splinegrid {
+namespace splinegrid::internal {
 namespace {
 
 // Quality of a set of blocks, ordered: fewer bad original cells first, then fewer folded
@@ -545,4 +545,4 @@ absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentM
   return engine.Run();
 }
 
-}  // namespace splinegrid
+}  // namespace splinegrid::internal

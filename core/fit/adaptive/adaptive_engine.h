@@ -1,4 +1,5 @@
-// The knot refinement loop shared by single-block and multi-block tolerance fits.
+// The knot refinement loop shared by single-block and multi-block tolerance fits (internal: its
+// settings are built from GridFitOptions or ToleranceFitOptions by the fits that run it).
 //
 // Given a SegmentModel (which directions share knots) and a tolerance per data point:
 //  1. Refine: fit every block (tensor least squares with the model's knots and pins); where some
@@ -29,16 +30,17 @@
 
 #include "absl/status/statusor.h"
 #include "core/fit/adaptive/segment_model.h"
+#include "core/fit/fit_defaults.h"
 #include "core/fit/report/grid_quality.h"
 #include "core/fit/solve/fairing.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/util/cancellation.h"
 
-namespace splinegrid {
+namespace splinegrid::internal {
 
 struct EngineOptions {
   // Refinement rounds before giving up.
-  int max_iterations = 60;
+  int max_iterations = kDefaultMaxRefinementRounds;
   // Try to drop every knot once the tolerances hold.
   bool remove_unneeded_knots = true;
   // The cell quality of block b's fit; unset: no quality check.
@@ -80,6 +82,6 @@ absl::StatusOr<EngineResult> RunAdaptiveFit(const MultiBlockGrid& grid, SegmentM
                                             std::vector<std::vector<double>>& edge_tolerances,
                                             const EngineOptions& options);
 
-}  // namespace splinegrid
+}  // namespace splinegrid::internal
 
 #endif  // SPLINEGRID_CORE_FIT_ADAPTIVE_ADAPTIVE_ENGINE_H_

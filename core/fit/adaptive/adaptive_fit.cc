@@ -47,12 +47,13 @@ absl::StatusOr<ToleranceFitResult> FitToTolerance(const StructuredBlock& block,
   std::vector<std::vector<double>> tolerances(1);
   tolerances[0].assign(tolerance.begin(), tolerance.end());
   if (tolerance.size() == 1) tolerances[0].assign(block.num_points(), tolerance[0]);
-  EngineOptions engine;
+  internal::EngineOptions engine;
   engine.max_iterations = options.max_iterations;
   engine.remove_unneeded_knots = options.remove_unneeded_knots;
   engine.cancel = options.cancel;
   std::vector<std::vector<double>> no_edges(1);
-  SG_ASSIGN_OR_RETURN(EngineResult run, RunAdaptiveFit(grid, model, tolerances, no_edges, engine));
+  SG_ASSIGN_OR_RETURN(internal::EngineResult run,
+                      internal::RunAdaptiveFit(grid, model, tolerances, no_edges, engine));
 
   ToleranceFitResult result;
   result.fitted = std::move(run.blocks[0]);

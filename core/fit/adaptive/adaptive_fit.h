@@ -25,18 +25,19 @@
 
 #include "absl/status/statusor.h"
 #include "core/fit/adaptive/refinement.h"
+#include "core/fit/fit_defaults.h"
 #include "core/fit/solve/tensor_fit.h"
 
 namespace splinegrid {
 
 struct ToleranceFitOptions {
   // Spline order (degree + 1) of every direction with enough points.
-  int order = 4;
-  Parametrization parametrization = Parametrization::kChordLength;
+  int order = kDefaultOrder;
+  Parametrization parametrization = kDefaultParametrization;
   // Most control points per direction; 0 means the direction's point count (interpolation).
   int max_controls_per_direction = 0;
   // Knot insertion rounds before giving up (each round splits every span that needs it).
-  int max_iterations = 60;
+  int max_iterations = kDefaultMaxRefinementRounds;
   // After the tolerance is met, try to drop knots one by one and keep each removal that still
   // meets it (cost: one tensor fit per knot).
   bool remove_unneeded_knots = true;

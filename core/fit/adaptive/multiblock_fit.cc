@@ -8,14 +8,12 @@
 #include "core/bspline/evaluation.h"
 #include "core/fit/adaptive/adaptive_engine.h"
 #include "core/fit/adaptive/segment_model.h"
+#include "core/fit/report/fit_report.h"
 #include "core/util/status_macros.h"
 #include "core/util/union_find.h"
 
-namespace splinegrid {
+namespace splinegrid::internal {
 namespace {
-
-// Refinement level of the wall curvature samples: three samples between grid points.
-constexpr int kCurvatureLevel = 2;
 
 // Union-find over (block, control index) pairs: a control's id is its block's offset plus its
 // index, so the first block in order owns a shared boundary (UnionFind keeps the smaller id).
@@ -182,113 +180,6 @@ std::vector<Extents> LinesWithWall(const StructuredBlock& block, const std::vect
   return lines;
 }
 
-std::string KindNames(uint8_t mask) {
-  if (mask == 0) return "interior";
-  std::string names;
-  for (BoundaryKind k : {BoundaryKind::kWall, BoundaryKind::kInterface, BoundaryKind::kOuter}) {
-    if (mask & static_cast<uint8_t>(k)) {
-      absl::StrAppend(&names, names.empty() ? "" : "/", std::string(BoundaryKindName(k)));
-    }
-  }
-  return names;
-}
-
-}  // namespace
-
-absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
-                                              const StructuredBlock& block,
-                                              const std::vector<uint8_t>& kinds) {
-  std::array<std::vector<double>, 3> params;
-  for (int d = 0; d < 3; ++d) params[d] = fitted.distribution.params(d);
-  const StructuredBlock eval = EvaluateGrid(fitted.spline, params);
-  KindDeviation dev;
-  const int s = block.spatial_dim();
-  for (int64_t p = 0; p < block.num_points(); ++p) {
-    double d2 = 0.0;
-    for (int c = 0; c < s; ++c) {
-      const double diff = eval.coords()[s * p + c] - block.coords()[s * p + c];
-      d2 += diff * diff;
-    }
-    const double d = std::sqrt(d2);
-    const uint8_t k = kinds[p];
-    if (k == 0) dev.interior = std::max(dev.interior, d);
-    if (k & static_cast<uint8_t>(BoundaryKind::kWall)) dev.wall = std::max(dev.wall, d);
-    if (k & static_cast<uint8_t>(BoundaryKind::kInterface))
-      dev.interface = std::max(dev.interface, d);
-    if (k & static_cast<uint8_t>(BoundaryKind::kOuter)) dev.outer = std::max(dev.outer, d);
-  }
-  return dev;
-}
-
-double MaxBoundaryGap(const Connectivity& connectivity, const std::vector<FittedBlock>& blocks,
-                      int max_level) {
-  double gap = 0.0;
-  for (const BoundaryMatch& m : connectivity.matches) {
-    const FittedBlock& fa = blocks[m.a.face.block];
-    const FittedBlock& fb = blocks[m.b.face.block];
-    for (int level = 0; level <= (m.step == 1 ? max_level : 0); ++level) {
-      std::array<std::vector<double>, 3> pa, pb;
-      for (int d = 0; d < 3; ++d) {
-        pa[d] = fa.distribution.Refined(d, m.a.begin[d], m.a.end[d], level);
-      }
-      for (int e = 0; e < 3; ++e) {
-        pb[e] = fb.distribution.Refined(e, m.b.begin[e], m.b.end[e], m.step == 1 ? level : 0);
-        if (m.step == 2) {
-          std::vector<double> even;
-          for (size_t q = 0; q < pb[e].size(); q += (pb[e].size() > 1 ? 2 : 1))
-            even.push_back(pb[e][q]);
-          if (m.b.end[e] > m.b.begin[e]) pb[e] = even;
-        }
-      }
-      const StructuredBlock ea = EvaluateGrid(fa.spline, pa);
-      const StructuredBlock eb = EvaluateGrid(fb.spline, pb);
-      const int s = ea.spatial_dim();
-      for (int k = 0; k < ea.extent(2); ++k) {
-        for (int j = 0; j < ea.extent(1); ++j) {
-          for (int i = 0; i < ea.extent(0); ++i) {
-            // The index in b's evaluated range of a's evaluated point (i, j, k).
-            const Extents x = {i, j, k};
-            Extents y = {0, 0, 0};
-            for (int d = 0; d < 3; ++d) {
-              const int e = m.b_direction[d];
-              if (e < 0) continue;
-              y[e] = m.reversed[d] ? eb.extent(e) - 1 - x[d] : x[d];
-            }
-            double d2 = 0.0;
-            for (int c = 0; c < s; ++c) {
-              const double diff = ea.Point(i, j, k)[c] - eb.Point(y[0], y[1], y[2])[c];
-              d2 += diff * diff;
-            }
-            gap = std::max(gap, std::sqrt(d2));
-          }
-        }
-      }
-    }
-  }
-  return gap;
-}
-
-absl::Status MultiBlockFitOptions::Validate() const {
-  if (order < 2 || order > kMaxOrder) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("order = ", order, " is outside [2, ", kMaxOrder, "]"));
-  }
-  SG_RETURN_IF_ERROR(ValidateControlCap(max_controls_per_direction, order));
-  if (max_iterations < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("max_iterations = ", max_iterations, " is negative"));
-  }
-  SG_RETURN_IF_ERROR(ValidateParametrization(parametrization));
-  SG_RETURN_IF_ERROR(tolerances.Validate());
-  SG_RETURN_IF_ERROR(connectivity.Validate());
-  SG_RETURN_IF_ERROR(features.Validate());
-  SG_RETURN_IF_ERROR(quality.Validate());
-  SG_RETURN_IF_ERROR(fairing.Validate());
-  return absl::OkStatus();
-}
-
-namespace {
-
 // Parameters of every block: averaged over all grid lines of each direction, or (walls) over
 // the lines that lie on walls where a direction has any. Sets *any_wall if some direction
 // differs.
@@ -318,21 +209,21 @@ struct PointTargets {
   std::vector<std::array<std::vector<int>, 3>> features;
 };
 
-// The point and edge tolerances of every block by the kinds of `result`, and the feature
-// points of every direction.
-PointTargets TargetsAndFeatures(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
-                                const MultiBlockFit& result) {
+// The point and edge tolerances of every block by `kinds`, and the feature points of every
+// direction.
+PointTargets TargetsAndFeatures(const MultiBlockGrid& grid, const BoundaryKinds& kinds,
+                                const BoundaryTolerances& tolerances,
+                                const FeatureOptions& features) {
   const int nb = static_cast<int>(grid.blocks.size());
   PointTargets targets;
   targets.tolerances.resize(nb);
   targets.edge_tolerances.resize(nb);
   targets.features.resize(nb);
   for (int b = 0; b < nb; ++b) {
-    targets.tolerances[b] = PointTolerances(result.kinds, b, options.tolerances);
-    targets.edge_tolerances[b] = PointEdgeTolerances(result.kinds, b, options.tolerances);
-    for (int d = 0; d < 3; ++d) {
-      targets.features[b][d] = DetectFeatures(grid.blocks[b], d, options.features);
-    }
+    targets.tolerances[b] = PointTolerances(kinds, b, tolerances);
+    targets.edge_tolerances[b] = PointEdgeTolerances(kinds, b, tolerances);
+    for (int d = 0; d < 3; ++d)
+      targets.features[b][d] = DetectFeatures(grid.blocks[b], d, features);
   }
   return targets;
 }
@@ -358,15 +249,15 @@ void SwitchOffPoleEdges(const MultiBlockGrid& grid, const std::vector<Pole>& pol
   }
 }
 
-// The adaptive engine's options from `options`; the quality check (when on) uses `quality`,
-// which must outlive the engine's run.
-EngineOptions EngineOptionsFor(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+// The adaptive engine's settings, from `options` once; the quality check (when on) uses
+// `quality`, which must outlive the engine's run.
+EngineOptions EngineOptionsFor(const MultiBlockGrid& grid, const GridFitOptions& options,
                                const CellQualityOptions& quality) {
   EngineOptions engine;
   engine.max_iterations = options.max_iterations;
   engine.remove_unneeded_knots = options.remove_unneeded_knots;
   engine.fairing = options.fairing;
-  engine.cancel = options.cancel;
+  engine.cancel = quality.cancel;
   if (options.check_quality) {
     engine.quality = [&grid, &quality](int b, const FittedBlock& fitted) {
       return CheckCellQuality(fitted, grid.blocks[b], quality);
@@ -379,177 +270,98 @@ EngineOptions EngineOptionsFor(const MultiBlockGrid& grid, const MultiBlockFitOp
 // poles first (each line to its mean), then the shared controls and the pole lines made one
 // value across blocks.
 void TakeRun(EngineResult run, const MultiBlockGrid& grid, const SegmentModel& model,
-             const Connectivity& shared, bool watertight, MultiBlockFit& result) {
-  result.blocks = std::move(run.blocks);
-  result.unfaired = std::move(run.unfaired);
-  CollapsePoles(result.poles, grid, result.blocks);
-  CollapsePoles(result.poles, grid, result.unfaired);
+             const Connectivity& shared, bool watertight, MultiBlockRun& result) {
+  CollapsePoles(result.poles, grid, run.blocks);
+  CollapsePoles(result.poles, grid, run.unfaired);
   if (watertight || !result.poles.empty()) {
-    CopySharedControls(model, shared, result.poles, grid, result.blocks);
-    if (!result.unfaired.empty()) {
-      CopySharedControls(model, shared, result.poles, grid, result.unfaired);
-    }
+    CopySharedControls(model, shared, result.poles, grid, run.blocks);
+    if (!run.unfaired.empty()) CopySharedControls(model, shared, result.poles, grid, run.unfaired);
   }
-  result.iterations = run.iterations;
-  result.knots_inserted = run.knots_inserted;
-  result.knots_removed = run.knots_removed;
-  result.quality_rounds = run.quality_rounds;
-  result.fairing_weight = run.fairing_weight;
+  result.fit.blocks.clear();
+  for (FittedBlock& fitted : run.blocks) result.fit.blocks.push_back({.fitted = std::move(fitted)});
+  result.unfaired = std::move(run.unfaired);
+  GridFitReport& report = result.fit.report;
+  report.iterations = run.iterations;
+  report.knots_inserted = run.knots_inserted;
+  report.knots_removed = run.knots_removed;
+  report.quality_rounds = run.quality_rounds;
+  report.fairing_weight = run.fairing_weight;
 }
 
-// The report of block b of `result` against the original (untightened) tolerances: its
-// deviation (into the block's summary too), by kind, and its cell quality.
-absl::StatusOr<BlockFitReport> ReportBlock(const MultiBlockGrid& grid,
-                                           const MultiBlockFitOptions& options,
-                                           const CellQualityOptions& quality, int b,
-                                           MultiBlockFit& result) {
-  FittedBlock& fitted = result.blocks[b];
-  const std::vector<double> tol = PointTolerances(result.kinds, b, options.tolerances);
-  std::array<std::vector<double>, 3> p;
-  for (int d = 0; d < 3; ++d) p[d] = fitted.distribution.params(d);
-  SG_ASSIGN_OR_RETURN(fitted.summary.deviation,
-                      MeasureDeviation(fitted.spline, p, grid.blocks[b], options.cancel, tol));
-  BlockFitReport report;
-  SG_ASSIGN_OR_RETURN(report.max_deviation,
-                      DeviationByKind(fitted, grid.blocks[b], result.kinds.point_kinds[b]));
-  SG_ASSIGN_OR_RETURN(report.quality, CheckCellQuality(fitted, grid.blocks[b], quality));
-  const Deviation& dev = fitted.summary.deviation;
-  report.tolerance_met = dev.max_ratio <= 1.0;
-  if (!report.tolerance_met) {
-    const Extents& at = dev.max_ratio_at;
-    const uint8_t kind = result.kinds.point_kinds[b][grid.blocks[b].Index(at[0], at[1], at[2])];
-    report.unmet_reason = absl::StrCat("block ", b, " ", KindNames(kind), " point (", at[0], ", ",
-                                       at[1], ", ", at[2], ") deviates ", dev.max_ratio,
-                                       " times its tolerance of ", options.tolerances.For(kind));
-  }
-  fitted.summary.num_points = grid.blocks[b].num_points();
-  fitted.summary.num_control_points = fitted.spline.num_control_points();
-  fitted.summary.compression_ratio =
-      static_cast<double>(fitted.summary.num_points) / fitted.summary.num_control_points;
-  return report;
-}
-
-// The reports of every block (ReportBlock), whether all are met (the first unmet block's
-// reason), the point and control counts, the largest boundary gap and the wall curvature.
-absl::Status ReportBlocks(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
-                          const CellQualityOptions& quality, MultiBlockFit& result) {
-  result.met = true;
-  result.quality_met = true;
-  result.reports.clear();
-  result.num_points = result.num_control_points = 0;
-  result.unmet_reason.clear();
-  for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
-    SG_ASSIGN_OR_RETURN(BlockFitReport report, ReportBlock(grid, options, quality, b, result));
-    result.quality_met = result.quality_met && report.quality.ok() && report.quality.measured();
-    if (!report.tolerance_met) {
-      if (result.met) result.unmet_reason = report.unmet_reason;
-      result.met = false;
-    }
-    result.num_points += grid.blocks[b].num_points();
-    result.num_control_points += result.blocks[b].spline.num_control_points();
-    result.reports.push_back(std::move(report));
-  }
-  result.max_gap = options.watertight ? MaxBoundaryGap(result.connectivity, result.blocks,
-                                                       options.quality.max_level)
-                                      : 0.0;
-  result.wall_curvature = WallCurvatureMetrics(result.blocks, result.kinds, kCurvatureLevel);
-  result.unfaired_wall_curvature = {};
-  if (!result.unfaired.empty()) {
-    result.unfaired_wall_curvature =
-        WallCurvatureMetrics(result.unfaired, result.kinds, kCurvatureLevel);
-  }
-  return absl::OkStatus();
-}
-
-// The fit with the given parameters; `result` holds the connectivity and kinds already.
-absl::Status FitWithParameters(const MultiBlockGrid& grid, const MultiBlockFitOptions& options,
+// The fit with the given parameters; `result` holds the connectivity, kinds and poles already.
+absl::Status FitWithParameters(const MultiBlockGrid& grid, const GridFitOptions& options,
+                               const BoundaryTolerances& tolerances,
+                               const CellQualityOptions& quality,
                                const std::vector<std::array<std::vector<double>, 3>>& params,
-                               MultiBlockFit& result) {
-  PointTargets targets = TargetsAndFeatures(grid, options, result);
+                               MultiBlockRun& result) {
+  PointTargets targets = TargetsAndFeatures(grid, result.fit.kinds, tolerances, options.features);
   SwitchOffPoleEdges(grid, result.poles, targets.edge_tolerances);
   const Connectivity none;
-  const Connectivity& shared = options.watertight ? result.connectivity : none;
+  const Connectivity& shared = options.watertight ? result.fit.connectivity : none;
   SG_ASSIGN_OR_RETURN(SegmentModel model,
                       SegmentModel::Build(grid, params, shared, targets.features, options.order,
                                           options.max_controls_per_direction));
-  CellQualityOptions quality = options.quality;
-  quality.cancel = options.cancel;
   SG_ASSIGN_OR_RETURN(EngineResult run,
                       RunAdaptiveFit(grid, model, targets.tolerances, targets.edge_tolerances,
                                      EngineOptionsFor(grid, options, quality)));
   TakeRun(std::move(run), grid, model, shared, options.watertight, result);
-  return ReportBlocks(grid, options, quality, result);
+  return ReportFit(grid, quality, &tolerances, result.unfaired, result.fit);
 }
 
 // Whether fit a is better than b: tolerances met, then fewer bad cells, fewer folded
 // sub-cells, then a smoother wall (smaller sum of squared curvature differences).
-bool Better(const MultiBlockFit& a, const MultiBlockFit& b) {
-  auto key = [](const MultiBlockFit& f) {
+bool Better(const GridFit& a, const GridFit& b) {
+  auto key = [](const GridFit& f) {
     int64_t bad = 0, folded = 0;
-    for (const BlockFitReport& r : f.reports) {
-      bad += r.quality.num_bad_cells;
-      folded += r.quality.folded;
+    for (const BlockFit& block : f.blocks) {
+      bad += block.quality.num_bad_cells;
+      folded += block.quality.folded;
     }
-    return std::make_tuple(!f.met, bad, folded, f.wall_curvature.sum_squared_differences);
+    return std::make_tuple(!f.report.tolerance_met, bad, folded,
+                           f.report.wall_curvature.sum_squared_differences);
   };
   return key(a) < key(b);
 }
 
-// OK for options and a grid FitMultiBlock can start on.
-absl::Status ValidateMultiBlockFit(const MultiBlockGrid& grid,
-                                   const MultiBlockFitOptions& options) {
-  SG_RETURN_IF_ERROR(options.Validate());
-  if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
-  return absl::OkStatus();
-}
+}  // namespace
 
-// FitMultiBlock after ValidateMultiBlockFit.
-absl::StatusOr<MultiBlockFit> FitValidated(const MultiBlockGrid& grid,
-                                           const Connectivity& connectivity,
-                                           const MultiBlockFitOptions& options) {
+absl::StatusOr<MultiBlockRun> FitMultiBlock(const MultiBlockGrid& grid,
+                                            const Connectivity& connectivity,
+                                            const BoundaryKinds& kinds,
+                                            const GridFitOptions& options,
+                                            const BoundaryTolerances& tolerances,
+                                            const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
-  MultiBlockFit result;
-  result.connectivity = connectivity;
+  CellQualityOptions quality = options.quality;
+  quality.cancel = cancel;
+  MultiBlockRun result;
+  result.fit.connectivity = connectivity;
+  result.fit.report.tolerances = tolerances;
   result.poles = FindPoles(grid, PoleTolerance(grid));
-  SG_ASSIGN_OR_RETURN(result.kinds,
-                      ClassifyBoundaries(grid, result.connectivity, options.face_kinds));
+  result.fit.kinds = kinds;
   bool any_wall = false;
   const bool walls_first = options.wall_parameters != WallParametrization::kAverage;
   SG_RETURN_IF_ERROR(FitWithParameters(
-      grid, options,
-      BlockParameters(grid, result.kinds, options.parametrization, walls_first, &any_wall),
+      grid, options, tolerances, quality,
+      BlockParameters(grid, result.fit.kinds, options.parametrization, walls_first, &any_wall),
       result));
   if (options.wall_parameters == WallParametrization::kAuto && any_wall) {
-    MultiBlockFit averaged;
-    averaged.connectivity = result.connectivity;
+    MultiBlockRun averaged;
+    averaged.fit.connectivity = result.fit.connectivity;
+    averaged.fit.kinds = result.fit.kinds;
+    averaged.fit.report.tolerances = tolerances;
     averaged.poles = result.poles;
-    averaged.kinds = result.kinds;
     SG_RETURN_IF_ERROR(FitWithParameters(
-        grid, options,
-        BlockParameters(grid, result.kinds, options.parametrization, false, &any_wall), averaged));
-    if (Better(averaged, result)) result = std::move(averaged);
+        grid, options, tolerances, quality,
+        BlockParameters(grid, result.fit.kinds, options.parametrization, false, &any_wall),
+        averaged));
+    if (Better(averaged.fit, result.fit)) result = std::move(averaged);
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const int nb = static_cast<int>(grid.blocks.size());
-  for (FittedBlock& fitted : result.blocks) fitted.summary.seconds = result.seconds / nb;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (BlockFit& block : result.fit.blocks)
+    block.fitted.summary.seconds = seconds / grid.blocks.size();
   return result;
 }
 
-}  // namespace
-
-absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
-                                            const MultiBlockFitOptions& options) {
-  SG_RETURN_IF_ERROR(ValidateMultiBlockFit(grid, options));
-  SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
-                      FindConnectivity(grid, options.connectivity));
-  return FitValidated(grid, connectivity, options);
-}
-
-absl::StatusOr<MultiBlockFit> FitMultiBlock(const MultiBlockGrid& grid,
-                                            const Connectivity& connectivity,
-                                            const MultiBlockFitOptions& options) {
-  SG_RETURN_IF_ERROR(ValidateMultiBlockFit(grid, options));
-  return FitValidated(grid, connectivity, options);
-}
-
-}  // namespace splinegrid
+}  // namespace splinegrid::internal

@@ -87,6 +87,7 @@
 #include "core/bspline/parametrization.h"
 #include "core/bspline/tensor_spline.h"
 #include "core/fit/adaptive/refinement.h"
+#include "core/fit/fit_defaults.h"
 #include "core/fit/report/wall_curvature.h"
 #include "core/fit/solve/fairing.h"
 #include "core/grid/structured_grid.h"
@@ -99,7 +100,7 @@ struct AirfoilFitOptions {
   // normalised coordinates). Also the largest trailing-edge gap that counts as sharp.
   double tolerance = 1e-4;
   // Spline order (degree + 1), 3 .. kMaxOrder; curvature needs degree >= 2.
-  int order = 4;
+  int order = kDefaultOrder;
   // Most control points; 0: as many as data points.
   int max_control_points = 0;
   // Initial parameters (before correction).

@@ -24,6 +24,7 @@
 #include "core/bspline/knot_vector.h"
 #include "core/bspline/parametrization.h"
 #include "core/bspline/tensor_spline.h"
+#include "core/fit/fit_defaults.h"
 #include "core/fit/solve/direction_fit.h"
 #include "core/grid/point_distribution.h"
 #include "core/grid/structured_grid.h"
@@ -35,12 +36,12 @@ struct FitOptions {
   // Spline order k (degree k - 1), in [2, kMaxOrder]. The only exception, forced by the data: a
   // direction with m < k points interpolates them at order m (its SplineDirection says so);
   // asking for fewer than k controls where there are at least k points is an error.
-  int order = 4;
+  int order = kDefaultOrder;
   // Control points per direction (i, j, k); 0 means as many as data points (interpolation).
   // Directions with one data point always get one control point. Nothing is clamped: a count
   // above the points or below the order is refused (ValidateControlCounts).
   Extents control_counts = {0, 0, 0};
-  Parametrization parametrization = Parametrization::kChordLength;
+  Parametrization parametrization = kDefaultParametrization;
   KnotPlacement knot_placement = KnotPlacement::kAveraged;
   // Fix the end controls of every direction to the data (corners exact, boundaries from the
   // boundary data alone); see the file comment.

@@ -1,0 +1,37 @@
+// Two measures of a fitted multi-block grid for its report: the largest deviation from the data
+// per boundary kind, and the largest gap between the two sides of every matched boundary.
+#ifndef SPLINEGRID_CORE_FIT_REPORT_FIT_DEVIATION_H_
+#define SPLINEGRID_CORE_FIT_REPORT_FIT_DEVIATION_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/fit/solve/tensor_fit.h"
+#include "core/grid/connectivity.h"
+#include "core/grid/structured_grid.h"
+
+namespace splinegrid {
+
+// Largest deviation per boundary kind (negative: the block has no point of that kind).
+struct KindDeviation {
+  double wall = -1.0;
+  double interface = -1.0;
+  double outer = -1.0;
+  double interior = -1.0;
+};
+
+// Largest distance of `fitted` from `block` at the data parameters, per kind of point (`kinds`:
+// the block's BoundaryKinds::point_kinds).
+absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
+                                              const StructuredBlock& block,
+                                              const std::vector<uint8_t>& kinds);
+
+// Largest distance between the coinciding points of every match of `connectivity` in `blocks`,
+// evaluated at refinement levels 0..max_level (hanging nodes: at the coarse side's points).
+double MaxBoundaryGap(const Connectivity& connectivity, const std::vector<FittedBlock>& blocks,
+                      int max_level);
+
+}  // namespace splinegrid
+
+#endif  // SPLINEGRID_CORE_FIT_REPORT_FIT_DEVIATION_H_
