@@ -1,17 +1,20 @@
 // The operations layer (server/ops) on its own: no gRPC, no protobuf; a real MemoryStore, budget
 // and deformer cache. Fit, fair and deform publish revisions; a deform's deformer is kept by its
-// reference and options; stale bases, folding motions and bad requests change nothing.
+// reference and options; stale bases, folding motions and bad requests change nothing; points
+// are evaluated on the revision asked for, and bad batches are refused naming the field.
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "core/bspline/evaluation.h"
 #include "core/grid/connectivity.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/ops/deform.h"
+#include "server/ops/evaluate_points.h"
 #include "server/ops/fit.h"
 #include "server/ops/wall_curvature.h"
 #include "server/store/memory_store.h"
@@ -186,6 +189,85 @@ TEST_F(OpsTest, WallCurvatureSamplesTheWallLinesWithinTheMessageLimit) {
   request.blocks = {1};
   EXPECT_THAT(ops::WallCurvature(ops_, request, {}).status().message(),
               HasSubstr("blocks: 1 is outside [0, 0]"));
+}
+
+TEST_F(OpsTest, EvaluatePointsEvaluatesTheRevisionAskedFor) {
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  ASSERT_TRUE(ops::Fit(ops_, "naca", options, {}).ok());
+  ASSERT_TRUE(ops::Deform(ops_, Pitch(3.0), {}).ok());
+  const std::vector<int32_t> blocks = {0};
+  const std::vector<double> parameters = {0.0, 0.0, 0.0, 0.25, 0.5, 0.0, 1.0, 1.0, 0.0};
+  ops::PointsRequest request{.grid_id = "naca",
+                             .revision = 1,
+                             .blocks = blocks,
+                             .parameters = parameters,
+                             .derivatives = true,
+                             .max_points = 100,
+                             .max_bytes = int64_t{4} << 20};
+  const ops::EvaluatedPoints fitted = ops::EvaluatePoints(ops_, request).value();
+  EXPECT_EQ(fitted.revision, 1);
+  ASSERT_EQ(fitted.spatial_dim, 2);
+  ASSERT_EQ(fitted.points.size(), 6u);
+  ASSERT_EQ(fitted.dw.size(), 6u);
+  const TensorSpline& spline = store_.Get("naca").value()->revisions[0]->blocks[0].fitted.spline;
+  for (int p = 0; p < 3; ++p) {
+    const Point3 uvw = {parameters[3 * p], parameters[3 * p + 1], parameters[3 * p + 2]};
+    const PartialDerivatives d = EvaluateDerivatives(spline, uvw, 1);
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_EQ(fitted.points[2 * p + c], d(0, 0, 0)[c]);
+      EXPECT_EQ(fitted.du[2 * p + c], d(1, 0, 0)[c]);
+      EXPECT_EQ(fitted.dv[2 * p + c], d(0, 1, 0)[c]);
+    }
+  }
+  // The latest (the pitched one) differs; by step, the same revision.
+  request.revision = 0;
+  request.derivatives = false;
+  const ops::EvaluatedPoints pitched = ops::EvaluatePoints(ops_, request).value();
+  EXPECT_EQ(pitched.revision, 2);
+  EXPECT_TRUE(pitched.du.empty());
+  EXPECT_NE(pitched.points[2], fitted.points[2]);
+  request.step = 7;
+  EXPECT_EQ(ops::EvaluatePoints(ops_, request).value().points, pitched.points);
+}
+
+TEST_F(OpsTest, EvaluatePointsRefusesBadBatchesNamingTheField) {
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  ASSERT_TRUE(ops::Fit(ops_, "naca", options, {}).ok());
+  std::vector<int32_t> blocks = {0};
+  std::vector<double> parameters = {0.5, 0.5, 0.0, 0.5, 1.5, 0.0};
+  ops::PointsRequest request{.grid_id = "naca",
+                             .blocks = blocks,
+                             .parameters = parameters,
+                             .max_points = 100,
+                             .max_bytes = int64_t{4} << 20};
+  EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),
+              HasSubstr("parameters[4] (v of point 1) = 1.5 is outside [0, 1]"));
+  parameters[4] = std::nan("");
+  EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),
+              HasSubstr("parameters[4] (v of point 1) = nan"));
+  parameters[4] = 0.5;
+  blocks = {0, 1};
+  request.blocks = blocks;
+  EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),
+              HasSubstr("blocks[1] = 1 is outside [0, 0]"));
+  blocks = {0, 0, 0};
+  request.blocks = blocks;
+  EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),
+              HasSubstr("blocks: 3 values for 2 points"));
+  request.blocks = std::span<const int32_t>(blocks).first(1);
+  request.parameters = std::span<const double>(parameters).first(5);
+  EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),
+              HasSubstr("parameters: 5 values is not a multiple of 3"));
+  request.parameters = parameters;
+  request.max_points = 1;
+  EXPECT_EQ(ops::EvaluatePoints(ops_, request).status().code(), absl::StatusCode::kOutOfRange);
+  request.max_points = 100;
+  request.revision = 9;
+  EXPECT_EQ(ops::EvaluatePoints(ops_, request).status().code(), absl::StatusCode::kNotFound);
+  request.grid_id = "nothing";
+  EXPECT_EQ(ops::EvaluatePoints(ops_, request).status().code(), absl::StatusCode::kNotFound);
 }
 
 }  // namespace
