@@ -137,8 +137,8 @@ struct GridFitReport {
   // whose every cell was skipped as collapsed (CellQuality::measured()).
   bool quality_met = false;
   int num_matches = 0;  // of the connectivity
-  // Largest distance between coinciding points of matched boundaries at levels 0..2 (0 when
-  // watertight: the tolerance mode).
+  // Largest distance between coinciding points of matched boundaries at levels
+  // 0..quality.max_level (0 up to rounding when watertight: the tolerance mode by default).
   double max_gap = 0.0;
   double fairing_weight = 0.0;
   CurvatureMetrics wall_curvature;           // at refinement level 2
