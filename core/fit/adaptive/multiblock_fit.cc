@@ -1,11 +1,11 @@
 #include "core/fit/adaptive/multiblock_fit.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <tuple>
 
-#include "absl/strings/str_cat.h"
-#include "core/bspline/evaluation.h"
 #include "core/fit/adaptive/adaptive_engine.h"
 #include "core/fit/adaptive/segment_model.h"
 #include "core/fit/report/fit_report.h"
