@@ -38,7 +38,9 @@ void ExpectSameFitOptions(const GridFitOptions& a, const GridFitOptions& b) {
   EXPECT_EQ(a.block_control_counts, b.block_control_counts);
   EXPECT_EQ(a.max_controls_per_direction, b.max_controls_per_direction);
   EXPECT_EQ(a.fairing.mode, b.fairing.mode);
-  if (a.fairing.mode != FairingMode::kOff) EXPECT_EQ(a.fairing.weight, b.fairing.weight);
+  if (a.fairing.mode != FairingMode::kOff) {
+    EXPECT_EQ(a.fairing.weight, b.fairing.weight);
+  }
   ASSERT_EQ(a.face_kinds.size(), b.face_kinds.size());
   for (size_t q = 0; q < a.face_kinds.size(); ++q) {
     EXPECT_EQ(a.face_kinds[q].face, b.face_kinds[q].face);

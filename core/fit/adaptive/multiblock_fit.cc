@@ -278,7 +278,7 @@ void TakeRun(EngineResult run, const MultiBlockGrid& grid, const SegmentModel& m
     if (!run.unfaired.empty()) CopySharedControls(model, shared, result.poles, grid, run.unfaired);
   }
   result.fit.blocks.clear();
-  for (FittedBlock& fitted : run.blocks) result.fit.blocks.push_back({.fitted = std::move(fitted)});
+  for (FittedBlock& fitted : run.blocks) result.fit.blocks.emplace_back().fitted = std::move(fitted);
   result.unfaired = std::move(run.unfaired);
   GridFitReport& report = result.fit.report;
   report.iterations = run.iterations;
