@@ -5,11 +5,10 @@
 
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
-#include "core/grid/connectivity.h"
 #include "core/util/status_macros.h"
-#include "proto/convert/archive_convert.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
+#include "server/ops/archive.h"
 #include "server/service.h"
 #include "server/store/grid_archive.h"
 #include "server/upload_reactor.h"
@@ -17,9 +16,8 @@
 namespace splinegrid::server {
 namespace {
 
-// Streams the records of one snapshot. They are built on the pool before the first write,
-// charged to the budget (about the size of the source points plus the revisions), and written
-// one at a time as the client takes them.
+// Streams the records of one snapshot (ops::ExportSnapshot). They are built on the pool before
+// the first write, charged to the budget, and written one at a time as the client takes them.
 class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
  public:
   ExportReactor(ServiceState* state, grpc::CallbackServerContext* context,
@@ -62,18 +60,20 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
     SG_HAPPENS_AFTER(this);
     const absl::Status status = [&]() -> absl::Status {
       SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
-      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, state_->store->Get(id));
       SG_ASSIGN_OR_RETURN(
-          memory_, state_->budget.Reserve(SourceBytes(grid->source->grid), "the export's records"));
-      int64_t bytes = 0;
-      SG_RETURN_IF_ERROR(ForEachRecord(*grid, [&](const v1::ArchiveRecord& record) {
-        records_.emplace_back();
-        *records_.back().mutable_record() = record;
-        bytes += static_cast<int64_t>(record.ByteSizeLong());
-        return absl::OkStatus();
-      }));
-      // The revisions come on top of the points charged above.
-      return state_->budget.Extend(&memory_, bytes - memory_.bytes(), "the export's records");
+          memory_,
+          ops::ExportSnapshot(
+              state_->Ops(), id, [&](const StoredGrid& grid) -> absl::StatusOr<int64_t> {
+                int64_t bytes = 0;
+                SG_RETURN_IF_ERROR(ForEachRecord(grid, [&](const v1::ArchiveRecord& record) {
+                  records_.emplace_back();
+                  *records_.back().mutable_record() = record;
+                  bytes += static_cast<int64_t>(record.ByteSizeLong());
+                  return absl::OkStatus();
+                }));
+                return bytes;
+              }));
+      return absl::OkStatus();
     }();
     if (!status.ok()) {
       End(status);
@@ -112,29 +112,9 @@ class ExportReactor : public grpc::ServerWriteReactor<v1::ExportGridResponse> {
   std::deque<v1::ExportGridResponse> records_;
 };
 
-// Fits reuse the connectivity a grid keeps with its source points (found once, at import), so
-// an archive's must be the one its points have: INVALID_ARGUMENT otherwise (a damaged or edited
-// archive would make fits share boundaries that do not coincide, or miss ones that do).
-absl::Status CheckConnectivity(const SourcePoints& source) {
-  SG_ASSIGN_OR_RETURN(const Connectivity found, FindConnectivity(source.grid));
-  v1::StoredConnectivity stored, expected;
-  EncodeStoredConnectivity(source.connectivity, &stored);
-  EncodeStoredConnectivity(found, &expected);
-  if (stored.SerializeAsString() != expected.SerializeAsString()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "header.connectivity does not match the archive's source points: it lists ",
-        source.connectivity.matches.size(), " block boundary match(es), this server finds ",
-        found.matches.size(),
-        source.connectivity.matches.size() == found.matches.size() ? " other ones" : "",
-        " in the points; the archive was changed or damaged, or written by a release that "
-        "matched boundaries differently (export it again from that server)"));
-  }
-  return absl::OkStatus();
-}
-
 // Assembles the records as they arrive (memory charged as data comes, not as the header
-// announces), then stores the grid on the pool: nothing is stored unless the whole archive
-// arrived and checks out.
+// announces), then stores the grid on the pool (ops::StoreArchived): nothing is stored unless
+// the whole archive arrived and checks out.
 class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
  public:
   ImportArchiveReactor(ServiceState* state, grpc::CallbackServerContext* context,
@@ -163,10 +143,9 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     absl::Cleanup release = [this] { assembler_.reset(); };
     SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
                         assembler_->Finish(/*check_counts=*/true));
-    grid->owner = caller_.owner();  // the importer's, not the exporter's
-    SG_RETURN_IF_ERROR(CheckConnectivity(*grid->source));
     log_.set_grid(absl::StrCat("grids/", grid->id));
-    SG_RETURN_IF_ERROR(state_->store->Create(grid));
+    SG_RETURN_IF_ERROR(ops::StoreArchived(state_->Ops(), grid, assembler_->stated_connectivity(),
+                                          caller_.owner()));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }
 

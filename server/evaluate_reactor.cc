@@ -1,4 +1,5 @@
-// SplineGridService::EvaluateGrid: a header, then chunks of about 256 KiB per field.
+// SplineGridService::EvaluateGrid: a header, then chunks of about 256 KiB per field, produced by
+// the operation (server/ops/evaluate_grid.h).
 //
 // Chunks are produced on the worker pool, a few ahead of the network: while one chunk is being
 // written the next ones are evaluated, so evaluation and transport overlap. Memory stays
@@ -8,12 +9,10 @@
 #include <deque>
 #include <mutex>
 
-#include "absl/strings/str_cat.h"
-#include "core/bspline/evaluation.h"
-#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/happens_before.h"
+#include "server/ops/evaluate_grid.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
@@ -24,12 +23,6 @@ constexpr size_t kMaxReady = 8;  // messages evaluated ahead of the network
 // Evaluations of at most this many points in all are cheap work for the scheduler (about a
 // millisecond: the points of a 225 x 65 grid); larger ones are long work, shared fairly.
 constexpr int64_t kMaxCheapPoints = int64_t{1} << 16;
-
-struct BlockPlan {
-  int block;
-  Extents extents;
-  std::array<std::vector<double>, 3> params;
-};
 
 class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse> {
  public:
@@ -94,72 +87,34 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     Pump();
   }
 
+  // The operation's plan, and the header that announces it.
   absl::StatusOr<std::unique_ptr<v1::EvaluateGridResponse>> Plan() {
-    SG_ASSIGN_OR_RETURN(const std::string id, ParseGridName(request_->name(), "name"));
-    SG_ASSIGN_OR_RETURN(grid_, state_->store->GetHolding(id, {request_->revision()}));
-    SG_ASSIGN_OR_RETURN(revision_,
-                        grid_->ResolveRevision(request_->revision(), OptionalStep(*request_)));
-    SG_ASSIGN_OR_RETURN(const Resolution resolution, ParseResolution(*request_));
-    const int num_blocks = static_cast<int>(revision_->blocks.size());
-    std::vector<int> blocks(request_->blocks().begin(), request_->blocks().end());
-    if (blocks.empty()) {
-      for (int b = 0; b < num_blocks; ++b) blocks.push_back(b);
-    }
+    ops::GridEvaluationRequest plan;
+    SG_ASSIGN_OR_RETURN(plan.grid_id, ParseGridName(request_->name(), "name"));
+    plan.revision = request_->revision();
+    plan.step = OptionalStep(*request_);
+    SG_ASSIGN_OR_RETURN(plan.resolution, ParseResolution(*request_));
+    plan.blocks.assign(request_->blocks().begin(), request_->blocks().end());
+    plan.derivatives = request_->derivatives();
+    plan.max_points = state_->options.max_output_points;
+    plan.chunk_values =
+        kChunkBytes / static_cast<int64_t>(float_values() ? sizeof(float) : sizeof(double));
+    plan.buffer_bytes = int64_t{kMaxReady + 4} * kChunkBytes;
+    SG_ASSIGN_OR_RETURN(evaluation_, ops::GridEvaluation::Plan(state_->Ops(), plan));
     auto header = std::make_unique<v1::EvaluateGridResponse>();
     v1::EvaluationHeader* h = header->mutable_header();
-    const int s = revision_->blocks.front().fitted.spline.spatial_dim();
-    int64_t total = 0, work_bytes = 0, param_bytes = 0;
-    std::vector<bool> seen(num_blocks, false);
-    for (size_t q = 0; q < blocks.size(); ++q) {
-      const int b = blocks[q];
-      if (b < 0 || b >= num_blocks) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("blocks[", q, "] = ", b, " is outside [0, ", num_blocks - 1, "]"));
-      }
-      if (seen[b]) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("blocks[", q, "] = ", b, " is repeated; name each block once"));
-      }
-      seen[b] = true;
-      const FittedBlock& fitted = revision_->blocks[b].fitted;
-      SG_ASSIGN_OR_RETURN(const Extents extents, SampleExtents(fitted.distribution, resolution),
-                          "block ", b, ": ");
-      total += NumPoints(extents);
-      if (total > state_->options.max_output_points) {
-        return absl::OutOfRangeError(absl::StrCat("the requested resolution gives over ", total,
-                                                  " points, more than the server's cap of ",
-                                                  state_->options.max_output_points,
-                                                  " (flag --max_output_points)"));
-      }
-      // The evaluator's intermediate nets: n_u' x n_v x n_w, and planes of n_u' x n_v.
-      const Extents n = fitted.spline.control_extents();
-      const int64_t net = int64_t{s} * extents[0] * n[1] * (n[2] + 3) * sizeof(double);
-      work_bytes = std::max(work_bytes, net * (request_->derivatives() ? 2 : 1));
+    for (const ops::EvaluatedBlock& block : evaluation_->blocks()) {
       v1::EvaluatedBlock* eb = h->add_blocks();
-      eb->set_block(b);
-      EncodeExtents(extents, eb->mutable_extents());
-      plan_.push_back({b, extents, {}});
-      param_bytes += (int64_t{extents[0]} + extents[1] + extents[2]) * int64_t{sizeof(double)};
+      eb->set_block(block.block);
+      EncodeExtents(block.extents, eb->mutable_extents());
     }
-    // Reserved before the parameters are sampled: a small request may ask for 2^30 of them.
-    SG_ASSIGN_OR_RETURN(memory_, state_->budget.Reserve(work_bytes + param_bytes +
-                                                            int64_t{kMaxReady + 4} * kChunkBytes,
-                                                        "the evaluation"));
-    for (BlockPlan& block : plan_) {
-      SG_ASSIGN_OR_RETURN(
-          block.params,
-          SampleParameters(revision_->blocks[block.block].fitted.distribution, resolution));
-    }
-    h->set_revision(revision_->number);
-    h->set_spatial_dim(s);
+    h->set_revision(evaluation_->revision());
+    h->set_spatial_dim(evaluation_->spatial_dim());
     h->set_precision(float_values() ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
     h->set_derivatives(request_->derivatives());
-    h->set_total_points(total);
-    produce_kind_ = total <= kMaxCheapPoints ? WorkKind::kCheap : WorkKind::kLong;
-    spatial_dim_ = s;
-    points_per_chunk_ = std::max<int64_t>(
-        1,
-        kChunkBytes / (s * static_cast<int64_t>(float_values() ? sizeof(float) : sizeof(double))));
+    h->set_total_points(evaluation_->total_points());
+    produce_kind_ =
+        evaluation_->total_points() <= kMaxCheapPoints ? WorkKind::kCheap : WorkKind::kLong;
     return header;
   }
 
@@ -241,69 +196,37 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     Pump();
   }
 
-  // One message per field for the next range of points; false when this was the last one.
+  // One message per field for the next chunk of points; false when this was the last one.
   bool NextStep(std::vector<std::unique_ptr<v1::EvaluateGridResponse>>* step) {
-    const BlockPlan& block = plan_[block_cursor_];
-    if (!evaluator_) {
-      evaluator_ = std::make_unique<GridEvaluator>(revision_->blocks[block.block].fitted.spline,
-                                                   block.params, request_->derivatives());
-    }
-    const int ni = block.extents[0];
-    const int64_t s = spatial_dim_;
-    int64_t line_end = line_ + 1;
-    int i_end = ni;
-    if (i_ == 0 && ni <= points_per_chunk_) {
-      line_end =
-          std::min(evaluator_->num_lines(), line_ + std::max<int64_t>(1, points_per_chunk_ / ni));
-    } else {
-      i_end = static_cast<int>(std::min<int64_t>(ni, i_ + points_per_chunk_));
-    }
-    const int64_t offset = s * (line_ * ni + i_);
-    const int64_t count = s * ((line_end - line_) * ni - i_ - (ni - i_end));
+    const ops::EvaluationChunk next = evaluation_->Next();
     std::array<double*, 4> out{};
     std::array<std::unique_ptr<v1::EvaluateGridResponse>, 4> messages;
     for (int f = 0; f < num_fields(); ++f) {
       messages[f] = std::make_unique<v1::EvaluateGridResponse>();
       v1::EvaluationChunk* chunk = messages[f]->mutable_chunk();
-      chunk->set_block(block.block);
+      chunk->set_block(next.block);
       chunk->set_field(static_cast<v1::Field>(v1::FIELD_POINTS + f));
-      chunk->set_offset(offset);
+      chunk->set_offset(next.offset);
       if (float_values()) {
-        scratch_[f].resize(count);
+        scratch_[f].resize(next.count);
         out[f] = scratch_[f].data();
       } else {
-        chunk->mutable_values()->Resize(static_cast<int>(count), 0.0);
+        chunk->mutable_values()->Resize(static_cast<int>(next.count), 0.0);
         out[f] = chunk->mutable_values()->mutable_data();
       }
     }
-    if (line_end == line_ + 1 && (i_ != 0 || i_end != ni)) {
-      evaluator_->EvaluateLineRange(line_, i_, i_end, out[0], out[1], out[2], out[3]);
-    } else {
-      evaluator_->EvaluateLines(line_, line_end, out[0], out[1], out[2], out[3]);
-    }
+    evaluation_->EvaluateNext(out);
     for (int f = 0; f < num_fields(); ++f) {
       if (float_values()) {
         // One narrowing copy of the chunk (vectorised), not a Set call per value.
         auto* values = messages[f]->mutable_chunk()->mutable_float_values();
-        values->Resize(static_cast<int>(count), 0.0f);
-        std::transform(out[f], out[f] + count, values->mutable_data(),
+        values->Resize(static_cast<int>(next.count), 0.0f);
+        std::transform(out[f], out[f] + next.count, values->mutable_data(),
                        [](double v) { return static_cast<float>(v); });
       }
       step->push_back(std::move(messages[f]));
     }
-    // Advance the cursor.
-    if (i_end == ni) {
-      line_ = line_end;
-      i_ = 0;
-    } else {
-      i_ = i_end;
-    }
-    if (line_ == evaluator_->num_lines()) {
-      evaluator_.reset();
-      line_ = 0;
-      ++block_cursor_;
-    }
-    return block_cursor_ < plan_.size();
+    return !evaluation_->done();
   }
 
   ServiceState* state_;
@@ -315,17 +238,8 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
   // This call's place among its principal's open streams.
   StreamSlot stream_;
   WorkKind produce_kind_ = WorkKind::kLong;  // set by Plan()
-  std::shared_ptr<const StoredGrid> grid_;
-  std::shared_ptr<const GridRevision> revision_;
-  std::vector<BlockPlan> plan_;
-  MemoryReservation memory_;
-  int spatial_dim_ = 3;
-  int64_t points_per_chunk_ = 1;
-  // Production cursor (used by one Produce task at a time).
-  size_t block_cursor_ = 0;
-  int64_t line_ = 0;
-  int i_ = 0;
-  std::unique_ptr<GridEvaluator> evaluator_;
+  std::unique_ptr<ops::GridEvaluation>
+      evaluation_;  // set by Plan(); produced by one task at a time
   std::array<std::vector<double>, 4> scratch_;
   // Shared between gRPC's and the pool's threads.
   std::mutex mu_;

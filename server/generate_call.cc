@@ -71,7 +71,7 @@ grpc::ServerUnaryReactor* SplineGridService::GenerateGrid(grpc::CallbackServerCo
         SG_ASSIGN_OR_RETURN(const ops::GenerateResult result,
                             ops::Generate(Ops(), std::move(generate), cancel));
         v1::GenerationReport* report = response->mutable_report();
-        EncodeGenerationReport(result.generated, result.grid->source->grid.blocks[0].extents(),
+        EncodeGenerationReport(result.generated, result.grid->source->grid().blocks[0].extents(),
                                result.profile_points, report);
         EncodeProfileGridOptions(result.options, report->mutable_parameters());
         report->mutable_profile()->set_name(result.profile_name);

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
+#include "proto/convert/deform_convert.h"
 #include "proto/convert/plot3d_format_convert.h"
 #include "proto/convert/source_boundaries_convert.h"
 #include "server/store/revision_codec.h"
@@ -40,16 +41,7 @@ void EncodeFitResponse(const GridRevision& revision, v1::FitGridResponse* out) {
 }
 
 void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
-  const DeformationCheck& c = deform.check;
-  out->set_check_level(c.level);
-  out->set_cells_checked(c.cells_checked);
-  if (c.cells_checked > 0) {
-    out->set_min_jacobian_ratio(c.min_jacobian_ratio);
-    out->set_max_jacobian_ratio(c.max_jacobian_ratio);
-    out->set_worst_block(c.worst_block);
-    EncodeExtents(c.worst_cell, out->mutable_worst_cell());
-  }
-  out->set_max_orthogonality_change_degrees(c.max_orthogonality_change_degrees);
+  EncodeDeformationCheck(deform.check, out);
   out->set_moved_controls(deform.moved_controls);
   out->set_decay_radius(std::isfinite(deform.decay_radius) ? deform.decay_radius : 0.0);
   out->set_seconds(deform.seconds);
@@ -61,7 +53,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   out->set_display_name(grid.display_name);
   out->set_owner(grid.owner);
   EncodeStoredTime(grid.create_time, out->mutable_create_time());
-  const MultiBlockGrid& source = grid.source->grid;
+  const MultiBlockGrid& source = grid.source->grid();
   v1::SourceGrid* src = out->mutable_source();
   src->set_spatial_dim(source.blocks.front().spatial_dim());
   int64_t points = 0;
@@ -74,7 +66,7 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   if (grid.source->plot3d.has_value()) {
     EncodePlot3dSourceFormat(*grid.source->plot3d, src->mutable_plot3d());
   }
-  const std::vector<BoundaryMatch>& matches = grid.source->connectivity.matches;
+  const std::vector<BoundaryMatch>& matches = grid.source->connectivity().matches;
   src->set_num_matches(static_cast<int>(matches.size()));
   if (view == v1::GRID_VIEW_FULL) {
     for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
@@ -149,18 +141,8 @@ void EncodeWallCurvature(const ops::WallCurvatureResult& result,
                          v1::GetWallCurvatureResponse* out) {
   out->set_revision(result.revision);
   out->set_spatial_dim(result.spatial_dim);
-  const int dim = result.spatial_dim;
   for (const ops::WallCurvatureLine& line : result.lines) {
-    v1::WallCurvatureLine* encoded = out->add_lines();
-    encoded->set_block(line.line.block);
-    encoded->set_direction(line.line.direction);
-    EncodeExtents(line.line.start, encoded->mutable_start());
-    encoded->set_length(line.line.length);
-    for (const CurvatureSample& s : line.samples) {
-      encoded->add_arc_length(s.arc_length);
-      for (int c = 0; c < dim; ++c) encoded->add_points(s.point[c]);
-      encoded->add_curvature(s.curvature);
-    }
+    EncodeWallCurvatureLine(line.line, line.samples, result.spatial_dim, out->add_lines());
   }
   EncodeCurvature(result.metrics, out->mutable_metrics());
 }

@@ -27,6 +27,7 @@
 #include "absl/time/time.h"
 #include "core/deform/deform_quality.h"
 #include "core/fit/grid_fit.h"
+#include "core/grid/fittable_grid.h"
 #include "core/grid/source_boundaries.h"
 #include "core/grid/structured_grid.h"
 #include "core/io/plot3d_source_format.h"
@@ -81,15 +82,19 @@ struct RevisionSummary {
 
 // The points a grid was imported from, with the budget they hold.
 struct SourcePoints {
-  MultiBlockGrid grid;
-  Connectivity connectivity;  // found at import
-  std::string format;         // how it arrived, e.g. "plot3d ascii 2d single-block"
+  // The points, checked for fitting and matched once, when the grid arrived (imported,
+  // generated, or loaded by this process); every fit uses them as they are.
+  FittableGrid checked;
+  std::string format;  // how it arrived, e.g. "plot3d ascii 2d single-block"
   // The file's boundary conditions (CGNS imports): default face kinds of fits, written back
   // with evaluations.
   SourceBoundaries boundaries;
   // Plot3D imports: the file's layout, for writing evaluations back the same way.
   std::optional<Plot3dSourceFormat> plot3d;
   MemoryReservation memory;
+
+  const MultiBlockGrid& grid() const { return checked.grid(); }
+  const Connectivity& connectivity() const { return checked.connectivity(); }
 };
 
 // A snapshot of a grid resource.

@@ -4,18 +4,15 @@
 // Memory is allocated and charged to the budget as data arrive, never from the header's
 // announced sizes; a stream that sends nothing for --import_idle_timeout is ended.
 #include <algorithm>
-#include <optional>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/planar_view.h"
-#include "core/io/plot3d.h"
-#include "core/io/plot3d_memory.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "proto/convert/plot3d_format_convert.h"
 #include "server/cgns_decoder.h"
 #include "server/grid_encoding.h"
+#include "server/ops/import.h"
 #include "server/service.h"
 #include "server/upload_reactor.h"
 
@@ -168,61 +165,45 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
     return header_.points().spatial_dim() * NumPoints(extents_[b]);
   }
 
-  // Decodes a CGNS upload in a child process (on the pool); its boundaries go to `boundaries`
-  // and its stated 1-to-1 connections to connections_ (compared with the found ones in Store).
-  absl::StatusOr<MultiBlockGrid> BuildCgnsSource(std::string* format,
-                                                 SourceBoundaries* boundaries) {
+  // Decodes a CGNS upload in a child process (on the pool), with the file's boundaries and its
+  // stated 1-to-1 connections (compared with the found ones when stored).
+  absl::StatusOr<ops::ImportedSource> BuildCgnsSource() {
     if (static_cast<int64_t>(bytes_.size()) != header_.cgns().total_bytes()) {
       return absl::InvalidArgumentError(absl::StrCat("cgns: ", bytes_.size(),
                                                      " bytes arrived but the header announced ",
                                                      header_.cgns().total_bytes()));
     }
-    SG_ASSIGN_OR_RETURN(
-        ImportedGrid imported,
-        DecodeCgnsUpload(bytes_, state_->options.cgns_decoder, &state_->budget, &grid_memory_,
-                         [this] { return context_->IsCancelled(); }));
-    bytes_ = std::string();
-    SG_RETURN_IF_ERROR(
-        state_->budget.Resize(&grid_memory_, SourceBytes(imported.grid), "the imported grid"));
-    *format = std::move(imported.format);
-    *boundaries = std::move(imported.boundaries);
-    connections_ = std::move(imported.connections);
-    return std::move(imported.grid);
+    ops::ImportedSource source;
+    SG_ASSIGN_OR_RETURN(source.imported, DecodeCgnsUpload(bytes_, state_->options.cgns_decoder,
+                                                          &state_->budget, &grid_memory_, [this] {
+                                                            return context_->IsCancelled();
+                                                          }));
+    source.memory = std::move(grid_memory_);
+    return source;
   }
 
-  // Builds the source grid from what arrived (on the pool).
-  absl::StatusOr<MultiBlockGrid> BuildSource(std::string* format, SourceBoundaries* boundaries) {
-    if (!have_header_) return absl::InvalidArgumentError("ImportGrid received no header");
-    if (header_.has_cgns()) return BuildCgnsSource(format, boundaries);
-    if (header_.has_plot3d()) {
-      if (static_cast<int64_t>(bytes_.size()) != header_.plot3d().total_bytes()) {
-        return absl::InvalidArgumentError(absl::StrCat("plot3d: ", bytes_.size(),
-                                                       " bytes arrived but the header announced ",
-                                                       header_.plot3d().total_bytes()));
-      }
-      Plot3dFormat detected;
-      // The parser's memory, bounded from the bytes before it allocates (text repeats "n*x"
-      // make a few bytes stand for gigabytes); then exactly the grid's.
-      SG_RETURN_IF_ERROR(state_->budget.Resize(&grid_memory_, Plot3dParseBytesBound(bytes_),
-                                               "parsing the Plot3D upload"));
-      Plot3dReadOptions read_options;
-      read_options.layout = Plot3dLayoutFromProto(header_.plot3d().layout());
-      SG_ASSIGN_OR_RETURN(MultiBlockGrid grid,
-                          ParsePlot3d(bytes_, "upload", read_options, &detected));
-      SG_RETURN_IF_ERROR(
-          state_->budget.Resize(&grid_memory_, SourceBytes(grid), "the imported grid"));
-      *format = absl::StrCat("plot3d ", DescribePlot3dFormat(detected));
-      plot3d_format_.emplace().file = detected;  // kept so evaluations can be written back alike
-      if (header_.plot3d().planar_view() ||
-          (header_.plot3d().planar_view_if_two_planes() && IsTwoPlaneGrid(grid))) {
-        SG_RETURN_IF_ERROR(
-            state_->budget.Resize(&grid_memory_, 2 * SourceBytes(grid), "the planar view"));
-        SG_ASSIGN_OR_RETURN(grid, PlanarView(grid, {}, &plot3d_format_->two_planes));
-        absl::StrAppend(format, ", planar view");
-      }
-      return grid;
+  // The Plot3D upload parsed by the operation (on the pool).
+  absl::StatusOr<ops::ImportedSource> BuildPlot3dSource() {
+    const v1::Plot3dSource& plot3d = header_.plot3d();
+    if (static_cast<int64_t>(bytes_.size()) != plot3d.total_bytes()) {
+      return absl::InvalidArgumentError(absl::StrCat("plot3d: ", bytes_.size(),
+                                                     " bytes arrived but the header announced ",
+                                                     plot3d.total_bytes()));
     }
-    MultiBlockGrid grid;
+    Plot3dReadOptions read_options;
+    read_options.layout = Plot3dLayoutFromProto(plot3d.layout());
+    const ops::PlanarViewChoice planar = plot3d.planar_view() ? ops::PlanarViewChoice::kAlways
+                                         : plot3d.planar_view_if_two_planes()
+                                             ? ops::PlanarViewChoice::kIfTwoPlanes
+                                             : ops::PlanarViewChoice::kNever;
+    return ops::ReadPlot3dUpload(state_->Ops(), bytes_, read_options, planar,
+                                 std::move(grid_memory_));
+  }
+
+  // The blocks of a points source, from the coordinates that arrived.
+  absl::StatusOr<ops::ImportedSource> BuildPointsSource() {
+    ops::ImportedSource source;
+    MultiBlockGrid& grid = source.imported.grid;
     const int s = header_.points().spatial_dim();
     for (size_t b = 0; b < extents_.size(); ++b) {
       const int64_t total = BlockValues(b);
@@ -242,41 +223,26 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
       SG_RETURN_IF_ERROR(ValidateFinite(block, absl::StrCat("points: block ", b)));
       grid.blocks.push_back(std::move(block));
     }
-    *format = "points";
-    return grid;
+    source.imported.format = "points";
+    source.memory = std::move(grid_memory_);
+    return source;
   }
 
-  absl::Status Store() {
-    auto source = std::make_shared<SourcePoints>();
-    SG_ASSIGN_OR_RETURN(source->grid, BuildSource(&source->format, &source->boundaries));
-    source->plot3d = std::move(plot3d_format_);
+  // Builds the source from what arrived and hands it to the operation (on the pool).
+  absl::Status Complete() override {
+    if (!have_header_) return absl::InvalidArgumentError("ImportGrid received no header");
+    absl::StatusOr<ops::ImportedSource> source = header_.has_cgns()     ? BuildCgnsSource()
+                                                 : header_.has_plot3d() ? BuildPlot3dSource()
+                                                                        : BuildPointsSource();
     bytes_ = std::string();
-    if (source->grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
-    // A grid that cannot be fitted (all points equal, a direction of zero length, cells of no
-    // area or volume) is refused here, naming the block, not stored for every fit to fail.
-    for (size_t b = 0; b < source->grid.blocks.size(); ++b) {
-      SG_RETURN_IF_ERROR(ValidateFittable(source->grid.blocks[b], absl::StrCat("block ", b)));
-    }
     upload_ = MemoryReservation();
-    SG_RETURN_IF_ERROR(
-        state_->budget.Resize(&grid_memory_, SourceBytes(source->grid), "the imported grid"));
-    source->memory = std::move(grid_memory_);
-    SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
-    for (std::string& note :
-         CompareConnections(connections_, source->connectivity, source->boundaries.block_names)) {
-      source->boundaries.notes.push_back(std::move(note));
-    }
-    auto grid = std::make_shared<StoredGrid>();
-    grid->display_name = header_.display_name();
-    grid->owner = caller_.owner();
-    grid->create_time = absl::Now();
-    grid->source = std::move(source);
-    SG_RETURN_IF_ERROR(CreateGrid(*state_->store, header_.grid_id(), grid));
+    if (!source.ok()) return source.status();
+    const ops::ImportRequest request = {header_.grid_id(), header_.display_name(), caller_.owner()};
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                        ops::StoreImported(state_->Ops(), request, *std::move(source)));
     log_.set_grid(absl::StrCat("grids/", grid->id));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }
-
-  absl::Status Complete() override { return Store(); }
 
   v1::Grid* response_;
   bool have_header_ = false;
@@ -284,10 +250,8 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
   MemoryReservation upload_;       // what arrived (capacity), charged as it grows
   MemoryReservation grid_memory_;  // the grid being built: the parser's bound, then its size
   std::string bytes_;              // Plot3D or CGNS file
-  std::optional<Plot3dSourceFormat> plot3d_format_;  // Plot3D source: its layout, once parsed
-  std::vector<Extents> extents_;                     // points source: the header's blocks
-  std::vector<std::vector<double>> coords_;          // and their coordinates so far
-  std::vector<StatedConnection> connections_;        // CGNS source: the file's 1-to-1 connections
+  std::vector<Extents> extents_;   // points source: the header's blocks
+  std::vector<std::vector<double>> coords_;  // and their coordinates so far
 };
 
 }  // namespace

@@ -40,6 +40,9 @@ struct ServiceState {
   Scheduler pool;        // the worker threads, cheap work first, long work fair across callers
   DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE
+
+  // The operations' view of the state (server/ops).
+  ops::OpsContext Ops() { return {*store, budget, deformers}; }
 };
 
 // Admits a call that needs `needed`: UNAVAILABLE while draining, UNAUTHENTICATED without valid
@@ -154,8 +157,7 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, const Work& work);
 
-  // The operations' view of the state (server/ops).
-  ops::OpsContext Ops() const { return {*state_->store, state_->budget, state_->deformers}; }
+  ops::OpsContext Ops() const { return state_->Ops(); }
 
   ServiceState* state_;
 };

@@ -1,12 +1,12 @@
 // SplineGridService::WatchGrid: a grid's revisions, the stored ones first, then each new one as
 // it is published.
 //
-// The call subscribes to the grid (GridStore::Subscribe), which gives, atomically, the current
-// snapshot and a subscription that queues every later revision in publication order; so each
-// revision is sent once, in order, and none stored after the call began is missed. The store
-// wakes the reactor (GridWatcher::Wake) after publishing, outside its lock; the reactor then
-// takes the next event and writes it, one Write at a time (the rest wait in the subscription,
-// at most ServerOptions::max_watch_lag of them). The stream ends
+// The call opens the operation's feed (server/ops/watch.h): the stored revisions, then a
+// subscription that queues every later one in publication order; so each revision is sent
+// once, in order, and none stored after the call began is missed. The store wakes the reactor
+// (GridWatcher::Wake) after publishing, outside its lock; the reactor then takes the next
+// revision and writes it, one Write at a time (the rest wait in the subscription, at most
+// ServerOptions::max_watch_lag of them). The stream ends
 //  - OK when the grid is deleted, after the revisions stored before the deletion;
 //  - CANCELLED when the client cancels or goes away (OnCancel, a failed write), or
 //    DEADLINE_EXCEEDED when its deadline passes;
@@ -21,7 +21,6 @@
 // Lifetime: the reactor is owned by a shared_ptr that it releases in OnDone; the store reaches it
 // only through a weak_ptr, and a wake-up holds a shared_ptr while it runs, so a wake-up racing
 // with the end of the call never touches a deleted reactor.
-#include <deque>
 #include <memory>
 #include <mutex>
 
@@ -29,6 +28,7 @@
 #include "core/util/status_macros.h"
 #include "server/grid_encoding.h"
 #include "server/happens_before.h"
+#include "server/ops/watch.h"
 #include "server/service.h"
 
 namespace splinegrid::server {
@@ -96,71 +96,36 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
                         AdmitStream(*state_, context_, Role::kRead, &log_));
     caller_ = std::move(admitted.caller);
     stream_ = std::move(admitted.slot);
-    absl::StatusOr<std::string> id = ParseGridName(request_->name(), "name");
-    if (!id.ok()) return id.status();
-    id_ = *std::move(id);
-    after_ = request_->after_revision();
-    if (after_ < -1) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("after_revision = ", after_,
-                       " is below -1 (0: every stored revision, -1: only new ones)"));
-    }
-    absl::StatusOr<GridStore::Watch> watch = state_->store->Subscribe(
-        id_, std::weak_ptr<GridWatcher>(self_), static_cast<size_t>(state_->options.max_watch_lag));
-    if (!watch.ok()) return watch.status();
+    SG_ASSIGN_OR_RETURN(std::string id, ParseGridName(request_->name(), "name"));
+    name_ = absl::StrCat("grids/", id);
+    SG_ASSIGN_OR_RETURN(
+        std::unique_ptr<ops::RevisionFeed> feed,
+        ops::RevisionFeed::Open(state_->Ops(), std::move(id), request_->after_revision(),
+                                std::weak_ptr<GridWatcher>(self_),
+                                static_cast<size_t>(state_->options.max_watch_lag)));
     std::lock_guard<std::mutex> lock(mu_);
-    subscription_ = std::move(watch->subscription);
-    const auto& stored = watch->snapshot->revisions;
-    last_sent_ = after_ >= 0 ? after_ : (stored.empty() ? 0 : stored.back()->number);
-    if (after_ >= 0) {
-      for (const auto& revision : stored) {
-        if (revision->number > after_) backlog_.push_back(RevisionSummary::Of(*revision));
-      }
-    }
+    feed_ = std::move(feed);
     return absl::OkStatus();
   }
 
-  // Under mu_: the next revision to write into message_ (true), or false after noting in
-  // status_ / deleted_ how the watch ends, if it does.
+  // Under mu_: the next revision into message_ (true), or false after noting in status_ how
+  // the watch ends, if it does (OK once the grid was deleted).
   bool NextMessage() {
     if (state_->draining.load()) {
       status_ = absl::UnavailableError("the server is shutting down");
       return false;
     }
-    RevisionSummary revision;
-    if (!backlog_.empty()) {
-      revision = backlog_.front();
-      backlog_.pop_front();
-    } else {
-      GridSubscription::End end = GridSubscription::End::kOpen;
-      bool found = false;
-      while (!found && subscription_->Next(&revision, &end)) {
-        found = revision.number > after_;  // after_ may lie beyond the latest at the start
+    const std::optional<RevisionSummary> revision = feed_->Next();
+    if (!revision) {
+      if (feed_->ended()) {
+        ended_ = true;
+        status_ = feed_->end_status();
       }
-      if (!found) {
-        switch (end) {
-          case GridSubscription::End::kOpen:  // nothing new yet
-            break;
-          case GridSubscription::End::kGridDeleted:
-            deleted_ = true;
-            break;
-          case GridSubscription::End::kLagged:
-            status_ = absl::ResourceExhaustedError(absl::StrCat(
-                "the client fell more than ", state_->options.max_watch_lag,
-                " revisions behind grids/", id_,
-                " and the watch was ended; watch again with after_revision = ", last_sent_));
-            break;
-          case GridSubscription::End::kClosed:
-            status_ = absl::UnavailableError("the server is shutting down");
-            break;
-        }
-        return false;
-      }
+      return false;
     }
     message_.Clear();
-    message_.set_name(absl::StrCat("grids/", id_));
-    EncodeRevisionInfo(revision, message_.mutable_revision());
-    last_sent_ = revision.number;
+    message_.set_name(name_);
+    EncodeRevisionInfo(*revision, message_.mutable_revision());
     return true;
   }
 
@@ -173,16 +138,16 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
       std::lock_guard<std::mutex> lock(mu_);
       // While a write is in flight, OnWriteDone pumps again; before Start is done, Start does.
       if (finished_ || writing_ || !started_) return;
-      if (status_.ok() && !deleted_) write = NextMessage();
+      if (status_.ok() && !ended_) write = NextMessage();
       if (write) {
         writing_ = true;
-      } else if (!status_.ok() || deleted_) {
+      } else if (!status_.ok() || ended_) {
         finished_ = finish = true;
         final_status = status_;
       }
     }
     if (finish) {
-      if (subscription_) state_->store->Unsubscribe(id_, subscription_.get());
+      if (feed_) feed_->Close();
       stream_.Release();  // the call is over for its principal once its status goes out
       log_.Finish(final_status);
       SG_HAPPENS_BEFORE(this);
@@ -203,18 +168,14 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   // This call's place among its principal's open streams.
   StreamSlot stream_;
   std::shared_ptr<WatchReactor> self_;  // this, until OnDone
-  // Set by Start before anything else can run.
-  std::string id_;
-  int64_t after_ = 0;
+  std::string name_;                    // grids/{id}, set by Start before anything else can run
   // Shared between gRPC's threads and the threads that publish revisions.
   std::mutex mu_;
-  std::shared_ptr<GridSubscription> subscription_;
-  std::deque<RevisionSummary> backlog_;  // the stored revisions still to send
-  v1::WatchGridResponse message_;        // being written while writing_
-  int64_t last_sent_ = 0;                // (or where the watch began)
+  std::unique_ptr<ops::RevisionFeed> feed_;
+  v1::WatchGridResponse message_;  // being written while writing_
   bool started_ = false;
   bool writing_ = false;
-  bool deleted_ = false;  // the grid was deleted and everything before it sent
+  bool ended_ = false;  // the feed ended (status_ says why; OK: the grid was deleted)
   bool finished_ = false;
   absl::Status status_;
 };

@@ -149,15 +149,14 @@ namespace {
 // FAILED_PRECONDITION for a block that cannot be fitted.
 absl::Status ValidateGridFit(const MultiBlockGrid& grid, const GridFitOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate(grid));
-  for (size_t b = 0; b < grid.blocks.size(); ++b) {
-    if (absl::Status s = ValidateFittable(grid.blocks[b], absl::StrCat("block ", b)); !s.ok()) {
-      return absl::FailedPreconditionError(s.message());
-    }
+  if (absl::Status s = ValidateFittableBlocks(grid); !s.ok()) {
+    return absl::FailedPreconditionError(s.message());
   }
   return absl::OkStatus();
 }
 
-// FitGrid after ValidateGridFit.
+// FitGrid once the options are valid and every block fittable (ValidateGridFit, or a
+// FittableGrid).
 absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectivity& connectivity,
                                      const GridFitOptions& options, const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
@@ -229,10 +228,10 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
   return FitValidated(grid, connectivity, options, cancel);
 }
 
-absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const Connectivity& connectivity,
-                                const GridFitOptions& options, const CancelCheck& cancel) {
-  SG_RETURN_IF_ERROR(ValidateGridFit(grid, options));
-  return FitValidated(grid, connectivity, options, cancel);
+absl::StatusOr<GridFit> FitGrid(const FittableGrid& grid, const GridFitOptions& options,
+                                const CancelCheck& cancel) {
+  SG_RETURN_IF_ERROR(options.Validate(grid.grid()));
+  return FitValidated(grid.grid(), grid.connectivity(), options, cancel);
 }
 
 }  // namespace splinegrid

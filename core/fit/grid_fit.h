@@ -25,6 +25,7 @@
 #include "core/fit/solve/tensor_fit.h"
 #include "core/grid/boundary_kinds.h"
 #include "core/grid/connectivity.h"
+#include "core/grid/fittable_grid.h"
 #include "core/grid/reference_length.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
@@ -178,11 +179,10 @@ struct GridFit {
 absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions& options,
                                 const CancelCheck& cancel = {});
 
-// The same for a grid whose connectivity is known: `connectivity` is FindConnectivity(grid)'s
-// (the service finds it once, at import, and keeps it with the source points);
-// options.connectivity is not used.
-absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const Connectivity& connectivity,
-                                const GridFitOptions& options, const CancelCheck& cancel = {});
+// The same for a grid checked once beforehand (FittableGrid::Check): the blocks are not checked
+// again and the grid's connectivity is used (options.connectivity is not).
+absl::StatusOr<GridFit> FitGrid(const FittableGrid& grid, const GridFitOptions& options,
+                                const CancelCheck& cancel = {});
 
 }  // namespace splinegrid
 

@@ -36,6 +36,8 @@ struct FaceRange {
   Face face;
   Extents begin = {0, 0, 0};
   Extents end = {0, 0, 0};
+
+  friend bool operator==(const FaceRange&, const FaceRange&) = default;
 };
 
 // Two coinciding face ranges. Index x of range `a` (x[d] in [a.begin[d], a.end[d]]) coincides
@@ -54,6 +56,8 @@ struct BoundaryMatch {
   Extents MapToB(const Extents& x) const;
   // e.g. "block 0 j=0 i[0..32] ~ block 0 j=0 i[192..224] reversed".
   std::string Describe() const;
+
+  friend bool operator==(const BoundaryMatch&, const BoundaryMatch&) = default;
 };
 
 struct ConnectivityOptions {
@@ -73,6 +77,8 @@ struct ConnectivityOptions {
 
 struct Connectivity {
   std::vector<BoundaryMatch> matches;
+
+  friend bool operator==(const Connectivity&, const Connectivity&) = default;
 };
 
 // Finds all matches between the boundaries of `grid`'s blocks. Cost about O(boundary points)

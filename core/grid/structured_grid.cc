@@ -118,7 +118,14 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
   double diagonal = 0.0;
   for (int c = 0; c < s; ++c) diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
   diagonal = std::sqrt(diagonal);
-  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) {
+  if (!std::isfinite(diagonal)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": the points span more than a double can hold (a bounding box from (",
+        absl::StrJoin(std::vector<double>(lo.begin(), lo.begin() + s), ", "), ") to (",
+        absl::StrJoin(std::vector<double>(hi.begin(), hi.begin() + s), ", "),
+        ")): scale the grid to its length unit"));
+  }
+  if (!(diagonal > 0.0)) {
     return absl::InvalidArgumentError(absl::StrCat(
         what, ": all ", block.num_points(), " points are equal (",
         absl::StrJoin(std::vector<double>(coords.begin(), coords.begin() + s), ", "),

@@ -366,6 +366,19 @@ void EncodeCurvature(const CurvatureMetrics& metrics, v1::CurvatureReport* out) 
   out->set_max_abs_curvature(metrics.max_abs_curvature);
 }
 
+void EncodeWallCurvatureLine(const WallLine& line, const std::vector<CurvatureSample>& samples,
+                             int spatial_dim, v1::WallCurvatureLine* out) {
+  out->set_block(line.block);
+  out->set_direction(line.direction);
+  EncodeExtents(line.start, out->mutable_start());
+  out->set_length(line.length);
+  for (const CurvatureSample& s : samples) {
+    out->add_arc_length(s.arc_length);
+    for (int c = 0; c < spatial_dim; ++c) out->add_points(s.point[c]);
+    out->add_curvature(s.curvature);
+  }
+}
+
 void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& blocks,
                      v1::FitReport* out) {
   out->set_tolerance_met(report.tolerance_met);

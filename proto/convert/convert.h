@@ -13,6 +13,7 @@
 #include "core/deform/boundary_controls.h"
 #include "core/deform/rigid_motion.h"
 #include "core/fit/grid_fit.h"
+#include "core/fit/report/wall_curvature.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/grid/sampling.h"
 #include "splinegrid/v1/grid.pb.h"
@@ -41,6 +42,11 @@ void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& b
                      v1::FitReport* out);
 
 void EncodeCurvature(const CurvatureMetrics& metrics, v1::CurvatureReport* out);
+
+// One wall line and its curvature samples (arc length, point, curvature; `spatial_dim`
+// coordinates per point).
+void EncodeWallCurvatureLine(const WallLine& line, const std::vector<CurvatureSample>& samples,
+                             int spatial_dim, v1::WallCurvatureLine* out);
 
 void EncodeBoundaryMatch(const BoundaryMatch& match, v1::BoundaryMatch* out);
 

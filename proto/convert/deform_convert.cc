@@ -77,4 +77,16 @@ absl::StatusOr<DeformMotion> ParseDeformMotion(const v1::DeformGridRequest& requ
   return absl::InvalidArgumentError("motion is unset: give rigid, controls or boundary_points");
 }
 
+void EncodeDeformationCheck(const DeformationCheck& check, v1::DeformReport* out) {
+  out->set_check_level(check.level);
+  out->set_cells_checked(check.cells_checked);
+  if (check.cells_checked > 0) {
+    out->set_min_jacobian_ratio(check.min_jacobian_ratio);
+    out->set_max_jacobian_ratio(check.max_jacobian_ratio);
+    out->set_worst_block(check.worst_block);
+    EncodeExtents(check.worst_cell, out->mutable_worst_cell());
+  }
+  out->set_max_orthogonality_change_degrees(check.max_orthogonality_change_degrees);
+}
+
 }  // namespace splinegrid

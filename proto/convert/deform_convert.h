@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/deform/deform_motion.h"
+#include "core/deform/deform_quality.h"
 #include "core/deform/deformer.h"
 #include "splinegrid/v1/splinegrid_service.pb.h"
 
@@ -26,6 +27,10 @@ absl::StatusOr<DeformMotion> ParseDeformMotion(const v1::DeformGridRequest& requ
 
 // The ranges of a BoundaryPointsMotion (positions or displacements at a refinement level).
 absl::StatusOr<std::vector<BoundaryPoints>> ParseBoundaryPoints(const v1::BoundaryPointsMotion& m);
+
+// What the fold gate measured (check level, Jacobian ratios and the worst cell when cells were
+// checked, orthogonality change) into the deform report.
+void EncodeDeformationCheck(const DeformationCheck& check, v1::DeformReport* out);
 
 }  // namespace splinegrid
 

@@ -52,13 +52,13 @@ absl::StatusOr<GridRevision> FitRevision(const OpsContext& context, const Source
   // Options that do not suit the grid are refused, naming the request's field, value and limit
   // ("spec.control_counts[0] = 1000 exceeds the 113 points of block 0 in i"); nothing is
   // clamped, and nothing is stored.
-  SG_RETURN_IF_ERROR(options.Validate(source.grid), SpecField(origin, parent));
+  SG_RETURN_IF_ERROR(options.Validate(source.grid()), SpecField(origin, parent));
   // Working memory of a fit: about the intermediate nets, parameters, tolerances and the
   // evaluations of the deviation and quality checks, bounded by a few times the source size.
   SG_ASSIGN_OR_RETURN(MemoryReservation work,
                       context.budget.Reserve(2 * source.memory.bytes(), "the fit"));
-  // The connectivity found at import (kept with the source points), not found again.
-  absl::StatusOr<GridFit> fitted = FitGrid(source.grid, source.connectivity, options, cancel);
+  // The points were checked and matched when the grid arrived, not again here.
+  absl::StatusOr<GridFit> fitted = FitGrid(source.checked, options, cancel);
   if (fitted.status().code() == absl::StatusCode::kFailedPrecondition) {
     // A grid that cannot be fitted, or one whose fit folds without options.allow_folds.
     return absl::FailedPreconditionError(

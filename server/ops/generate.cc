@@ -59,7 +59,7 @@ absl::StatusOr<ProfilePoints> StoredWallProfile(GridStore& store, const StoredWa
     return absl::InvalidArgumentError(
         absl::StrCat("stored_wall.block = ", b, " is outside [0, ", num_blocks - 1, "]"));
   }
-  const StructuredBlock& source = grid->source->grid.blocks[b];
+  const StructuredBlock& source = grid->source->grid().blocks[b];
   const Extents& n = source.extents();
   if (source.spatial_dim() != 2 || n[2] != 1 || n[1] < 2) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -155,8 +155,9 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
   source->format = absl::StrFormat("generated %s O-grid %dx%d around %s",
                                    LayerMethodName(request.options.method), n[0], n[1],
                                    bare_points ? "points" : absl::StrCat("'", profile.name, "'"));
-  source->grid.blocks.push_back(std::move(result.generated.block));
-  SG_ASSIGN_OR_RETURN(source->connectivity, FindConnectivity(source->grid));
+  MultiBlockGrid generated_grid;
+  generated_grid.blocks.push_back(std::move(result.generated.block));
+  SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(generated_grid)));
 
   SG_ASSIGN_OR_RETURN(GridRevision revision,
                       FitRevision(context, *source, fit_options, RevisionOrigin::kFit, 0, cancel));

@@ -35,7 +35,7 @@ absl::StatusOr<WallCurvatureResult> WallCurvature(const OpsContext& context,
     if (wanted[line.block]) lines.push_back(line);
   }
   // Refuse before sampling what cannot be sent: arc length, curvature and the point per sample.
-  const int dim = grid->source->grid.blocks.front().spatial_dim();
+  const int dim = grid->source->grid().blocks.front().spatial_dim();
   int64_t samples = 0;
   for (const WallLine& line : lines) samples += (int64_t{line.length} - 1) * (1 << level) + 1;
   const int64_t bytes = samples * (dim + 2) * static_cast<int64_t>(sizeof(double));

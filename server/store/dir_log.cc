@@ -88,7 +88,7 @@ class DirLog final : public DurableLog {
     v1::ArchiveRecord record;
     *record.mutable_header() = EncodeGridHeader(grid, 0);
     payloads.push_back(Serialize(record));
-    SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid, kSourceChunkValues,
+    SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid(), kSourceChunkValues,
                                           [&](const v1::SourceChunk& chunk) {
                                             v1::ArchiveRecord r;
                                             *r.mutable_source() = chunk;

@@ -22,18 +22,18 @@ v1::ArchiveHeader EncodeGridHeader(const StoredGrid& grid, int64_t num_revisions
   if (source.plot3d.has_value()) {
     EncodePlot3dSourceFormat(*source.plot3d, header.mutable_source_plot3d());
   }
-  header.set_spatial_dim(source.grid.blocks.front().spatial_dim());
-  for (const StructuredBlock& block : source.grid.blocks) {
+  header.set_spatial_dim(source.grid().blocks.front().spatial_dim());
+  for (const StructuredBlock& block : source.grid().blocks) {
     EncodeExtents(block.extents(), header.add_source_blocks());
     if (!block.iblank().empty()) header.set_source_iblank(true);
   }
-  EncodeStoredConnectivity(source.connectivity, header.mutable_connectivity());
+  EncodeStoredConnectivity(source.connectivity(), header.mutable_connectivity());
   if (!source.boundaries.empty()) {
     EncodeSourceBoundaries(source.boundaries, header.mutable_source_boundaries());
   }
   int64_t chunks = 0;
   // Count exactly as ForEachSourceChunk cuts (it cannot fail on a stored grid).
-  ForEachSourceChunk(source.grid, kSourceChunkValues, [&](const v1::SourceChunk&) {
+  ForEachSourceChunk(source.grid(), kSourceChunkValues, [&](const v1::SourceChunk&) {
     ++chunks;
     return absl::OkStatus();
   }).IgnoreError();
@@ -47,7 +47,7 @@ absl::Status ForEachRecord(const StoredGrid& grid,
   v1::ArchiveRecord record;
   *record.mutable_header() = EncodeGridHeader(grid, static_cast<int64_t>(grid.revisions.size()));
   SG_RETURN_IF_ERROR(emit(record));
-  SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid, kSourceChunkValues,
+  SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid(), kSourceChunkValues,
                                         [&](const v1::SourceChunk& chunk) {
                                           v1::ArchiveRecord r;
                                           *r.mutable_source() = chunk;
@@ -126,24 +126,26 @@ absl::Status GridAssembler::FinishSource(const std::string& event) {
         absl::StrCat(event, " after ", chunks_, " of the header's ", header_->num_source_chunks(),
                      " source chunks: the source points are incomplete (truncated archive?)"));
   }
-    auto points = std::make_shared<SourcePoints>();
-    SG_ASSIGN_OR_RETURN(points->grid, std::move(*source_).Finish());
-    source_.reset();
-    SG_ASSIGN_OR_RETURN(points->connectivity, ParseStoredConnectivity(header_->connectivity(), points->grid));
-    points->format = header_->source_format();
-    if (header_->has_source_plot3d()) {
-      SG_ASSIGN_OR_RETURN(points->plot3d,
-                          ParsePlot3dSourceFormat(header_->source_plot3d(),
-                                                  static_cast<int>(points->grid.blocks.size()),
-                                                  "header.source_plot3d"));
-    }
-    std::vector<Extents> extents;
-    for (const StructuredBlock& block : points->grid.blocks) extents.push_back(block.extents());
-    SG_ASSIGN_OR_RETURN(points->boundaries,
-                        ParseSourceBoundaries(header_->source_boundaries(), extents,
-                                              "header.source_boundaries"));
-    points->memory = std::move(source_memory_);
-    grid_->source = std::move(points);
+  auto points = std::make_shared<SourcePoints>();
+  SG_ASSIGN_OR_RETURN(MultiBlockGrid grid, std::move(*source_).Finish());
+  source_.reset();
+  SG_ASSIGN_OR_RETURN(stated_connectivity_, ParseStoredConnectivity(header_->connectivity(), grid));
+  SG_ASSIGN_OR_RETURN(points->checked, FittableGrid::Check(std::move(grid)),
+                      "the archive's source points: ");
+  points->format = header_->source_format();
+  if (header_->has_source_plot3d()) {
+    SG_ASSIGN_OR_RETURN(points->plot3d,
+                        ParsePlot3dSourceFormat(header_->source_plot3d(),
+                                                static_cast<int>(points->grid().blocks.size()),
+                                                "header.source_plot3d"));
+  }
+  std::vector<Extents> extents;
+  for (const StructuredBlock& block : points->grid().blocks) extents.push_back(block.extents());
+  SG_ASSIGN_OR_RETURN(
+      points->boundaries,
+      ParseSourceBoundaries(header_->source_boundaries(), extents, "header.source_boundaries"));
+  points->memory = std::move(source_memory_);
+  grid_->source = std::move(points);
   return absl::OkStatus();
 }
 
@@ -156,11 +158,11 @@ absl::Status GridAssembler::AddRevision(const v1::StoredRevision& stored) {
   if (source_) SG_RETURN_IF_ERROR(FinishSource("a revision came"));
   SG_ASSIGN_OR_RETURN(std::shared_ptr<const GridRevision> revision, LoadRevision(stored, budget_));
   if (!grid_->revisions.empty() && revision->number <= grid_->revisions.back()->number) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "revision ", revision->number, " follows revision ", grid_->revisions.back()->number,
-        ": revisions must come in ascending order"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("revision ", revision->number, " follows revision ",
+                     grid_->revisions.back()->number, ": revisions must come in ascending order"));
   }
-  SG_RETURN_IF_ERROR(CheckRevisionMatchesSource(*revision, grid_->source->grid));
+  SG_RETURN_IF_ERROR(CheckRevisionMatchesSource(*revision, grid_->source->grid()));
   grid_->revisions.push_back(std::move(revision));
   return absl::OkStatus();
 }
@@ -169,9 +171,9 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> GridAssembler::Finish(bool check_cou
   if (!header_) return absl::InvalidArgumentError("the archive is empty: no header");
   if (source_) SG_RETURN_IF_ERROR(FinishSource("the archive ends"));
   if (check_counts && static_cast<int64_t>(grid_->revisions.size()) != header_->num_revisions()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "the archive ends after ", grid_->revisions.size(), " of the header's ",
-        header_->num_revisions(), " revisions: it is truncated"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("the archive ends after ", grid_->revisions.size(), " of the header's ",
+                     header_->num_revisions(), " revisions: it is truncated"));
   }
   return std::move(grid_);
 }

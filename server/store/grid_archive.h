@@ -42,8 +42,14 @@ class GridAssembler {
 
   // Whether the header and every source chunk arrived (revisions may follow).
   bool has_source() const;
-  // The grid. With `check_counts` the header's num_revisions must match what arrived.
+  // The grid. With `check_counts` the header's num_revisions must match what arrived. Its
+  // source points are checked for fitting and matched here (FittableGrid::Check): a block that
+  // cannot be fitted is INVALID_ARGUMENT naming it.
   absl::StatusOr<std::shared_ptr<StoredGrid>> Finish(bool check_counts);
+
+  // The connectivity the header states (once the source is finished). The grid keeps the one
+  // this server finds in the points; an importer compares the two.
+  const Connectivity& stated_connectivity() const { return stated_connectivity_; }
 
  private:
   // Turns the assembled points into the grid's source; `event` says what ended them.
@@ -55,6 +61,7 @@ class GridAssembler {
   std::optional<SourceAssembler> source_;
   MemoryReservation source_memory_;
   int64_t chunks_ = 0;
+  Connectivity stated_connectivity_;
   std::shared_ptr<StoredGrid> grid_;
 };
 

@@ -133,7 +133,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> RedisSnapshots::DecodeRevisi
     return absl::DataLossError(
         absl::StrCat(what, " in Redis holds revision ", (*revision)->number));
   }
-  SG_RETURN_IF_ERROR(Damaged(CheckRevisionMatchesSource(**revision, source.grid), what));
+  SG_RETURN_IF_ERROR(Damaged(CheckRevisionMatchesSource(**revision, source.grid()), what));
   return revision;
 }
 

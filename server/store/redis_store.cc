@@ -205,10 +205,10 @@ absl::Status RedisStore::CheckRevisionSize(const std::string& id, int64_t number
 
 absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
   const std::string& id = grid->id;
-  if (!grid->source || grid->source->grid.blocks.empty()) {
+  if (!grid->source || grid->source->grid().blocks.empty()) {
     return absl::InvalidArgumentError(absl::StrCat("grids/", id, " has no source points"));
   }
-  const int64_t source_bytes = SourceBytes(grid->source->grid);
+  const int64_t source_bytes = SourceBytes(grid->source->grid());
   if (source_bytes > options_.max_source_bytes) {
     return absl::ResourceExhaustedError(absl::StrCat(
         "grids/", id, ": the source points take ", FormatBytes(source_bytes), " (", source_bytes,
@@ -291,7 +291,7 @@ absl::Status RedisStore::WriteGeneration(
     return absl::OkStatus();
   };
   SG_RETURN_IF_ERROR(
-      ForEachSourceChunk(grid.source->grid, kSourceChunkValues, [&](const v1::SourceChunk& chunk) {
+      ForEachSourceChunk(grid.source->grid(), kSourceChunkValues, [&](const v1::SourceChunk& chunk) {
         batch.push_back(chunk.SerializeAsString());
         return std::ssize(batch) == kChunksPerRound ? flush() : absl::OkStatus();
       }));

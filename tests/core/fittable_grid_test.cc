@@ -1,16 +1,21 @@
-// FitGrid with a known connectivity (the service finds it once, at import): the same fit as
-// finding it again, in both modes, and the given connectivity is the one used.
+// FittableGrid: a grid checked and matched once (the service does it when a grid arrives) fits
+// exactly like the same grid given as points, in both modes; the check refuses what FitGrid
+// refuses, naming the block, and its connectivity options are the ones used.
 #include <algorithm>
 #include <span>
 
 #include "core/fit/grid_fit.h"
 #include "core/grid/connectivity.h"
+#include "core/grid/fittable_grid.h"
 #include "core/io/plot3d.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/test_data.h"
 
 namespace splinegrid {
 namespace {
+
+using ::testing::HasSubstr;
 
 // The NACA 0012 C-grid: one block whose wake cut is a match with itself.
 MultiBlockGrid Naca() {
@@ -27,33 +32,67 @@ void ExpectSameFit(const GridFit& a, const GridFit& b) {
   }
   EXPECT_EQ(a.report.num_matches, b.report.num_matches);
   EXPECT_EQ(a.report.max_gap, b.report.max_gap);
+  EXPECT_EQ(a.report.max_deviation, b.report.max_deviation);
 }
 
-TEST(GridFitConnectivityTest, AGivenConnectivityFitsLikeAFoundOne) {
+TEST(FittableGridTest, ACheckedGridFitsLikeItsPoints) {
   const MultiBlockGrid grid = Naca();
-  const Connectivity found = FindConnectivity(grid).value();
-  ASSERT_EQ(found.matches.size(), 1u);
+  const FittableGrid checked = FittableGrid::Check(grid).value();
+  EXPECT_EQ(checked.connectivity(), FindConnectivity(grid).value());
+  ASSERT_EQ(checked.connectivity().matches.size(), 1u);
 
   GridFitOptions tolerances;
   tolerances.boundary_tolerances = BoundaryTolerances();  // the paper's, relative
-  const GridFit a = FitGrid(grid, tolerances).value();
-  const GridFit b = FitGrid(grid, found, tolerances).value();
-  ExpectSameFit(a, b);
+  const GridFit b = FitGrid(checked, tolerances).value();
+  ExpectSameFit(FitGrid(grid, tolerances).value(), b);
   EXPECT_EQ(b.report.num_matches, 1);
   EXPECT_LT(b.report.max_gap, 1e-9);  // watertight across the wake cut (rounding only)
 
   GridFitOptions counts;
   counts.control_counts = {40, 14, 0};
   counts.allow_folds = true;  // few controls fold this grid; the fit is compared, not judged
-  ExpectSameFit(FitGrid(grid, counts).value(), FitGrid(grid, found, counts).value());
+  ExpectSameFit(FitGrid(grid, counts).value(), FitGrid(checked, counts).value());
+
+  // Options are still checked, naming the field.
+  counts.control_counts = {400, 14, 0};
+  EXPECT_THAT(FitGrid(checked, counts).status().message(), HasSubstr("control_counts"));
 }
 
-TEST(GridFitConnectivityTest, TheGivenConnectivityIsTheOneUsed) {
-  const MultiBlockGrid grid = Naca();
+TEST(FittableGridTest, TheCheckRefusesWhatCannotBeFittedNamingTheBlock) {
+  MultiBlockGrid grid = Naca();
+  StructuredBlock collapsed({4, 3, 1}, 2);
+  std::fill(collapsed.coords().begin(), collapsed.coords().end(), 0.5);
+  grid.blocks.push_back(collapsed);
+  const absl::Status refused = FittableGrid::Check(grid).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.message(), HasSubstr("block 1: all 12 points are equal"));
+  // FitGrid on the points says the same, as a precondition of the grid.
+  const absl::Status fit = FitGrid(grid, GridFitOptions()).status();
+  EXPECT_EQ(fit.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(fit.message(), HasSubstr("block 1: all 12 points are equal"));
+
+  // Finite coordinates whose span overflows are not called "equal".
+  MultiBlockGrid huge = Naca();
+  huge.blocks[0].coords()[7] = 1e300;
+  huge.blocks[0].coords()[9] = -1e300;
+  EXPECT_THAT(FittableGrid::Check(huge).status().message(),
+              HasSubstr("block 0: the points span more than a double can hold"));
+
+  EXPECT_THAT(FittableGrid::Check(MultiBlockGrid()).status().message(), HasSubstr("no blocks"));
+  EXPECT_FALSE(FitGrid(FittableGrid(), GridFitOptions()).ok());
+}
+
+TEST(FittableGridTest, ItsConnectivityOptionsAreTheOnesUsed) {
+  // Matches must join at least 1000 points: the wake cut (33) is ignored, so the checked grid
+  // has no match, and a fit of it shares no boundary.
+  ConnectivityOptions strict;
+  strict.min_points = 1000;
+  const FittableGrid checked = FittableGrid::Check(Naca(), strict).value();
+  EXPECT_TRUE(checked.connectivity().matches.empty());
   GridFitOptions counts;
   counts.control_counts = {40, 14, 0};
   counts.allow_folds = true;
-  const GridFit fit = FitGrid(grid, Connectivity{}, counts).value();
+  const GridFit fit = FitGrid(checked, counts).value();
   EXPECT_EQ(fit.report.num_matches, 0);
   EXPECT_TRUE(fit.connectivity.matches.empty());
 }

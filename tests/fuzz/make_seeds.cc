@@ -77,9 +77,9 @@ void Plot3dStreamAndPlanesSeeds() {
                               .has_block_count = count,
                               .has_iblank = iblank,
                               .bytes_per_real = bytes_per_real};
-          const std::string suffix = absl::StrCat(
-              encoding == Plot3dEncoding::kBinaryBigEndian ? "be" : "le", "_r", bytes_per_real,
-              "_3d", count ? "_count" : "", iblank ? "_iblank" : "");
+          const std::string suffix =
+              absl::StrCat(encoding == Plot3dEncoding::kBinaryBigEndian ? "be" : "le", "_r",
+                           bytes_per_real, "_3d", count ? "_count" : "", iblank ? "_iblank" : "");
           format.framing = Plot3dFraming::kCStream;
           Write("plot3d_binary", "stream_" + suffix, EncodePlot3d(grid, format).value());
           format.framing = Plot3dFraming::kFortranRecords;
@@ -157,8 +157,7 @@ void ArchiveSeeds(const MultiBlockGrid& naca, GridFit fit) {
   grid->display_name = "NACA 0012 29 x 9";
   grid->create_time = absl::FromUnixSeconds(1700000000);
   auto source = std::make_shared<server::SourcePoints>();
-  source->grid = naca;
-  source->connectivity = fit.connectivity;
+  source->checked = FittableGrid::Check(naca).value();
   source->format = "plot3d ascii 2d single-block";
   grid->source = std::move(source);
   auto revision = std::make_shared<server::GridRevision>();

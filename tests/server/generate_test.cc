@@ -207,7 +207,7 @@ TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
   const auto stored = server_->state().store->Get("cgrid").value();
   const std::vector<uint8_t>& kinds = stored->revisions.back()->kinds.point_kinds.at(0);
   int wall = 0;
-  for (int i = 0; i < stored->source->grid.blocks[0].extent(0); ++i) {
+  for (int i = 0; i < stored->source->grid().blocks[0].extent(0); ++i) {
     wall += (kinds[i] & static_cast<uint8_t>(BoundaryKind::kWall)) != 0;
   }
   ASSERT_GT(wall, 50);

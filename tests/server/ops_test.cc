@@ -32,8 +32,9 @@ class OpsTest : public ::testing::Test {
     grid->id = "naca";
     grid->create_time = absl::Now();
     auto source = std::make_shared<SourcePoints>();
-    source->grid = ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
-    source->connectivity = FindConnectivity(source->grid).value();
+    source->checked =
+        FittableGrid::Check(ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value())
+            .value();
     source->format = "plot3d";
     grid->source = std::move(source);
     ASSERT_TRUE(store_.Create(grid).ok());
@@ -134,7 +135,7 @@ TEST_F(OpsTest, KeptDeformersKeepTheirGatesWithinTheCapAndChargeTheBudget) {
   const std::shared_ptr<const StoredGrid> grid = store_.Get("naca").value();
   GridFitOptions options;
   options.boundary_tolerances = BoundaryTolerances();
-  const GridFit fit = FitGrid(grid->source->grid, options).value();
+  const GridFit fit = FitGrid(grid->source->grid(), options).value();
   std::vector<FittedBlock> blocks;
   for (const BlockFit& b : fit.blocks) blocks.push_back(b.fitted);
   const Deformer deformer = Deformer::Create(blocks, fit.kinds, DeformOptions()).value();
@@ -200,6 +201,7 @@ TEST_F(OpsTest, EvaluatePointsEvaluatesTheRevisionAskedFor) {
   const std::vector<double> parameters = {0.0, 0.0, 0.0, 0.25, 0.5, 0.0, 1.0, 1.0, 0.0};
   ops::PointsRequest request{.grid_id = "naca",
                              .revision = 1,
+                             .step = std::nullopt,
                              .blocks = blocks,
                              .parameters = parameters,
                              .derivatives = true,
@@ -238,8 +240,11 @@ TEST_F(OpsTest, EvaluatePointsRefusesBadBatchesNamingTheField) {
   std::vector<int32_t> blocks = {0};
   std::vector<double> parameters = {0.5, 0.5, 0.0, 0.5, 1.5, 0.0};
   ops::PointsRequest request{.grid_id = "naca",
+                             .revision = 0,
+                             .step = std::nullopt,
                              .blocks = blocks,
                              .parameters = parameters,
+                             .derivatives = false,
                              .max_points = 100,
                              .max_bytes = int64_t{4} << 20};
   EXPECT_THAT(ops::EvaluatePoints(ops_, request).status().message(),

@@ -194,7 +194,7 @@ std::shared_ptr<StoredGrid> MakeGrid(const std::string& id,
   grid->display_name = "grid " + id;
   grid->create_time = absl::FromUnixNanos(1700000000123456789);
   auto source = std::make_shared<server::SourcePoints>();
-  source->grid = std::move(points);
+  source->checked = FittableGrid::Check(std::move(points)).value();
   source->format = "test points";
   grid->source = std::move(source);
   return grid;
@@ -301,7 +301,7 @@ TEST_F(RedisStoreTest, CreateGetListDeleteAcrossReplicas) {
   EXPECT_EQ(g1->display_name, "grid g1");
   EXPECT_EQ(g1->create_time, absl::FromUnixNanos(1700000000123456789));
   EXPECT_EQ(g1->source->format, "test points");
-  EXPECT_TRUE(SameBits(g1->source->grid.blocks[0].coords(), SmallGrid(9, 7).blocks[0].coords()));
+  EXPECT_TRUE(SameBits(g1->source->grid().blocks[0].coords(), SmallGrid(9, 7).blocks[0].coords()));
   EXPECT_TRUE(g1->revisions.empty());
 
   EXPECT_THAT(a_->Create(MakeGrid("g2")), StatusIs(absl::StatusCode::kAlreadyExists, "g2"));
@@ -640,15 +640,26 @@ TEST_F(RedisStoreTest, SourceOfSeveralChunksRoundTripsBitwise) {
   // 2 x 400 x 300 = 240000 coordinates: two chunks, then iblank; a small second block.
   StructuredBlock big({400, 300, 1}, 2);
   std::span<double> coords = big.coords();
-  for (size_t v = 0; v < coords.size(); ++v) coords[v] = std::sin(0.001 * v) * 1e3 + 1e-9 * v;
+  // A wavy grid (the store keeps fittable points only) whose low bits differ everywhere, with
+  // a negative zero, a denormal and a value one ulp off.
+  for (int j = 0; j < 300; ++j) {
+    for (int i = 0; i < 400; ++i) {
+      const size_t p = 400 * j + i;
+      coords[2 * p] = i + 0.25 * std::sin(0.01 * j) + 1e-9 * p;
+      coords[2 * p + 1] = j + 0.25 * std::sin(0.01 * i) + 1e-9 * p;
+    }
+  }
   coords[0] = -0.0;
   coords[1] = std::numeric_limits<double>::denorm_min();
-  coords[123457] = 1e300;
+  coords[123457] = std::nextafter(coords[123457], 1e9);
   big.iblank().assign(120000, 1);
   big.iblank()[99999] = 0;
   points.blocks.push_back(std::move(big));
   StructuredBlock small({5, 4, 1}, 2);
-  for (size_t v = 0; v < small.coords().size(); ++v) small.coords()[v] = 0.1 * v;
+  for (int p = 0; p < 20; ++p) {
+    small.coords()[2 * p] = 0.1 * (p % 5);
+    small.coords()[2 * p + 1] = 0.1 * (p / 5) + 0.01 * p;
+  }
   small.iblank().assign(20, 1);
   small.iblank()[7] = 0;
   small.iblank()[8] = -2;
@@ -657,9 +668,9 @@ TEST_F(RedisStoreTest, SourceOfSeveralChunksRoundTripsBitwise) {
   const absl::Status created = a_->Create(MakeGrid("big", std::move(points)));
   ASSERT_TRUE(created.ok()) << created;
   const auto got = b_->Get("big").value();
-  ASSERT_EQ(got->source->grid.blocks.size(), 2u);
+  ASSERT_EQ(got->source->grid().blocks.size(), 2u);
   for (int b = 0; b < 2; ++b) {
-    const StructuredBlock& block = got->source->grid.blocks[b];
+    const StructuredBlock& block = got->source->grid().blocks[b];
     EXPECT_EQ(block.extents(), expected.blocks[b].extents());
     EXPECT_TRUE(SameBits(block.coords(), expected.blocks[b].coords())) << "block " << b;
     EXPECT_EQ(block.iblank(), expected.blocks[b].iblank());
