@@ -104,9 +104,9 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
   if (active.empty()) return absl::OkStatus();  // a single point: nothing to span
   const int dims = static_cast<int>(active.size());
   if (dims == 3 && s == 2) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": ", n[0], " x ", n[1], " x ", n[2],
-        " points with 2 coordinates: a volume block needs 3 (x, y, z) coordinates"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": ", n[0], " x ", n[1], " x ", n[2],
+                     " points with 2 coordinates: a volume block needs 3 (x, y, z) coordinates"));
   }
   // L: the diagonal of the bounding box.
   const auto coords = block.coords();
@@ -119,17 +119,19 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
   for (int c = 0; c < s; ++c) diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
   diagonal = std::sqrt(diagonal);
   if (!std::isfinite(diagonal)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": the points span more than a double can hold (a bounding box from (",
-        absl::StrJoin(std::vector<double>(lo.begin(), lo.begin() + s), ", "), ") to (",
-        absl::StrJoin(std::vector<double>(hi.begin(), hi.begin() + s), ", "),
-        ")): scale the grid to its length unit"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what,
+                     ": the coordinates are too large to measure the block (the diagonal of its "
+                     "bounding box from (",
+                     absl::StrJoin(std::vector<double>(lo.begin(), lo.begin() + s), ", "), ") to (",
+                     absl::StrJoin(std::vector<double>(hi.begin(), hi.begin() + s), ", "),
+                     ") overflows a double): scale the grid to its length unit"));
   }
   if (!(diagonal > 0.0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": all ", block.num_points(), " points are equal (",
-        absl::StrJoin(std::vector<double>(coords.begin(), coords.begin() + s), ", "),
-        "): a grid collapsed to a point cannot be fitted"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": all ", block.num_points(), " points are equal (",
+                     absl::StrJoin(std::vector<double>(coords.begin(), coords.begin() + s), ", "),
+                     "): a grid collapsed to a point cannot be fitted"));
   }
   // A direction of zero length: no two neighbours along it differ.
   for (int d : active) {
@@ -149,9 +151,9 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
     if (!spans) {
       const std::string dir(1, kNames[d]);
       return absl::InvalidArgumentError(absl::StrCat(
-          what, ": direction ", dir, " has zero length: each of its ", dir,
-          "-lines of ", n[d], " points is a single repeated point (the block is collapsed in ",
-          dir, "); give the direction one point or spread its points"));
+          what, ": direction ", dir, " has zero length: each of its ", dir, "-lines of ", n[d],
+          " points is a single repeated point (the block is collapsed in ", dir,
+          "); give the direction one point or spread its points"));
     }
   }
   // The cells' measure: a corner's edge vectors along the active directions, at every corner.

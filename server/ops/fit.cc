@@ -60,7 +60,7 @@ absl::StatusOr<GridRevision> FitRevision(const OpsContext& context, const Source
   // The points were checked and matched when the grid arrived, not again here.
   absl::StatusOr<GridFit> fitted = FitGrid(source.checked, options, cancel);
   if (fitted.status().code() == absl::StatusCode::kFailedPrecondition) {
-    // A grid that cannot be fitted, or one whose fit folds without options.allow_folds.
+    // A fit that folds without options.allow_folds, or data that leave controls undetermined.
     return absl::FailedPreconditionError(
         absl::StrCat(fitted.status().message(), "; nothing was stored"));
   }

@@ -121,40 +121,47 @@ absl::Status GridAssembler::AddChunk(const v1::SourceChunk& chunk) {
 }
 
 absl::Status GridAssembler::FinishSource(const std::string& event) {
+  absl::Status status = AssembleSource(event);
+  // Nothing can follow a source that did not assemble: later records and Finish say why.
+  if (!status.ok()) source_error_ = status;
+  return status;
+}
+
+absl::Status GridAssembler::AssembleSource(const std::string& event) {
   if (!source_->complete() || chunks_ != header_->num_source_chunks()) {
     return absl::InvalidArgumentError(
         absl::StrCat(event, " after ", chunks_, " of the header's ", header_->num_source_chunks(),
                      " source chunks: the source points are incomplete (truncated archive?)"));
   }
   auto points = std::make_shared<SourcePoints>();
-  SG_ASSIGN_OR_RETURN(MultiBlockGrid grid, std::move(*source_).Finish());
+  SG_ASSIGN_OR_RETURN(unchecked_, std::move(*source_).Finish());
   source_.reset();
-  SG_ASSIGN_OR_RETURN(stated_connectivity_, ParseStoredConnectivity(header_->connectivity(), grid));
-  SG_ASSIGN_OR_RETURN(points->checked, FittableGrid::Check(std::move(grid)),
-                      "the archive's source points: ");
+  SG_ASSIGN_OR_RETURN(stated_connectivity_,
+                      ParseStoredConnectivity(header_->connectivity(), unchecked_));
   points->format = header_->source_format();
   if (header_->has_source_plot3d()) {
     SG_ASSIGN_OR_RETURN(points->plot3d,
                         ParsePlot3dSourceFormat(header_->source_plot3d(),
-                                                static_cast<int>(points->grid().blocks.size()),
+                                                static_cast<int>(unchecked_.blocks.size()),
                                                 "header.source_plot3d"));
   }
   std::vector<Extents> extents;
-  for (const StructuredBlock& block : points->grid().blocks) extents.push_back(block.extents());
+  for (const StructuredBlock& block : unchecked_.blocks) extents.push_back(block.extents());
   SG_ASSIGN_OR_RETURN(
       points->boundaries,
       ParseSourceBoundaries(header_->source_boundaries(), extents, "header.source_boundaries"));
   points->memory = std::move(source_memory_);
-  grid_->source = std::move(points);
+  points_ = std::move(points);
   return absl::OkStatus();
 }
 
 bool GridAssembler::has_source() const {
-  return (grid_ && grid_->source) || (source_ && source_->complete());
+  return points_ != nullptr || (source_ && source_->complete());
 }
 
 absl::Status GridAssembler::AddRevision(const v1::StoredRevision& stored) {
   if (!header_) return absl::InvalidArgumentError("a revision came before the header");
+  SG_RETURN_IF_ERROR(source_error_);
   if (source_) SG_RETURN_IF_ERROR(FinishSource("a revision came"));
   SG_ASSIGN_OR_RETURN(std::shared_ptr<const GridRevision> revision, LoadRevision(stored, budget_));
   if (!grid_->revisions.empty() && revision->number <= grid_->revisions.back()->number) {
@@ -162,14 +169,20 @@ absl::Status GridAssembler::AddRevision(const v1::StoredRevision& stored) {
         absl::StrCat("revision ", revision->number, " follows revision ",
                      grid_->revisions.back()->number, ": revisions must come in ascending order"));
   }
-  SG_RETURN_IF_ERROR(CheckRevisionMatchesSource(*revision, grid_->source->grid()));
+  SG_RETURN_IF_ERROR(CheckRevisionMatchesSource(*revision, unchecked_));
   grid_->revisions.push_back(std::move(revision));
   return absl::OkStatus();
 }
 
 absl::StatusOr<std::shared_ptr<StoredGrid>> GridAssembler::Finish(bool check_counts) {
   if (!header_) return absl::InvalidArgumentError("the archive is empty: no header");
+  SG_RETURN_IF_ERROR(source_error_);
   if (source_) SG_RETURN_IF_ERROR(FinishSource("the archive ends"));
+  // The points are checked for fitting and matched once, here (on the caller's worker, not
+  // as records arrive): a block that cannot be fitted refuses the whole grid.
+  SG_ASSIGN_OR_RETURN(points_->checked, FittableGrid::Check(std::move(unchecked_)),
+                      "the archive's source points: ");
+  grid_->source = std::move(points_);
   if (check_counts && static_cast<int64_t>(grid_->revisions.size()) != header_->num_revisions()) {
     return absl::InvalidArgumentError(
         absl::StrCat("the archive ends after ", grid_->revisions.size(), " of the header's ",

@@ -52,8 +52,10 @@ class GridAssembler {
   const Connectivity& stated_connectivity() const { return stated_connectivity_; }
 
  private:
-  // Turns the assembled points into the grid's source; `event` says what ended them.
+  // Turns the assembled points into the grid's source (checked by Finish); `event` says what
+  // ended them. An error is kept: every later call returns it.
   absl::Status FinishSource(const std::string& event);
+  absl::Status AssembleSource(const std::string& event);
 
   MemoryBudget* budget_;
   std::string id_;
@@ -62,6 +64,10 @@ class GridAssembler {
   MemoryReservation source_memory_;
   int64_t chunks_ = 0;
   Connectivity stated_connectivity_;
+  // The finished source without its points, and the points, until Finish checks them.
+  std::shared_ptr<SourcePoints> points_;
+  MultiBlockGrid unchecked_;
+  absl::Status source_error_;
   std::shared_ptr<StoredGrid> grid_;
 };
 

@@ -76,7 +76,7 @@ TEST(FittableGridTest, TheCheckRefusesWhatCannotBeFittedNamingTheBlock) {
   huge.blocks[0].coords()[7] = 1e300;
   huge.blocks[0].coords()[9] = -1e300;
   EXPECT_THAT(FittableGrid::Check(huge).status().message(),
-              HasSubstr("block 0: the points span more than a double can hold"));
+              HasSubstr("block 0: the coordinates are too large to measure the block"));
 
   EXPECT_THAT(FittableGrid::Check(MultiBlockGrid()).status().message(), HasSubstr("no blocks"));
   EXPECT_FALSE(FitGrid(FittableGrid(), GridFitOptions()).ok());
