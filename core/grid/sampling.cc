@@ -1,5 +1,8 @@
 #include "core/grid/sampling.h"
 
+#include <cmath>
+#include <string>
+
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 
@@ -26,7 +29,58 @@ absl::StatusOr<IndexBox> CheckedBox(const PointDistribution& distribution,
   return *resolution.box;
 }
 
+std::string DistributionField(int d, absl::string_view member = "") {
+  return absl::StrCat("distributions.", std::string(1, kNames[d]), member.empty() ? "" : ".",
+                      member);
+}
+
+// The distributions can be followed with these point counts (see SampleExtents).
+absl::Status CheckDistributions(const std::array<Distribution, 3>& distributions,
+                                const Extents& extents) {
+  int measured = -1;
+  for (int d = 0; d < 3; ++d) {
+    const Distribution& dist = distributions[d];
+    const bool geometric = dist.kind == Distribution::Kind::kGeometric;
+    if (IsMeasured(dist.kind)) {
+      if (measured >= 0) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            DistributionField(measured), " and ", DistributionField(d),
+            " are both measured along grid lines (uniform arc length or geometric); at most one "
+            "direction may be, the others keep one parameter per index"));
+      }
+      measured = d;
+    }
+    if (geometric) {
+      if (!(std::isfinite(dist.first_spacing) && dist.first_spacing > 0.0)) {
+        return absl::InvalidArgumentError(absl::StrCat(DistributionField(d, "first_spacing"), " = ",
+                                                       dist.first_spacing,
+                                                       " is not a positive finite length"));
+      }
+      if (extents[d] < 3) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            DistributionField(d), " is geometric but the resolution gives ", extents[d],
+            " point(s) in that direction; a first spacing needs at least 3"));
+      }
+    } else if (dist.first_spacing != 0.0) {
+      return absl::InvalidArgumentError(absl::StrCat(DistributionField(d, "first_spacing"), " = ",
+                                                     dist.first_spacing,
+                                                     " is only for the geometric distribution"));
+    } else if (dist.from_end) {
+      return absl::InvalidArgumentError(absl::StrCat(DistributionField(d, "from_end"),
+                                                     " is only for the geometric distribution"));
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
+
+std::vector<double> UniformParameters(double begin, double end, int count) {
+  std::vector<double> out(count, begin);
+  for (int q = 1; q < count; ++q) out[q] = begin + (end - begin) * q / (count - 1);
+  if (count > 1) out.back() = end;
+  return out;
+}
 
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
                                       const Resolution& resolution) {
@@ -51,6 +105,7 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
       }
       extents[d] = static_cast<int>(n);
     }
+    SG_RETURN_IF_ERROR(CheckDistributions(resolution.distributions, extents));
     return extents;
   }
   for (int d = 0; d < 3; ++d) {
@@ -70,6 +125,7 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
     }
     extents[d] = n;
   }
+  SG_RETURN_IF_ERROR(CheckDistributions(resolution.distributions, extents));
   return extents;
 }
 
@@ -79,9 +135,23 @@ absl::StatusOr<std::array<std::vector<double>, 3>> SampleParameters(
   SG_ASSIGN_OR_RETURN(const IndexBox box, CheckedBox(distribution, resolution));
   std::array<std::vector<double>, 3> params;
   for (int d = 0; d < 3; ++d) {
-    params[d] = resolution.kind == Resolution::Kind::kLevel
-                    ? distribution.Refined(d, box.begin[d], box.end[d], resolution.level)
-                    : distribution.Resampled(d, box.begin[d], box.end[d], extents[d]);
+    switch (resolution.distributions[d].kind) {
+      case Distribution::Kind::kOriginal:
+        params[d] = resolution.kind == Resolution::Kind::kLevel
+                        ? distribution.Refined(d, box.begin[d], box.end[d], resolution.level)
+                        : distribution.Resampled(d, box.begin[d], box.end[d], extents[d]);
+        break;
+      case Distribution::Kind::kUniformParameter:
+        params[d] = UniformParameters(distribution.params(d)[box.begin[d]],
+                                      distribution.params(d)[box.end[d]], extents[d]);
+        break;
+      case Distribution::Kind::kUniformArcLength:
+      case Distribution::Kind::kGeometric:
+        return absl::InvalidArgumentError(
+            absl::StrCat(DistributionField(d),
+                         " is measured along the spline's grid lines; sample it with "
+                         "BlockSampling"));
+    }
   }
   return params;
 }

@@ -1,5 +1,6 @@
 // Where to evaluate a fitted block: resolution by refinement level or by point counts, over the
-// whole block or an index sub-box, following the block's point distribution.
+// whole block or an index sub-box, following the block's point distribution or another
+// distribution per direction.
 #ifndef SPLINEGRID_CORE_GRID_SAMPLING_H_
 #define SPLINEGRID_CORE_GRID_SAMPLING_H_
 
@@ -19,6 +20,29 @@ struct IndexBox {
   Extents end = {0, 0, 0};
 };
 
+// How the points of one direction are spread between the box's first and last index. The count
+// comes from the resolution; the ends are always the original end points.
+struct Distribution {
+  enum class Kind {
+    kOriginal,          // the original clustering (point_distribution.h)
+    kUniformParameter,  // evenly spaced in the spline parameter
+    // Measured along every grid line of the spline (block_sampling.h):
+    kUniformArcLength,  // evenly spaced in arc length
+    kGeometric,         // first interval of arc length first_spacing, the next ones growing
+                        // (or shrinking) by a constant ratio to the line's end
+  };
+  Kind kind = Kind::kOriginal;
+  double first_spacing = 0.0;  // kGeometric: in the grid's length unit, > 0
+  bool from_end = false;       // kGeometric: the first interval at the last index instead
+
+  friend bool operator==(const Distribution&, const Distribution&) = default;
+};
+
+// Arc length and geometric distributions place every grid line's points on that line.
+inline bool IsMeasured(Distribution::Kind kind) {
+  return kind == Distribution::Kind::kUniformArcLength || kind == Distribution::Kind::kGeometric;
+}
+
 struct Resolution {
   enum class Kind {
     kLevel,   // 2^level - 1 new points in every original interval; level 0 = original points
@@ -28,6 +52,9 @@ struct Resolution {
   int level = 0;
   Extents counts = {1, 1, 1};
   std::optional<IndexBox> box;  // absent: the whole block
+  // Per direction i, j, k. At most one direction may be measured (IsMeasured): the others
+  // stay one parameter per index, so every measured line is an iso-parameter line.
+  std::array<Distribution, 3> distributions;
 };
 
 // Highest refinement level accepted (2^20 points per original interval is already absurd).
@@ -37,13 +64,20 @@ inline constexpr int kMaxRefinementLevel = 20;
 // the parameters (for size checks). Errors, naming the field and value: INVALID_ARGUMENT for a
 // negative level, counts below 1, a box outside the block or with end < begin, counts above 1
 // in a direction with one original point; OUT_OF_RANGE for a level above kMaxRefinementLevel or
-// more than 2^30 points in a direction.
+// more than 2^30 points in a direction; INVALID_ARGUMENT for a distribution that cannot be
+// followed (two measured directions, a geometric one with fewer than 3 points or a first
+// spacing that is not positive and finite, a first_spacing or from_end on another kind).
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
                                       const Resolution& resolution);
 
-// The parameters per direction for `resolution` (see SampleExtents for the errors).
+// The parameters per direction for `resolution` (see SampleExtents for the errors). A measured
+// distribution needs the spline: INVALID_ARGUMENT here, use BlockSampling.
 absl::StatusOr<std::array<std::vector<double>, 3>> SampleParameters(
     const PointDistribution& distribution, const Resolution& resolution);
+
+// `count` parameters evenly spaced from `begin` to `end`, both ends exact (count >= 1; a single
+// one is `begin`).
+std::vector<double> UniformParameters(double begin, double end, int count);
 
 }  // namespace splinegrid
 

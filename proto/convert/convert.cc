@@ -1,8 +1,10 @@
 #include "proto/convert/convert.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
@@ -521,6 +523,33 @@ absl::StatusOr<Resolution> ParseResolution(const v1::EvaluateGridRequest& reques
   if (request.has_index_box()) {
     resolution.box = IndexBox{ParseExtents(request.index_box().begin()),
                               ParseExtents(request.index_box().end())};
+  }
+  const v1::Distributions& wanted = request.distributions();
+  const std::array<const v1::Distribution*, 3> per_direction = {&wanted.i(), &wanted.j(),
+                                                                &wanted.k()};
+  for (int d = 0; d < 3; ++d) {
+    const v1::Distribution& in = *per_direction[d];
+    Distribution& out = resolution.distributions[d];
+    switch (in.kind()) {
+      case v1::Distribution::KIND_ORIGINAL:
+        out.kind = Distribution::Kind::kOriginal;
+        break;
+      case v1::Distribution::KIND_UNIFORM_PARAMETER:
+        out.kind = Distribution::Kind::kUniformParameter;
+        break;
+      case v1::Distribution::KIND_UNIFORM_ARC_LENGTH:
+        out.kind = Distribution::Kind::kUniformArcLength;
+        break;
+      case v1::Distribution::KIND_GEOMETRIC:
+        out.kind = Distribution::Kind::kGeometric;
+        break;
+      default:
+        return absl::InvalidArgumentError(absl::StrCat("distributions.", std::string(1, "ijk"[d]),
+                                                       ".kind = ", in.kind(),
+                                                       " is not a known distribution"));
+    }
+    out.first_spacing = in.first_spacing();
+    out.from_end = in.from_end();
   }
   return resolution;
 }

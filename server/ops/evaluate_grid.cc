@@ -6,6 +6,14 @@
 #include "core/util/status_macros.h"
 
 namespace splinegrid::server::ops {
+namespace {
+
+// Output lines (all i for one (j, k)) of a block.
+int64_t NumLines(const EvaluatedBlock& block) {
+  return int64_t{block.extents[1]} * block.extents[2];
+}
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
     const OpsContext& context, const GridEvaluationRequest& request) {
@@ -47,16 +55,18 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
     const int64_t net = int64_t{s} * extents[0] * n[1] * (n[2] + 3) * sizeof(double);
     work_bytes = std::max(work_bytes, net * (request.derivatives ? 2 : 1));
     plan->blocks_.push_back({b, extents});
-    param_bytes += (int64_t{extents[0]} + extents[1] + extents[2]) * int64_t{sizeof(double)};
+    param_bytes += BlockSampling::Bytes(request.resolution, extents);
   }
   // Reserved before the parameters are sampled: a small request may ask for 2^30 of them.
   SG_ASSIGN_OR_RETURN(
       plan->memory_,
       context.budget.Reserve(work_bytes + param_bytes + request.buffer_bytes, "the evaluation"));
   for (const EvaluatedBlock& block : plan->blocks_) {
+    const FittedBlock& fitted = rev.blocks[block.block].fitted;
     SG_ASSIGN_OR_RETURN(
-        plan->params_.emplace_back(),
-        SampleParameters(rev.blocks[block.block].fitted.distribution, request.resolution));
+        plan->samplings_.emplace_back(),
+        BlockSampling::Create(fitted.spline, fitted.distribution, request.resolution), "block ",
+        block.block, ": ");
   }
   plan->derivatives_ = request.derivatives;
   plan->spatial_dim_ = s;
@@ -67,16 +77,17 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
 
 EvaluationChunk GridEvaluation::Next() {
   const EvaluatedBlock& block = blocks_[cursor_];
-  if (!evaluator_) {
+  const BlockSampling& sampling = samplings_[cursor_];
+  if (!evaluator_ && sampling.measured_direction() < 0) {
     evaluator_ = std::make_unique<GridEvaluator>(revision_->blocks[block.block].fitted.spline,
-                                                 params_[cursor_], derivatives_);
+                                                 sampling.params(), derivatives_);
   }
   // Whole lines while they fit in a chunk, else pieces of one line.
   const int ni = block.extents[0];
   line_end_ = line_ + 1;
   i_end_ = ni;
   if (i_ == 0 && ni <= chunk_points_) {
-    line_end_ = std::min(evaluator_->num_lines(), line_ + std::max<int64_t>(1, chunk_points_ / ni));
+    line_end_ = std::min(NumLines(block), line_ + std::max<int64_t>(1, chunk_points_ / ni));
   } else {
     i_end_ = static_cast<int>(std::min<int64_t>(ni, i_ + chunk_points_));
   }
@@ -85,8 +96,13 @@ EvaluationChunk GridEvaluation::Next() {
 }
 
 void GridEvaluation::EvaluateNext(const std::array<double*, 4>& out) {
-  const int ni = blocks_[cursor_].extents[0];
-  if (line_end_ == line_ + 1 && (i_ != 0 || i_end_ != ni)) {
+  const EvaluatedBlock& block = blocks_[cursor_];
+  const int ni = block.extents[0];
+  if (!evaluator_) {  // a measured distribution: point by point
+    const int64_t first = line_ * ni + i_, last = (line_end_ - 1) * ni + i_end_;
+    EvaluateSampledPoints(revision_->blocks[block.block].fitted.spline, samplings_[cursor_], first,
+                          last - first, out[0], out[1], out[2], out[3]);
+  } else if (line_end_ == line_ + 1 && (i_ != 0 || i_end_ != ni)) {
     evaluator_->EvaluateLineRange(line_, i_, i_end_, out[0], out[1], out[2], out[3]);
   } else {
     evaluator_->EvaluateLines(line_, line_end_, out[0], out[1], out[2], out[3]);
@@ -97,7 +113,7 @@ void GridEvaluation::EvaluateNext(const std::array<double*, 4>& out) {
   } else {
     i_ = i_end_;
   }
-  if (line_ == evaluator_->num_lines()) {
+  if (line_ == NumLines(block)) {
     evaluator_.reset();
     line_ = 0;
     ++cursor_;

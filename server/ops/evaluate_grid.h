@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/bspline/block_sampling.h"
 #include "core/bspline/evaluation.h"
 #include "core/grid/sampling.h"
 #include "server/ops/ops_context.h"
@@ -78,14 +79,14 @@ class GridEvaluation {
   int64_t total_points_ = 0;
   int64_t chunk_points_ = 1;
   std::vector<EvaluatedBlock> blocks_;
-  std::vector<std::array<std::vector<double>, 3>> params_;  // per entry of blocks_
+  std::vector<BlockSampling> samplings_;  // per entry of blocks_
   // Cursor: block entry, line and first point of the next chunk, and the chunk's end.
   size_t cursor_ = 0;
   int64_t line_ = 0;
   int i_ = 0;
   int64_t line_end_ = 0;
   int i_end_ = 0;
-  std::unique_ptr<GridEvaluator> evaluator_;
+  std::unique_ptr<GridEvaluator> evaluator_;  // for the current block, unless it is measured
 };
 
 }  // namespace splinegrid::server::ops
