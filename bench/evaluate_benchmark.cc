@@ -1,10 +1,13 @@
 // Evaluation throughput by sum factorisation (GridEvaluator) of a fixed control net at
 // growing output resolutions spanning >= 100x; items_per_second = output points per second.
-// The output array is allocated once and written in full each iteration.
+// The output array is allocated once and written in full each iteration. BM_EvaluateDistribution:
+// the same surface with a distribution on demand (block_sampling.h), placing and evaluating the
+// points, beside the original clustering by GridEvaluator in the same run.
 #include <cmath>
 
 #include "bench/grid_samples.h"
 #include "benchmark/benchmark.h"
+#include "core/bspline/block_sampling.h"
 #include "core/bspline/evaluation.h"
 #include "core/fit/solve/tensor_fit.h"
 
@@ -94,6 +97,36 @@ BENCHMARK(BM_EvaluateVolumeWithDerivatives)
     ->Arg(64 * 64 * 64)
     ->Arg(128 * 128 * 128)
     ->Unit(benchmark::kMillisecond);
+
+// Arg: 0 the original clustering (tensor grid, GridEvaluator), 1 geometric in j from a first
+// spacing of 1e-4 (the surface spans about 2 x 3), 2 uniform arc length in i; 640 x 640 points
+// of a 24 x 24 control net.
+void BM_EvaluateDistribution(benchmark::State& state) {
+  const TensorSpline spline = SampleSpline({24, 24, 1});
+  std::array<std::vector<double>, 3> data = {
+      std::vector<double>(48), std::vector<double>(48), {0.0}};
+  for (int i = 0; i < 48; ++i) data[0][i] = data[1][i] = i / 47.0;
+  const PointDistribution distribution = PointDistribution::Create(data).value();
+  Resolution resolution;
+  resolution.kind = Resolution::Kind::kCounts;
+  resolution.counts = {640, 640, 1};
+  if (state.range(0) == 1) resolution.distributions[1] = {Distribution::Kind::kGeometric, 1e-4};
+  if (state.range(0) == 2) resolution.distributions[0] = {Distribution::Kind::kUniformArcLength};
+  std::vector<double> points(3 * NumPoints(resolution.counts));
+  for (auto _ : state) {
+    const BlockSampling sampling = BlockSampling::Create(spline, distribution, resolution).value();
+    if (sampling.measured_direction() < 0) {
+      GridEvaluator evaluator(spline, sampling.params(), /*first_derivatives=*/false);
+      evaluator.EvaluateLines(0, evaluator.num_lines(), points.data());
+    } else {
+      EvaluateSampledPoints(spline, sampling, 0, NumPoints(sampling.extents()), points.data());
+    }
+    benchmark::DoNotOptimize(points.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * NumPoints(resolution.counts));
+}
+BENCHMARK(BM_EvaluateDistribution)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace splinegrid::bench

@@ -88,11 +88,12 @@ std::vector<CommandSpec> MakeCommands() {
        {}},
       {"eval",
        "eval NAME (--level L | --res a,b,c) [--revision R | --step N | --steps A:B] [--block b] "
-       "[--box i0:i1,j0:j1[,k0:k1]] [--derivs] [--float32] -o OUT.{vts,vtm,x,xyz,pvd}",
+       "[--box i0:i1,j0:j1[,k0:k1]] [--dist DIR=KIND,...] [--derivs] [--float32] "
+       "-o OUT.{vts,vtm,x,xyz,pvd}",
        "evaluate a revision at a refinement level or resolution into a file",
        /*client=*/true,
-       {"o", "level", "res", "revision", "step", "block", "box", "derivs", "float32", "steps",
-        "compress", "jacobian", "quality", "deviation"},
+       {"o", "level", "res", "revision", "step", "block", "box", "dist", "derivs", "float32",
+        "steps", "compress", "jacobian", "quality", "deviation"},
        {}},
       {"deform",
        "deform NAME [--rotate DEG [--about X,Y[,Z]] [--axis X,Y,Z]] [--translate DX,DY[,DZ]] "

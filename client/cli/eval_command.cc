@@ -27,7 +27,8 @@ absl::Status Eval(const Args& args) {
   if (args.size() != 1 || out.empty()) {
     return Usage(
         "usage: splinegrid eval NAME (--level L | --res a,b,c) [--revision R | --step N] "
-        "[--block b] [--derivs] [--jacobian] [--quality] [--deviation] [--nocompress] "
+        "[--block b] [--box ...] [--dist DIR=KIND,...] [--derivs] [--jacobian] [--quality] "
+        "[--deviation] [--nocompress] "
         "-o OUT.{vts,vtm,x,xyz,cgns}, or --steps A:B -o OUT.pvd");
   }
   v1::EvaluateGridRequest request;
@@ -69,6 +70,7 @@ absl::Status Eval(const Args& args) {
     EncodeExtents(begin, box->mutable_begin());
     EncodeExtents(end, box->mutable_end());
   }
+  SG_RETURN_IF_ERROR(ParseDistributionFlag(absl::GetFlag(FLAGS_dist), &request));
   request.set_derivatives(absl::GetFlag(FLAGS_derivs));
   request.set_precision(absl::GetFlag(FLAGS_float32) ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
   // Output fields, the source's Plot3D layout and ParaView time series (eval_support.h).

@@ -58,6 +58,47 @@ absl::StatusOr<MultiBlockGrid> ReadArchiveSource(const std::string& path) {
 
 }  // namespace
 
+absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequest* request) {
+  v1::Distributions* distributions = request->mutable_distributions();
+  for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
+    const std::vector<std::string> sides = absl::StrSplit(part, absl::MaxSplits('=', 1));
+    v1::Distribution* out = nullptr;
+    if (sides.size() == 2 && sides[0] == "i") out = distributions->mutable_i();
+    if (sides.size() == 2 && sides[0] == "j") out = distributions->mutable_j();
+    if (sides.size() == 2 && sides[0] == "k") out = distributions->mutable_k();
+    if (out == nullptr) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--dist: '", part, "' is not DIR=KIND with DIR i, j or k"));
+    }
+    const std::vector<std::string> kind = absl::StrSplit(sides[1], ':');
+    if (kind.size() == 1 && kind[0] == "original") {
+      out->set_kind(v1::Distribution::KIND_ORIGINAL);
+    } else if (kind.size() == 1 && kind[0] == "parameter") {
+      out->set_kind(v1::Distribution::KIND_UNIFORM_PARAMETER);
+    } else if (kind.size() == 1 && kind[0] == "arclength") {
+      out->set_kind(v1::Distribution::KIND_UNIFORM_ARC_LENGTH);
+    } else if (kind[0] == "geometric" && (kind.size() == 2 || kind.size() == 3)) {
+      double first = 0.0;
+      if (!absl::SimpleAtod(kind[1], &first)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--dist: '", kind[1], "' in '", part, "' is not a number"));
+      }
+      if (kind.size() == 3 && kind[2] != "end") {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--dist: '", kind[2], "' in '", part, "' is not 'end'"));
+      }
+      out->set_kind(v1::Distribution::KIND_GEOMETRIC);
+      out->set_first_spacing(first);
+      out->set_from_end(kind.size() == 3);
+    } else {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--dist: '", sides[1], "' in '", part,
+                       "' is not original, parameter, arclength or geometric:FIRST[:end]"));
+    }
+  }
+  return absl::OkStatus();
+}
+
 bool IsSeriesPath(const std::string& out) {
   return std::filesystem::path(out).extension() == ".pvd";
 }
@@ -70,10 +111,11 @@ absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& 
   options.quality = absl::GetFlag(FLAGS_quality);
   options.deviation = absl::GetFlag(FLAGS_deviation);
   options.compress = absl::GetFlag(FLAGS_compress);
-  if (options.deviation &&
-      (request->has_counts() || request->refinement_level() != 0 || request->has_index_box())) {
+  if (options.deviation && (request->has_counts() || request->refinement_level() != 0 ||
+                            request->has_index_box() || request->has_distributions())) {
     return absl::InvalidArgumentError(
-        "--deviation is measured at the source points: evaluate with --level 0 and no --box");
+        "--deviation is measured at the source points: evaluate with --level 0, no --box and "
+        "no --dist");
   }
   const std::string ext = std::filesystem::path(out).extension().string();
   if ((options.jacobian || options.quality || options.deviation) && ext != ".vts" &&

@@ -16,6 +16,11 @@ namespace splinegrid::cli {
 // Whether `out` asks for a time series (ends in .pvd).
 bool IsSeriesPath(const std::string& out);
 
+// --dist DIR=KIND[,...] (see the flag's help) into request->distributions; INVALID_ARGUMENT
+// naming the part that is not understood. The server checks the rest (one measured direction,
+// spacings against the lines' lengths).
+absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequest* request);
+
 // The output options of --derivs, --jacobian, --quality, --deviation and --compress; sets
 // request->derivatives when the derivatives or the Jacobian need them. INVALID_ARGUMENT, before
 // any call, for VTK fields or an explicit --compress/--nocompress with a file that is not VTK,

@@ -68,6 +68,12 @@ ABSL_FLAG(int, level, -1, "eval/curvature: refinement level (0 = original points
 ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
 ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");
+ABSL_FLAG(std::string, dist, "",
+          "eval: point distributions, DIR=KIND[,...] with DIR i, j or k and KIND original, "
+          "parameter (uniform in the spline parameter), arclength (uniform in arc length) or "
+          "geometric:FIRST[:end] (first spacing FIRST at the first index, or at the last with "
+          ":end); e.g. --dist j=geometric:2e-6 for a new wall spacing. At most one direction may "
+          "be arclength or geometric");
 ABSL_FLAG(std::string, o, "",
           "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D, .cgns; eval: "
           ".pvd series); curvature: .csv; export: the archive (.sgrid)");
@@ -75,8 +81,9 @@ ABSL_FLAG(bool, derivs, false,
           "eval: also dX/du, dX/dv[, dX/dw] (VTK point arrays; with .x/.xyz a Plot3D function "
           "file NAME.f beside it)");
 ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
-ABSL_FLAG(std::string, steps, "",
-          "eval: a:b, the deformed revisions of time steps a to b as a ParaView series (-o NAME.pvd)");
+ABSL_FLAG(
+    std::string, steps, "",
+    "eval: a:b, the deformed revisions of time steps a to b as a ParaView series (-o NAME.pvd)");
 ABSL_FLAG(bool, compress, true, "eval: zlib-compress VTK XML data (--nocompress: raw)");
 ABSL_FLAG(bool, jacobian, false, "eval: VTK point field 'jacobian' of the spline mapping");
 ABSL_FLAG(bool, quality, false, "eval: VTK cell field 'scaled_jacobian' (1 ideal, <= 0 folded)");

@@ -49,6 +49,7 @@ ABSL_DECLARE_FLAG(int, level);
 ABSL_DECLARE_FLAG(std::string, res);
 ABSL_DECLARE_FLAG(std::string, block);
 ABSL_DECLARE_FLAG(std::string, box);
+ABSL_DECLARE_FLAG(std::string, dist);
 ABSL_DECLARE_FLAG(std::string, o);
 ABSL_DECLARE_FLAG(bool, derivs);
 ABSL_DECLARE_FLAG(bool, float32);

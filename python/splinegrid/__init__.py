@@ -17,6 +17,7 @@ framed record files of ``.sgrid`` archives (``Client.export_grid`` / ``Client.im
 from splinegrid.client import Client
 from splinegrid._args import grid_name
 from splinegrid._transport import GRID_ROUTING_HEADER, SERVICE
+from splinegrid.distributions import Distribution
 from splinegrid.errors import SplinegridError
 from splinegrid.filekind import FileKind, detect_file_kind
 from splinegrid.results import (ArchiveSummary, BoundaryPoints, EvaluatedBlock, EvaluatedGrid,
@@ -30,6 +31,7 @@ __all__ = [
     "ArchiveSummary",
     "BoundaryPoints",
     "Client",
+    "Distribution",
     "EvaluatedBlock",
     "EvaluatedGrid",
     "EvaluatedPoints",

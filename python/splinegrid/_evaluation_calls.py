@@ -15,6 +15,7 @@ from splinegrid._args import Blocks, Triple, _block_list, _extents, _set_step, g
 from splinegrid._calls import _Calls
 from splinegrid._evaluation import _assemble
 from splinegrid._transport import _Attempt, _routing_grid
+from splinegrid.distributions import Distributions, _set_distributions
 from splinegrid.errors import SplinegridError
 from splinegrid.results import EvaluatedGrid, EvaluatedPoints, WallCurvatureLine
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
@@ -26,7 +27,7 @@ _PARAMETERS_FIELD = 4  # EvaluatePointsRequest.parameters (packed doubles)
 def _evaluate_request(name: str, level: Optional[int], counts: Optional[Triple],
                       blocks: Blocks, index_box: Optional[tuple[Triple, Triple]],
                       derivatives: bool, dtype: npt.DTypeLike, revision: int,
-                      step: Optional[int]
+                      step: Optional[int], distributions: Distributions = None
                       ) -> tuple[service_pb2.EvaluateGridRequest, _wire.Dtype]:
     """The EvaluateGridRequest of :meth:`Client.evaluate`'s arguments and the dtype of the
     result; ValueError naming the argument that is wrong."""
@@ -53,6 +54,7 @@ def _evaluate_request(name: str, level: Optional[int], counts: Optional[Triple],
         begin, end = index_box
         request.index_box.begin.CopyFrom(_extents(begin, "index_box begin", fill=0))
         request.index_box.end.CopyFrom(_extents(end, "index_box end", fill=0))
+    _set_distributions(request, distributions)
     return request, out_dtype
 
 
@@ -121,7 +123,8 @@ class _EvaluationCalls(_Calls):
                  counts: Optional[Triple] = None, blocks: Blocks = None,
                  index_box: Optional[tuple[Triple, Triple]] = None,
                  derivatives: bool = False, dtype: npt.DTypeLike = np.float64,
-                 revision: int = 0, step: Optional[int] = None) -> EvaluatedGrid:
+                 revision: int = 0, step: Optional[int] = None,
+                 distributions: Distributions = None) -> EvaluatedGrid:
         """Evaluates blocks of a revision (0: latest) on a grid of parameters.
 
         Resolution: ``level`` l puts 2^l - 1 new points in every original interval (0, the
@@ -132,13 +135,16 @@ class _EvaluationCalls(_Calls):
         ``(i, j[, k])`` in original grid indices, inclusive at both ends (missing: 0).
         ``dtype`` float32 transfers single precision (half the bytes). ``step``: instead of
         ``revision``, the latest revision stamped with this solver time step (the result's
-        ``revision`` says which one).
+        ``revision`` says which one). ``distributions``: another point distribution per
+        direction, ``{"j": Distribution.geometric(2e-6)}`` for a new wall spacing, or
+        ``{"i": "uniform_arc_length"}`` (see :class:`Distribution`).
 
         Returns an :class:`EvaluatedGrid`, a list of :class:`EvaluatedBlock` whose arrays are
         shaped ``(nk, nj, ni, s)`` with ``dtype``.
         """
         request, out_dtype = _evaluate_request(name, level, counts, blocks, index_box,
-                                               derivatives, dtype, revision, step)
+                                               derivatives, dtype, revision, step,
+                                               distributions)
 
         def attempt(a: _Attempt) -> EvaluatedGrid:
             call = self._evaluate_grid(request, timeout=a.timeout, metadata=a.metadata)
