@@ -59,6 +59,7 @@ absl::StatusOr<MultiBlockGrid> ReadArchiveSource(const std::string& path) {
 }  // namespace
 
 absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequest* request) {
+  if (text.empty()) return absl::OkStatus();  // no distributions field: the original clustering
   v1::Distributions* distributions = request->mutable_distributions();
   for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
     const std::vector<std::string> sides = absl::StrSplit(part, absl::MaxSplits('=', 1));
