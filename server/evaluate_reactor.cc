@@ -24,6 +24,11 @@ constexpr size_t kMaxReady = 8;  // messages evaluated ahead of the network
 // millisecond: the points of a 225 x 65 grid); larger ones are long work, shared fairly.
 constexpr int64_t kMaxCheapPoints = int64_t{1} << 16;
 
+bool IsMeasuredKind(v1::Distribution::Kind kind) {
+  return kind == v1::Distribution::KIND_UNIFORM_ARC_LENGTH ||
+         kind == v1::Distribution::KIND_GEOMETRIC;
+}
+
 class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse> {
  public:
   EvaluateReactor(ServiceState* state, grpc::CallbackServerContext* context,
@@ -40,8 +45,12 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     }
     caller_ = std::move(admitted->caller);
     stream_ = std::move(admitted->slot);
-    if (absl::Status status =
-            state_->pool.TrySubmit(caller_.principal, WorkKind::kCheap, [this] { Start(); });
+    // Planning a measured distribution places every output point: long work.
+    const v1::Distributions& d = request->distributions();
+    const bool measured = IsMeasuredKind(d.i().kind()) || IsMeasuredKind(d.j().kind()) ||
+                          IsMeasuredKind(d.k().kind());
+    if (absl::Status status = state_->pool.TrySubmit(
+            caller_.principal, measured ? WorkKind::kLong : WorkKind::kCheap, [this] { Start(); });
         !status.ok()) {
       Fail(status);
     }
@@ -100,6 +109,7 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     plan.chunk_values =
         kChunkBytes / static_cast<int64_t>(float_values() ? sizeof(float) : sizeof(double));
     plan.buffer_bytes = int64_t{kMaxReady + 4} * kChunkBytes;
+    plan.cancel = cancel_;
     SG_ASSIGN_OR_RETURN(evaluation_, ops::GridEvaluation::Plan(state_->Ops(), plan));
     auto header = std::make_unique<v1::EvaluateGridResponse>();
     v1::EvaluationHeader* h = header->mutable_header();
@@ -113,8 +123,9 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     h->set_precision(float_values() ? v1::PRECISION_FLOAT : v1::PRECISION_DOUBLE);
     h->set_derivatives(request_->derivatives());
     h->set_total_points(evaluation_->total_points());
-    produce_kind_ =
-        evaluation_->total_points() <= kMaxCheapPoints ? WorkKind::kCheap : WorkKind::kLong;
+    produce_kind_ = evaluation_->total_points() <= kMaxCheapPoints && !evaluation_->pointwise()
+                        ? WorkKind::kCheap
+                        : WorkKind::kLong;
     return header;
   }
 

@@ -65,7 +65,8 @@ int64_t BlockSampling::Bytes(const Resolution& resolution, const Extents& extent
 
 absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
                                                     const PointDistribution& distribution,
-                                                    const Resolution& resolution) {
+                                                    const Resolution& resolution,
+                                                    const CancelCheck& cancel) {
   BlockSampling sampling;
   SG_ASSIGN_OR_RETURN(sampling.extents_, SampleExtents(distribution, resolution));
   int d = -1;
@@ -89,6 +90,7 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
   sampling.line_params_.resize(NumPoints(n));
   for (int c = 0; c < n[e2]; ++c) {
     for (int a = 0; a < n[e1]; ++a) {
+      SG_RETURN_IF_ERROR(PollCancel(cancel));
       Point3 fixed = {0.0, 0.0, 0.0};
       fixed[e1] = sampling.params_[e1][a];
       fixed[e2] = sampling.params_[e2][c];

@@ -63,10 +63,11 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
       context.budget.Reserve(work_bytes + param_bytes + request.buffer_bytes, "the evaluation"));
   for (const EvaluatedBlock& block : plan->blocks_) {
     const FittedBlock& fitted = rev.blocks[block.block].fitted;
-    SG_ASSIGN_OR_RETURN(
-        plan->samplings_.emplace_back(),
-        BlockSampling::Create(fitted.spline, fitted.distribution, request.resolution), "block ",
-        block.block, ": ");
+    SG_ASSIGN_OR_RETURN(plan->samplings_.emplace_back(),
+                        BlockSampling::Create(fitted.spline, fitted.distribution,
+                                              request.resolution, request.cancel),
+                        "block ", block.block, ": ");
+    plan->pointwise_ |= plan->samplings_.back().measured_direction() >= 0;
   }
   plan->derivatives_ = request.derivatives;
   plan->spatial_dim_ = s;

@@ -31,6 +31,7 @@ struct GridEvaluationRequest {
   // with the evaluator's.
   int64_t chunk_values = 1;
   int64_t buffer_bytes = 0;
+  CancelCheck cancel;  // polled while a measured distribution is placed
 };
 
 struct EvaluatedBlock {
@@ -49,9 +50,10 @@ struct EvaluationChunk {
 class GridEvaluation {
  public:
   // Resolves the revision, checks the blocks (in range, each once), the output size against
-  // max_points and reserves the memory, then samples the parameters. Errors: NOT_FOUND (grid,
-  // revision, step), INVALID_ARGUMENT naming the field and value, OUT_OF_RANGE over
-  // max_points, RESOURCE_EXHAUSTED from the memory budget.
+  // max_points and reserves the memory, then samples the parameters (O(points) for a measured
+  // distribution: plan it as long work). Errors: NOT_FOUND (grid, revision, step),
+  // INVALID_ARGUMENT naming the field and value, OUT_OF_RANGE over max_points,
+  // RESOURCE_EXHAUSTED from the memory budget, CANCELLED.
   static absl::StatusOr<std::unique_ptr<GridEvaluation>> Plan(const OpsContext& context,
                                                               const GridEvaluationRequest& request);
 
@@ -59,6 +61,9 @@ class GridEvaluation {
   int spatial_dim() const { return spatial_dim_; }
   int num_fields() const { return derivatives_ ? 4 : 1; }
   int64_t total_points() const { return total_points_; }
+  // Whether some block has a measured distribution (block_sampling.h): its points are placed
+  // and evaluated one by one, about 100x the cost of a tensor grid's.
+  bool pointwise() const { return pointwise_; }
   const std::vector<EvaluatedBlock>& blocks() const { return blocks_; }
 
   bool done() const { return cursor_ == blocks_.size(); }
@@ -77,6 +82,7 @@ class GridEvaluation {
   bool derivatives_ = false;
   int spatial_dim_ = 0;
   int64_t total_points_ = 0;
+  bool pointwise_ = false;
   int64_t chunk_points_ = 1;
   std::vector<EvaluatedBlock> blocks_;
   std::vector<BlockSampling> samplings_;  // per entry of blocks_

@@ -213,6 +213,13 @@ TEST(BlockSamplingTest, RefusalsNameTheField) {
   Resolution stray_end = Counts(9, 12);
   stray_end.distributions[2] = {Distribution::Kind::kUniformParameter, 0.0, true};
   EXPECT_THAT(error(stray_end), HasSubstr("distributions.k.from_end is only for"));
+  // A cancelled caller stops the placement; a tensor sampling has nothing to cancel.
+  Resolution measured = Counts(9, 12);
+  measured.distributions[1] = {Distribution::Kind::kUniformArcLength};
+  const CancelCheck cancelled = [] { return true; };
+  EXPECT_EQ(BlockSampling::Create(spline, distribution, measured, cancelled).status().code(),
+            absl::StatusCode::kCancelled);
+  EXPECT_TRUE(BlockSampling::Create(spline, distribution, Counts(9, 12), cancelled).ok());
   // SampleParameters alone cannot place a measured direction.
   EXPECT_THAT(SampleParameters(distribution, two).status().ToString(), HasSubstr("are both"));
   Resolution one = Counts(9, 12);
