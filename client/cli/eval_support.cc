@@ -5,6 +5,8 @@
 #include <cerrno>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <string>
 #include <vector>
 
 #include "absl/cleanup/cleanup.h"
@@ -61,6 +63,7 @@ absl::StatusOr<MultiBlockGrid> ReadArchiveSource(const std::string& path) {
 absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequest* request) {
   if (text.empty()) return absl::OkStatus();  // no distributions field: the original clustering
   v1::Distributions* distributions = request->mutable_distributions();
+  std::set<std::string> seen;
   for (absl::string_view part : absl::StrSplit(text, ',', absl::SkipEmpty())) {
     const std::vector<std::string> sides = absl::StrSplit(part, absl::MaxSplits('=', 1));
     v1::Distribution* out = nullptr;
@@ -70,6 +73,10 @@ absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequ
     if (out == nullptr) {
       return absl::InvalidArgumentError(
           absl::StrCat("--dist: '", part, "' is not DIR=KIND with DIR i, j or k"));
+    }
+    if (!seen.insert(sides[0]).second) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--dist: direction ", sides[0], " is given twice"));
     }
     const std::vector<std::string> kind = absl::StrSplit(sides[1], ':');
     if (kind.size() == 1 && kind[0] == "original") {
@@ -112,8 +119,12 @@ absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& 
   options.quality = absl::GetFlag(FLAGS_quality);
   options.deviation = absl::GetFlag(FLAGS_deviation);
   options.compress = absl::GetFlag(FLAGS_compress);
+  const v1::Distributions& d = request->distributions();
+  const bool redistributed = d.i().kind() != v1::Distribution::KIND_ORIGINAL ||
+                             d.j().kind() != v1::Distribution::KIND_ORIGINAL ||
+                             d.k().kind() != v1::Distribution::KIND_ORIGINAL;
   if (options.deviation && (request->has_counts() || request->refinement_level() != 0 ||
-                            request->has_index_box() || request->has_distributions())) {
+                            request->has_index_box() || redistributed)) {
     return absl::InvalidArgumentError(
         "--deviation is measured at the source points: evaluate with --level 0, no --box and "
         "no --dist");

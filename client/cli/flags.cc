@@ -72,8 +72,8 @@ ABSL_FLAG(std::string, dist, "",
           "eval: point distributions, DIR=KIND[,...] with DIR i, j or k and KIND original, "
           "parameter (uniform in the spline parameter), arclength (uniform in arc length) or "
           "geometric:FIRST[:end] (first spacing FIRST at the first index, or at the last with "
-          ":end); e.g. --dist j=geometric:2e-6 for a new wall spacing. At most one direction may "
-          "be arclength or geometric");
+          ":end; arc length along each grid line); e.g. --dist j=geometric:2e-6 for a new wall "
+          "spacing. At most one direction may be arclength or geometric; -o .cgns refuses it");
 ABSL_FLAG(std::string, o, "",
           "eval/offset: output file (.vts, .vtm, .x binary or .xyz text Plot3D, .cgns; eval: "
           ".pvd series); curvature: .csv; export: the archive (.sgrid)");

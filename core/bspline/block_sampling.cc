@@ -57,8 +57,9 @@ std::vector<double> TargetLengths(const Distribution& distribution, double lengt
 
 int64_t BlockSampling::Bytes(const Resolution& resolution, const Extents& extents) {
   int64_t values = int64_t{extents[0]} + extents[1] + extents[2];
-  for (const Distribution& d : resolution.distributions) {
-    if (IsMeasured(d.kind)) values += NumPoints(extents);
+  for (int d = 0; d < 3; ++d) {
+    // The parameters of every line, and one line's target lengths (twice, mirrored).
+    if (IsMeasured(resolution.distributions[d].kind)) values += NumPoints(extents) + 2 * extents[d];
   }
   return values * int64_t{sizeof(double)};
 }
@@ -88,6 +89,11 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
   const Extents& n = sampling.extents_;
   const auto [e1, e2] = Others(d);
   sampling.line_params_.resize(NumPoints(n));
+  // A line shorter than this is a collapsed edge: its length is rounding (the derivative
+  // weights of equal control points cancel only in exact arithmetic).
+  double scale = 0.0;
+  for (double x : spline.control()) scale = std::max(scale, std::abs(x));
+  const double negligible = 1e-12 * scale;
   for (int c = 0; c < n[e2]; ++c) {
     for (int a = 0; a < n[e1]; ++a) {
       SG_RETURN_IF_ERROR(PollCancel(cancel));
@@ -100,7 +106,7 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
       };
       const LineArcLength line(spline, d, fixed, t0, t1);
       double* t = sampling.line_params_.data() + (int64_t{a} + int64_t{n[e1]} * c) * n[d];
-      if (line.length() == 0.0) {
+      if (line.length() <= negligible) {
         const std::vector<double> even = UniformParameters(t0, t1, n[d]);
         std::copy(even.begin(), even.end(), t);
         continue;
@@ -113,8 +119,8 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
       }
       const std::vector<double> s = TargetLengths(wanted, line.length(), n[d]);
       for (int q = 0; q < n[d]; ++q) t[q] = line.ParameterAt(s[q]);
-      t[0] = t0;
-      t[n[d] - 1] = t1;
+      t[0] = t0;  // a single point sits at the first index, as in the other distributions
+      if (n[d] > 1) t[n[d] - 1] = t1;
       for (int q = 1; q < n[d]; ++q) {
         if (!(t[q] > t[q - 1])) {
           return absl::InvalidArgumentError(

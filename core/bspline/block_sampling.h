@@ -24,8 +24,9 @@ class BlockSampling {
   // The parameters of `resolution` on the block (`spline`, `distribution`). Errors: those of
   // SampleExtents, and INVALID_ARGUMENT when a geometric first spacing is not below the length
   // of a grid line (naming the line), or a distribution's spacings fall below what double
-  // precision separates on a line. A line of zero length (a collapsed edge) gets evenly spaced
-  // parameters: all its points coincide whatever the distribution. A measured direction costs
+  // precision separates on a line. A line of negligible length (under 1e-12 of the largest
+  // control coordinate: a collapsed edge) gets evenly spaced parameters: all its points
+  // coincide whatever the distribution. A measured direction costs
   // about 0.1-0.2 us per point; `cancel` is polled once per grid line (CANCELLED).
   static absl::StatusOr<BlockSampling> Create(const TensorSpline& spline,
                                               const PointDistribution& distribution,

@@ -170,7 +170,7 @@ double LineArcLength::ParameterAt(double s) const {
   for (int iteration = 0; iteration < 100 && std::abs(g) > g_floor; ++iteration) {
     (g > 0.0 ? hi : lo) = t;
     const double speed = Speed(interval, t);
-    double next = speed > 0.0 ? t - g / speed : lo;
+    double next = speed > 0.0 ? t - g / speed : 0.5 * (lo + hi);
     if (!(next >= lo && next <= hi)) next = 0.5 * (lo + hi);
     const double step = next - t;
     if (std::abs(step) <= kUlps * std::abs(t) || !(hi > lo)) return next;

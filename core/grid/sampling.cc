@@ -34,6 +34,19 @@ std::string DistributionField(int d, absl::string_view member = "") {
                       member);
 }
 
+// OUT_OF_RANGE when the points of `extents` (each at most 2^30) exceed 2^40 in all: no output
+// that large fits any budget, and the product of three counts could overflow an int64.
+absl::Status CheckTotal(const Extents& extents, absl::string_view field) {
+  constexpr int64_t kMax = int64_t{1} << 40;
+  const int64_t plane = int64_t{extents[0]} * extents[1];  // below 2^60
+  if (plane > kMax || extents[2] > kMax / plane) {
+    return absl::OutOfRangeError(absl::StrCat(field, " gives ", extents[0], " x ", extents[1],
+                                              " x ", extents[2],
+                                              " points, over 2^40 in one block"));
+  }
+  return absl::OkStatus();
+}
+
 // The distributions can be followed with these point counts (see SampleExtents).
 absl::Status CheckDistributions(const std::array<Distribution, 3>& distributions,
                                 const Extents& extents) {
@@ -105,6 +118,7 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
       }
       extents[d] = static_cast<int>(n);
     }
+    SG_RETURN_IF_ERROR(CheckTotal(extents, absl::StrCat("refinement_level = ", resolution.level)));
     SG_RETURN_IF_ERROR(CheckDistributions(resolution.distributions, extents));
     return extents;
   }
@@ -125,6 +139,7 @@ absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
     }
     extents[d] = n;
   }
+  SG_RETURN_IF_ERROR(CheckTotal(extents, "counts"));
   SG_RETURN_IF_ERROR(CheckDistributions(resolution.distributions, extents));
   return extents;
 }

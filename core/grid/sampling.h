@@ -63,8 +63,8 @@ inline constexpr int kMaxRefinementLevel = 20;
 // The point counts that `resolution` gives on a block with `distribution`, without building
 // the parameters (for size checks). Errors, naming the field and value: INVALID_ARGUMENT for a
 // negative level, counts below 1, a box outside the block or with end < begin, counts above 1
-// in a direction with one original point; OUT_OF_RANGE for a level above kMaxRefinementLevel or
-// more than 2^30 points in a direction; INVALID_ARGUMENT for a distribution that cannot be
+// in a direction with one original point; OUT_OF_RANGE for a level above kMaxRefinementLevel,
+// more than 2^30 points in a direction or 2^40 in all; INVALID_ARGUMENT for a distribution that cannot be
 // followed (two measured directions, a geometric one with fewer than 3 points or a first
 // spacing that is not positive and finite, a first_spacing or from_end on another kind).
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,

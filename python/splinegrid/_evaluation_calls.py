@@ -137,7 +137,9 @@ class _EvaluationCalls(_Calls):
         ``revision``, the latest revision stamped with this solver time step (the result's
         ``revision`` says which one). ``distributions``: another point distribution per
         direction, ``{"j": Distribution.geometric(2e-6)}`` for a new wall spacing, or
-        ``{"i": "uniform_arc_length"}`` (see :class:`Distribution`).
+        ``{"i": "uniform_arc_length"}`` (see :class:`Distribution`; the ends stay those of the
+        block or ``index_box``; with float32 a first spacing under about 1e-7 of the
+        coordinates is lost in transfer).
 
         Returns an :class:`EvaluatedGrid`, a list of :class:`EvaluatedBlock` whose arrays are
         shaped ``(nk, nj, ni, s)`` with ``dtype``.

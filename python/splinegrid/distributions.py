@@ -1,6 +1,6 @@
 """Point distributions on demand for :meth:`Client.evaluate`: per direction, how the points
 between the block's (or box's) first and last index are spread. The count still comes from
-``level`` or ``counts``; the end points are always the block's own."""
+``level`` or ``counts``; the end points are always those of the block (or ``index_box``)."""
 
 from __future__ import annotations
 

@@ -44,16 +44,19 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
     const FittedBlock& fitted = rev.blocks[b].fitted;
     SG_ASSIGN_OR_RETURN(const Extents extents,
                         SampleExtents(fitted.distribution, request.resolution), "block ", b, ": ");
-    total += NumPoints(extents);
+    total += NumPoints(extents);  // each at most 2^40 (SampleExtents): no overflow
     if (total > request.max_points) {
       return absl::OutOfRangeError(absl::StrCat("the requested resolution gives over ", total,
                                                 " points, more than the server's cap of ",
                                                 request.max_points, " (flag --max_output_points)"));
     }
     // The evaluator's intermediate nets: n_u' x n_v x n_w, and planes of n_u' x n_v.
+    // Measured blocks are evaluated point by point, without them.
     const Extents n = fitted.spline.control_extents();
     const int64_t net = int64_t{s} * extents[0] * n[1] * (n[2] + 3) * sizeof(double);
-    work_bytes = std::max(work_bytes, net * (request.derivatives ? 2 : 1));
+    bool measured = false;
+    for (const Distribution& d : request.resolution.distributions) measured |= IsMeasured(d.kind);
+    if (!measured) work_bytes = std::max(work_bytes, net * (request.derivatives ? 2 : 1));
     plan->blocks_.push_back({b, extents});
     param_bytes += BlockSampling::Bytes(request.resolution, extents);
   }

@@ -43,6 +43,7 @@ TEST(DistFlagTest, WhatIsNotUnderstoodIsNamed) {
   EXPECT_THAT(error("j=tanh"), HasSubstr("'tanh' in 'j=tanh' is not original, parameter"));
   EXPECT_THAT(error("j=geometric"), HasSubstr("is not original, parameter"));
   EXPECT_THAT(error("j=geometric:abc"), HasSubstr("'abc' in 'j=geometric:abc' is not a number"));
+  EXPECT_THAT(error("j=arclength,j=geometric:1e-5"), HasSubstr("direction j is given twice"));
   EXPECT_THAT(error("j=geometric:1e-5:start"),
               HasSubstr("'start' in 'j=geometric:1e-5:start' is not 'end'"));
 }

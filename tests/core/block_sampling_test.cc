@@ -117,6 +117,81 @@ TEST(BlockSamplingTest, GeometricFirstSpacingOnEveryLineAndConstantRatio) {
   }
 }
 
+// The annulus extruded along z with uneven heights: the k-lines are straight and vertical.
+TensorSpline Extruded() {
+  const TensorSpline base = Annulus();
+  const std::vector<double> heights = {0.0, 0.05, 0.3, 1.0, 4.0};
+  std::vector<double> control;
+  for (double z : heights) {
+    for (size_t p = 0; p < base.control().size(); p += 2) {
+      control.insert(control.end(), {base.control()[p], base.control()[p + 1], z});
+    }
+  }
+  return TensorSpline::Create({base.knots(0), base.knots(1), Clamped(4, 5)}, 3, control).value();
+}
+
+TEST(BlockSamplingTest, VolumeMeasuredInKFromTheEndAndEvaluatedPointByPoint) {
+  const TensorSpline spline = Extruded();
+  std::array<std::vector<double>, 3> params = {std::vector<double>(9), std::vector<double>(12),
+                                               std::vector<double>(7)};
+  for (int d = 0; d < 3; ++d) {
+    for (size_t q = 0; q < params[d].size(); ++q) params[d][q] = q / (params[d].size() - 1.0);
+  }
+  const PointDistribution distribution = PointDistribution::Create(params).value();
+  Resolution resolution;
+  resolution.kind = Resolution::Kind::kCounts;
+  resolution.counts = {5, 4, 30};
+  resolution.distributions[2] = {Distribution::Kind::kGeometric, 1e-3, /*from_end=*/true};
+  const BlockSampling sampling = BlockSampling::Create(spline, distribution, resolution).value();
+  EXPECT_EQ(sampling.measured_direction(), 2);
+  const int64_t n = NumPoints(sampling.extents());
+  std::vector<double> x(3 * n), du(3 * n), dv(3 * n), dw(3 * n);
+  EvaluateSampledPoints(spline, sampling, 0, n, x.data(), du.data(), dv.data(), dw.data());
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      // Output order i fastest, then j, then k; the last interval of every k-line is 1e-3.
+      const auto at = [&](int k) { return 3 * (i + 5 * (j + int64_t{4} * k)); };
+      EXPECT_NEAR(x[at(29) + 2] - x[at(28) + 2], 1e-3, 1e-12) << i << ", " << j;
+      EXPECT_EQ(x[at(0) + 2], 0.0);
+      EXPECT_NEAR(x[at(29) + 2], 4.0, 1e-14);
+      for (int k = 0; k < 30; k += 7) {
+        const PartialDerivatives d = EvaluateDerivatives(spline, sampling.ParametersAt(i, j, k), 1);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(x[at(k) + c], d(0, 0, 0)[c]);
+          EXPECT_EQ(dw[at(k) + c], d(0, 0, 1)[c]);
+        }
+      }
+    }
+  }
+}
+
+TEST(BlockSamplingTest, OnePointSitsAtTheFirstIndexAndACollapsedLineIsKept) {
+  const TensorSpline spline = Annulus();
+  const PointDistribution distribution = EvenDistribution(9, 12);
+  Resolution one = Counts(9, 1);
+  one.distributions[1] = {Distribution::Kind::kUniformArcLength};
+  const BlockSampling first = BlockSampling::Create(spline, distribution, one).value();
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(first.ParametersAt(i, 0, 0)[1], 0.0);
+
+  // A pole: every control of the column a = 0 at one point (up to rounding, as a fit leaves
+  // it). Its j-line is shorter than any first spacing, and is kept, not refused.
+  std::vector<double> control(spline.control().begin(), spline.control().end());
+  for (int b = 0; b < 6; ++b) {
+    control[2 * 7 * b] = 0.5 + (b % 2) * 1e-16;
+    control[2 * 7 * b + 1] = 0.25;
+  }
+  const TensorSpline pole = TensorSpline::Create(spline.all_knots(), 2, control).value();
+  Resolution resolution = Counts(9, 20);
+  resolution.distributions[1] = {Distribution::Kind::kGeometric, 1e-4};
+  const auto sampling = BlockSampling::Create(pole, distribution, resolution);
+  ASSERT_TRUE(sampling.ok()) << sampling.status();
+  for (int j = 0; j < 20; ++j) {
+    const Point3 x = EvaluatePoint(pole, sampling->ParametersAt(0, j, 0));
+    EXPECT_NEAR(x[0], 0.5, 1e-15);
+    EXPECT_NEAR(x[1], 0.25, 1e-15);
+  }
+}
+
 TEST(BlockSamplingTest, UniformArcLengthAlongCurvedLines) {
   const TensorSpline spline = Annulus();
   const PointDistribution distribution = EvenDistribution(9, 12);
@@ -201,8 +276,19 @@ TEST(BlockSamplingTest, RefusalsNameTheField) {
   for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
     Resolution spacing = Counts(9, 12);
     spacing.distributions[1] = {Distribution::Kind::kGeometric, bad};
+    EXPECT_THAT(error(spacing), HasSubstr("is not a positive finite length"));
     EXPECT_THAT(error(spacing), HasSubstr("distributions.j.first_spacing = "));
   }
+  // Counts whose product would overflow are refused before anything is sized.
+  const PointDistribution volume =
+      PointDistribution::Create({std::vector<double>{0.0, 1.0}, std::vector<double>{0.0, 1.0},
+                                 std::vector<double>{0.0, 1.0}})
+          .value();
+  Resolution huge;
+  huge.kind = Resolution::Kind::kCounts;
+  huge.counts = {1 << 16, 1 << 24, 1 << 24};
+  EXPECT_EQ(SampleExtents(volume, huge).status().code(), absl::StatusCode::kOutOfRange);
+  EXPECT_THAT(SampleExtents(volume, huge).status().message(), HasSubstr("over 2^40"));
   Resolution long_first = Counts(9, 12);
   long_first.distributions[1] = {Distribution::Kind::kGeometric, 50.0};
   EXPECT_THAT(error(long_first), HasSubstr("is not below the length"));

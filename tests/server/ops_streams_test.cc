@@ -191,13 +191,20 @@ TEST_F(OpsStreamsTest, NewWallSpacingKeepsTheWallExactlyAndFoldsNoCell) {
     EXPECT_EQ(folded_before, 0) << "level " << level;
     EXPECT_EQ(folded, 0) << "level " << level;
   }
-  // Uniform arc length along the C (an isotropic spacing for an Euler grid): no fold either.
+  // Uniform arc length along the C (an isotropic spacing for an Euler grid): even chords along
+  // the wall line (to the chord/arc difference) and no fold.
   ops::GridEvaluationRequest request = Evaluation(1);
   request.resolution.distributions[0] = {Distribution::Kind::kUniformArcLength};
   auto plan = ops::GridEvaluation::Plan(ops_, request);
   ASSERT_TRUE(plan.ok()) << plan.status();
   const std::vector<double> x = Drain(**plan);
   const Extents n = (*plan)->blocks()[0].extents;
+  std::vector<double> chords;
+  for (int i = 1; i < n[0]; ++i) {
+    chords.push_back(std::hypot(x[2 * i] - x[2 * i - 2], x[2 * i + 1] - x[2 * i - 1]));
+  }
+  const auto [shortest, longest] = std::minmax_element(chords.begin(), chords.end());
+  EXPECT_GT(*shortest / *longest, 0.95);
   const double sign = CellArea(x, n[0], n[0] / 2, 0) > 0 ? 1.0 : -1.0;
   int folded = 0;
   for (int j = 0; j + 1 < n[1]; ++j) {
@@ -235,12 +242,18 @@ TEST_F(OpsStreamsTest, GridEvaluationRefusesNamingTheFieldAndReservesItsMemory) 
     EXPECT_GT(budget_.used(), before + (1 << 20));
   }
   EXPECT_EQ(budget_.used(), before);
-  request = Evaluation(20);
+  request = Evaluation(13);  // 1.8M x 0.5M points: nets of gigabytes
   request.max_points = int64_t{1} << 62;
   request.derivatives = false;
   request.blocks = {0};
   EXPECT_EQ(ops::GridEvaluation::Plan(ops_, request).status().code(),
             absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(budget_.used(), before);
+  // Beyond 2^40 points in a block nothing is sized at all.
+  request = Evaluation(20);
+  request.max_points = int64_t{1} << 62;
+  EXPECT_THAT(ops::GridEvaluation::Plan(ops_, request).status().message(),
+              HasSubstr("points, over 2^40 in one block"));
   EXPECT_EQ(budget_.used(), before);
 }
 
