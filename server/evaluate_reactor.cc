@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 
+#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 #include "proto/convert/convert.h"
 #include "server/happens_before.h"
@@ -23,11 +24,6 @@ constexpr size_t kMaxReady = 8;  // messages evaluated ahead of the network
 // Evaluations of at most this many points in all are cheap work for the scheduler (about a
 // millisecond: the points of a 225 x 65 grid); larger ones are long work, shared fairly.
 constexpr int64_t kMaxCheapPoints = int64_t{1} << 16;
-
-bool IsMeasuredKind(v1::Distribution::Kind kind) {
-  return kind == v1::Distribution::KIND_UNIFORM_ARC_LENGTH ||
-         kind == v1::Distribution::KIND_GEOMETRIC;
-}
 
 class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse> {
  public:
@@ -46,9 +42,9 @@ class EvaluateReactor : public grpc::ServerWriteReactor<v1::EvaluateGridResponse
     caller_ = std::move(admitted->caller);
     stream_ = std::move(admitted->slot);
     // Planning a measured distribution places every output point: long work.
-    const v1::Distributions& d = request->distributions();
-    const bool measured = IsMeasuredKind(d.i().kind()) || IsMeasuredKind(d.j().kind()) ||
-                          IsMeasuredKind(d.k().kind());
+    // (A resolution that does not parse is refused by Start, cheaply.)
+    const absl::StatusOr<Resolution> resolution = ParseResolution(*request);
+    const bool measured = resolution.ok() && MeasuredDirection(*resolution) >= 0;
     if (absl::Status status = state_->pool.TrySubmit(
             caller_.principal, measured ? WorkKind::kLong : WorkKind::kCheap, [this] { Start(); });
         !status.ok()) {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "client/cli/eval_support.h"
 #include "core/util/status_macros.h"
 #include "io/cgns/cgns_io.h"
 #include "proto/convert/archive_convert.h"
@@ -28,14 +29,11 @@ absl::StatusOr<CgnsOutputContext> FetchCgnsOutputContext(client::Client& client,
     return absl::InvalidArgumentError(
         "-o *.cgns holds grid points only: --derivs has no place in it (write .vts/.vtm)");
   }
-  for (const v1::Distribution* d :
-       {&request.distributions().i(), &request.distributions().j(), &request.distributions().k()}) {
-    if (d->kind() != v1::Distribution::KIND_ORIGINAL) {
-      return absl::InvalidArgumentError(
-          "-o *.cgns maps boundary conditions and connectivity by index at the original "
-          "clustering; --dist moves points along block interfaces differently in each block: "
-          "write .vts/.vtm/.x instead");
-    }
+  if (Redistributes(request)) {
+    return absl::InvalidArgumentError(
+        "-o *.cgns maps boundary conditions and connectivity by index at the original "
+        "clustering; --dist moves points along block interfaces differently in each block: "
+        "write .vts/.vtm/.x instead");
   }
   if (request.refinement_level() > 20) {
     return absl::InvalidArgumentError(

@@ -107,6 +107,13 @@ absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequ
   return absl::OkStatus();
 }
 
+bool Redistributes(const v1::EvaluateGridRequest& request) {
+  const v1::Distributions& d = request.distributions();
+  return d.i().kind() != v1::Distribution::KIND_ORIGINAL ||
+         d.j().kind() != v1::Distribution::KIND_ORIGINAL ||
+         d.k().kind() != v1::Distribution::KIND_ORIGINAL;
+}
+
 bool IsSeriesPath(const std::string& out) {
   return std::filesystem::path(out).extension() == ".pvd";
 }
@@ -119,12 +126,8 @@ absl::StatusOr<EvalOutputOptions> EvalOutputOptionsFromFlags(const std::string& 
   options.quality = absl::GetFlag(FLAGS_quality);
   options.deviation = absl::GetFlag(FLAGS_deviation);
   options.compress = absl::GetFlag(FLAGS_compress);
-  const v1::Distributions& d = request->distributions();
-  const bool redistributed = d.i().kind() != v1::Distribution::KIND_ORIGINAL ||
-                             d.j().kind() != v1::Distribution::KIND_ORIGINAL ||
-                             d.k().kind() != v1::Distribution::KIND_ORIGINAL;
   if (options.deviation && (request->has_counts() || request->refinement_level() != 0 ||
-                            request->has_index_box() || redistributed)) {
+                            request->has_index_box() || Redistributes(*request))) {
     return absl::InvalidArgumentError(
         "--deviation is measured at the source points: evaluate with --level 0, no --box and "
         "no --dist");

@@ -21,6 +21,10 @@ bool IsSeriesPath(const std::string& out);
 // spacings against the lines' lengths).
 absl::Status ParseDistributionFlag(const std::string& text, v1::EvaluateGridRequest* request);
 
+// Whether `request` asks for another distribution than the original clustering in some
+// direction (--dist with a kind other than original).
+bool Redistributes(const v1::EvaluateGridRequest& request);
+
 // The output options of --derivs, --jacobian, --quality, --deviation and --compress; sets
 // request->derivatives when the derivatives or the Jacobian need them. INVALID_ARGUMENT, before
 // any call, for VTK fields or an explicit --compress/--nocompress with a file that is not VTK,

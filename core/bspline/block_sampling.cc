@@ -57,10 +57,9 @@ std::vector<double> TargetLengths(const Distribution& distribution, double lengt
 
 int64_t BlockSampling::Bytes(const Resolution& resolution, const Extents& extents) {
   int64_t values = int64_t{extents[0]} + extents[1] + extents[2];
-  for (int d = 0; d < 3; ++d) {
-    // The parameters of every line, and one line's target lengths (twice, mirrored).
-    if (IsMeasured(resolution.distributions[d].kind)) values += NumPoints(extents) + 2 * extents[d];
-  }
+  // The parameters of every line, and one line's target lengths (twice, mirrored).
+  const int d = MeasuredDirection(resolution);
+  if (d >= 0) values += NumPoints(extents) + 2 * extents[d];
   return values * int64_t{sizeof(double)};
 }
 
@@ -70,10 +69,7 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
                                                     const CancelCheck& cancel) {
   BlockSampling sampling;
   SG_ASSIGN_OR_RETURN(sampling.extents_, SampleExtents(distribution, resolution));
-  int d = -1;
-  for (int e = 0; e < 3; ++e) {
-    if (IsMeasured(resolution.distributions[e].kind)) d = e;
-  }
+  const int d = MeasuredDirection(resolution);
   // The tensor directions (the measured one sampled evenly in parameter, then dropped).
   Resolution tensor = resolution;
   if (d >= 0) tensor.distributions[d] = {Distribution::Kind::kUniformParameter};

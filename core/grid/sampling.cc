@@ -88,6 +88,13 @@ absl::Status CheckDistributions(const std::array<Distribution, 3>& distributions
 
 }  // namespace
 
+int MeasuredDirection(const Resolution& resolution) {
+  for (int d = 0; d < 3; ++d) {
+    if (IsMeasured(resolution.distributions[d].kind)) return d;
+  }
+  return -1;
+}
+
 std::vector<double> UniformParameters(double begin, double end, int count) {
   std::vector<double> out(count, begin);
   for (int q = 1; q < count; ++q) out[q] = begin + (end - begin) * q / (count - 1);

@@ -57,6 +57,10 @@ struct Resolution {
   std::array<Distribution, 3> distributions;
 };
 
+// The direction of `resolution` with a measured distribution, or -1 (SampleExtents refuses
+// more than one).
+int MeasuredDirection(const Resolution& resolution);
+
 // Highest refinement level accepted (2^20 points per original interval is already absurd).
 inline constexpr int kMaxRefinementLevel = 20;
 
@@ -64,8 +68,8 @@ inline constexpr int kMaxRefinementLevel = 20;
 // the parameters (for size checks). Errors, naming the field and value: INVALID_ARGUMENT for a
 // negative level, counts below 1, a box outside the block or with end < begin, counts above 1
 // in a direction with one original point; OUT_OF_RANGE for a level above kMaxRefinementLevel,
-// more than 2^30 points in a direction or 2^40 in all; INVALID_ARGUMENT for a distribution that cannot be
-// followed (two measured directions, a geometric one with fewer than 3 points or a first
+// more than 2^30 points in a direction or 2^40 in all; INVALID_ARGUMENT for a distribution that
+// cannot be followed (two measured directions, a geometric one with fewer than 3 points or a first
 // spacing that is not positive and finite, a first_spacing or from_end on another kind).
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
                                       const Resolution& resolution);

@@ -30,6 +30,7 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
   const int s = rev.blocks.front().fitted.spline.spatial_dim();
   int64_t total = 0, work_bytes = 0, param_bytes = 0;
   std::vector<bool> seen(num_blocks, false);
+  const bool measured = MeasuredDirection(request.resolution) >= 0;
   for (size_t q = 0; q < blocks.size(); ++q) {
     const int b = blocks[q];
     if (b < 0 || b >= num_blocks) {
@@ -54,8 +55,6 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
     // Measured blocks are evaluated point by point, without them.
     const Extents n = fitted.spline.control_extents();
     const int64_t net = int64_t{s} * extents[0] * n[1] * (n[2] + 3) * sizeof(double);
-    bool measured = false;
-    for (const Distribution& d : request.resolution.distributions) measured |= IsMeasured(d.kind);
     if (!measured) work_bytes = std::max(work_bytes, net * (request.derivatives ? 2 : 1));
     plan->blocks_.push_back({b, extents});
     param_bytes += BlockSampling::Bytes(request.resolution, extents);
@@ -70,13 +69,17 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
                         BlockSampling::Create(fitted.spline, fitted.distribution,
                                               request.resolution, request.cancel),
                         "block ", block.block, ": ");
-    plan->pointwise_ |= plan->samplings_.back().measured_direction() >= 0;
   }
   plan->derivatives_ = request.derivatives;
   plan->spatial_dim_ = s;
   plan->total_points_ = total;
   plan->chunk_points_ = std::max<int64_t>(1, request.chunk_values / s);
   return plan;
+}
+
+bool GridEvaluation::pointwise() const {
+  return std::any_of(samplings_.begin(), samplings_.end(),
+                     [](const BlockSampling& s) { return s.measured_direction() >= 0; });
 }
 
 EvaluationChunk GridEvaluation::Next() {

@@ -63,7 +63,7 @@ class GridEvaluation {
   int64_t total_points() const { return total_points_; }
   // Whether some block has a measured distribution (block_sampling.h): its points are placed
   // and evaluated one by one, about 100x the cost of a tensor grid's.
-  bool pointwise() const { return pointwise_; }
+  bool pointwise() const;
   const std::vector<EvaluatedBlock>& blocks() const { return blocks_; }
 
   bool done() const { return cursor_ == blocks_.size(); }
@@ -82,7 +82,6 @@ class GridEvaluation {
   bool derivatives_ = false;
   int spatial_dim_ = 0;
   int64_t total_points_ = 0;
-  bool pointwise_ = false;
   int64_t chunk_points_ = 1;
   std::vector<EvaluatedBlock> blocks_;
   std::vector<BlockSampling> samplings_;  // per entry of blocks_
