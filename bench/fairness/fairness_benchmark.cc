@@ -413,7 +413,7 @@ void SoakClient(const Server& server, int index, absl::Time end, const std::stri
         generate.set_airfoil_file(airfoil);
         generate.set_wall_points(129);
         generate.set_layers(32);
-        generate.set_allow_folds(true);  // the interpolated O-grid folds at its seam (issue 16)
+        generate.set_allow_folds(true);  // it folds beside the NACA 0012's blunt base's corners
         timed("GenerateGrid", [&] { return client->Generate(generate).status(); });
         timed("DeleteGrid", [&] { return client->Delete(own + "-gen"); });
         break;

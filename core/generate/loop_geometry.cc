@@ -34,6 +34,23 @@ std::vector<Point2> LoopNormals(const std::vector<Point2>& p, double orientation
   return normals;
 }
 
+Point2 CornerBisector(const std::vector<Point2>& p, int i, double orientation) {
+  const int n = static_cast<int>(p.size());
+  const int prev = i == 0 ? n - 2 : i - 1;
+  const int next = i == n - 1 ? 1 : i + 1;
+  auto unit = [](const Point2& from, const Point2& to) {
+    const double dx = to[0] - from[0], dy = to[1] - from[1], len = std::hypot(dx, dy);
+    return len > 0.0 ? Point2{dx / len, dy / len} : Point2{0.0, 0.0};
+  };
+  const Point2 a = unit(p[prev], p[i]), b = unit(p[i], p[next]);
+  // The sum of the sides' unit normals; at a cusp (sides reversed) it vanishes and the
+  // bisector continues the arriving side.
+  Point2 m = {orientation * (a[1] + b[1]), -orientation * (a[0] + b[0])};
+  if (std::hypot(m[0], m[1]) < 1e-9) m = {a[0] - b[0], a[1] - b[1]};
+  const double len = std::hypot(m[0], m[1]);
+  return len > 0.0 ? Point2{m[0] / len, m[1] / len} : Point2{0.0, 0.0};
+}
+
 double TurningDegrees(const std::vector<Point2>& p, int i) {
   const int n = static_cast<int>(p.size());
   const int prev = i == 0 ? n - 2 : i - 1;

@@ -14,8 +14,8 @@
 //    until it does not, so no layer intersects itself;
 //  - normals are smoothed more the farther the layer (normal_smoothing sweeps times the
 //    fraction of the layers done), and the fairing weight grows the same way, so the far field
-//    rounds out; a corner stays a corner (its normal the bisector, the refit split there) while
-//    the layer turns there by 15 degrees or more, then it is smoothed like any point;
+//    rounds out; a corner stays a corner (its normal the bisector, CornerBisector, the refit split
+//    there) while the layer turns there by 15 degrees or more, then it is smoothed like any point;
 //  - points slide along each layer from the wall's distribution towards even spacing, layer k
 //    by uniformity / (layers - k) of the way (so that the unevenness left is the fraction of
 //    layers still to go), but no point by more than tan(a) times the step, the tilt a growing

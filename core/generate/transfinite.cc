@@ -93,8 +93,12 @@ absl::StatusOr<StructuredBlock> TransfiniteGrid(const WallLoop& wall,
   std::vector<Point2> normals = LoopNormals(w, orientation);
   for (int c : wall.corners) {
     const int at = c == n - 1 ? 0 : c;
-    // Not at a sharp trailing edge: its neighbours' lines must leave the thin wedge first.
-    if (TurningDegrees(w, at) > kMaxFanTurning) continue;
+    // Not at a sharp trailing edge: its neighbours' lines must leave the thin wedge first, and
+    // its own line, alone in the exterior angle, bisects it.
+    if (TurningDegrees(w, at) > kMaxFanTurning) {
+      normals[at] = CornerBisector(w, at, orientation);
+      continue;
+    }
     for (int side : {-1, 1}) {
       for (int q = 1; q <= kCornerFan; ++q) {
         int i = at + side * q;

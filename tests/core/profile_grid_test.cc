@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "core/generate/elliptic.h"
+#include "core/generate/loop_geometry.h"
 #include "core/generate/offset_march.h"
 #include "core/generate/transfinite.h"
 #include "core/generate/wall_loop.h"
@@ -62,6 +64,36 @@ void MeasureOrthogonalityBeyondFans(ProfileGrid* grid) {
       MeasureOGrid(grid->block, fan).wall_orthogonality_degrees;
 }
 
+// Every cell of the seam's two columns (i = 0 and i = ni - 2, either side of the line leaving
+// the trailing edge) is strictly convex: the bilinear map of the cell has a positive Jacobian at
+// all four corners, so no refinement of it folds (its Jacobian determinant is affine in each
+// parameter, hence positive inside when it is at the corners). At a sharp trailing edge the two
+// seam cells share an exterior angle of 180 degrees plus the edge's turning: a seam line off
+// its bisector by more than half the wedge leaves one of them a reflex angle there.
+void ExpectConvexSeamCells(const ProfileGrid& grid, const std::string& what) {
+  const StructuredBlock& g = grid.block;
+  const int ni = g.extent(0), nj = g.extent(1);
+  auto at = [&](int i, int j) { return Point2{g.Point(i, j, 0)[0], g.Point(i, j, 0)[1]}; };
+  auto minus = [](const Point2& a, const Point2& b) { return Point2{a[0] - b[0], a[1] - b[1]}; };
+  int non_convex = 0;
+  std::string first;
+  for (int i : {0, ni - 2}) {
+    for (int j = 0; j + 1 < nj; ++j) {
+      const Point2 x00 = at(i, j), x10 = at(i + 1, j), x01 = at(i, j + 1), x11 = at(i + 1, j + 1);
+      const double corner_jacobians[4] = {
+          Cross(minus(x10, x00), minus(x01, x00)), Cross(minus(x10, x00), minus(x11, x10)),
+          Cross(minus(x11, x01), minus(x01, x00)), Cross(minus(x11, x01), minus(x11, x10))};
+      for (double jac : corner_jacobians) {
+        if (!(jac > 0.0)) {
+          if (non_convex++ == 0) first = absl::StrCat("(", i, ", ", j, ")");
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(non_convex, 0) << what << ": first non-convex seam cell " << first;
+}
+
 class SharedAirfoilGridTest : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SharedAirfoilGridTest, OffsetsMeetTheCriteria) {
@@ -70,6 +102,7 @@ TEST_P(SharedAirfoilGridTest, OffsetsMeetTheCriteria) {
   EXPECT_EQ(grid.block.extent(0), 257);
   EXPECT_EQ(grid.block.extent(1), 129);
   ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " offsets");
+  ExpectConvexSeamCells(grid, GetParam() + " offsets");
   // The growth ratio makes the layers add up to the distance.
   EXPECT_NEAR(1e-5 * (std::pow(grid.growth_ratio, 128) - 1.0) / (grid.growth_ratio - 1.0), 50.0,
               1e-9);
@@ -83,6 +116,7 @@ TEST_P(SharedAirfoilGridTest, OffsetsOfACoarseGridCloseIn) {
   options.distance = 5.0;
   const ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
   ExpectGoodGrid(grid, 1e-4, 5.0, GetParam() + " coarse offsets");
+  ExpectConvexSeamCells(grid, GetParam() + " coarse offsets");
 }
 
 TEST_P(SharedAirfoilGridTest, OrthogonalisedTransfiniteMeetsTheCriteria) {
@@ -91,6 +125,7 @@ TEST_P(SharedAirfoilGridTest, OrthogonalisedTransfiniteMeetsTheCriteria) {
   ProfileGrid grid = GenerateProfileGrid(Coordinates(GetParam()), options).value();
   MeasureOrthogonalityBeyondFans(&grid);
   ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " transfinite");
+  ExpectConvexSeamCells(grid, GetParam() + " transfinite");
 }
 
 TEST_P(SharedAirfoilGridTest, EllipticMeetsTheCriteria) {
@@ -103,6 +138,7 @@ TEST_P(SharedAirfoilGridTest, EllipticMeetsTheCriteria) {
   // The boundary layer is the orthogonalised transfinite grid's: its trailing-edge fans too.
   MeasureOrthogonalityBeyondFans(&grid);
   ExpectGoodGrid(grid, 1e-5, 50.0, GetParam() + " elliptic");
+  ExpectConvexSeamCells(grid, GetParam() + " elliptic");
 }
 
 // The coarse level's spline as the fine level's initial guess saves fine sweeps against
@@ -199,6 +235,32 @@ TEST(EllipticTest, RejectsBadOptionsAndGrids) {
 
 INSTANTIATE_TEST_SUITE_P(Airfoils, SharedAirfoilGridTest,
                          ::testing::Values("naca0012", "rae2822", "sc20714"));
+
+// The bisector of a corner halves its angle whatever its sides' lengths (the central-difference
+// normal does only for equal sides), and a cusp continues its arriving side.
+TEST(LoopGeometryTest, CornerBisectorHalvesTheAngleWhateverTheSides) {
+  constexpr double kPi = 3.14159265358979323846;
+  // A thin wedge at the origin, counter-clockwise: in along the upper side (length 3), out
+  // along the lower side (length 1), 8 degrees apart; the exterior bisector is +x rotated by
+  // the wedge's tilt.
+  const double tilt = 0.1, half = 4.0 * kPi / 180.0;
+  const Point2 upper = {3.0 * std::cos(kPi + tilt - half), 3.0 * std::sin(kPi + tilt - half)};
+  const Point2 lower = {1.0 * std::cos(kPi + tilt + half), 1.0 * std::sin(kPi + tilt + half)};
+  const Point2 far = {4.0 * std::cos(kPi + tilt), 4.0 * std::sin(kPi + tilt)};  // in the wedge
+  const std::vector<Point2> loop = {{0.0, 0.0}, lower, far, upper, {0.0, 0.0}};
+  const double orientation = SignedArea2(loop) > 0.0 ? 1.0 : -1.0;
+  const Point2 n = CornerBisector(loop, 0, orientation);
+  EXPECT_NEAR(std::hypot(n[0], n[1]), 1.0, 1e-15);
+  EXPECT_NEAR(std::atan2(n[1], n[0]), tilt, 1e-12);
+  // The central difference is far off: it is normal to the chord from `upper` to `lower`.
+  const Point2 chord = LoopNormals(loop, orientation)[0];
+  EXPECT_GT(std::abs(std::atan2(chord[1], chord[0]) - tilt), 0.5);
+  // A cusp: both sides along -x.
+  const std::vector<Point2> cusp = {{0, 0}, {-1, 0}, {-2, 1}, {-1, 0}, {0, 0}};
+  const Point2 c = CornerBisector(cusp, 0, 1.0);
+  EXPECT_NEAR(c[0], 1.0, 1e-15);
+  EXPECT_NEAR(c[1], 0.0, 1e-15);
+}
 
 TEST(ProfileGridTest, StraightTransfiniteLinesAreNotOrthogonal) {
   // Without the orthogonalisation the lines run straight to the circle: the wall angle is off
