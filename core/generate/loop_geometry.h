@@ -26,12 +26,19 @@ double SignedArea2(const std::vector<Point2>& p);
 std::vector<Point2> LoopNormals(const std::vector<Point2>& p, double orientation);
 
 // The outward unit bisector of the angle at point i: the normalised sum of its two sides' unit
-// normals, whatever their lengths. A grid line leaving a corner that no fan widens must be it:
+// normals, whatever their lengths. A grid line leaving a thin wedge (kWedgeDegrees) must be it:
 // the corner's two cells share the exterior angle 180 + turning degrees, and any other split of
 // a thin wedge gives one of them a reflex angle. At a sharp trailing edge with sides of 2.8e-3
 // and 3.0e-3 the central-difference normal is 33 degrees off the bisector, so the seam's first
 // cell is non-convex (a 209 degree angle at the edge) and its refinements fold.
 Point2 CornerBisector(const std::vector<Point2>& p, int i, double orientation);
+
+// A corner turning by more than this many degrees is a thin wedge (a sharp trailing edge): its
+// two cells share more than 300 degrees, so its line must be the bisector (CornerBisector).
+// Blunter corners (a blunt base's, turning about 90 degrees) keep the central-difference
+// normal: both cells stay convex with it, the transfinite fans were tuned to it, and the
+// bisector there made one SC(2)-0714 grid fold (a fan's last line crossing its neighbour).
+inline constexpr double kWedgeDegrees = 120.0;
 
 // How far the loop turns at point i, in degrees (0 where it runs straight on).
 double TurningDegrees(const std::vector<Point2>& p, int i);

@@ -296,7 +296,9 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
     const LayerCorners sharp = SharpCorners(p, corners);
     std::vector<Point2> normals = LoopNormals(p, orientation);
     for (int i = 0; i < n; ++i) {
-      if (sharp.is_corner[i]) normals[i] = CornerBisector(p, i, orientation);
+      if (sharp.is_corner[i] && TurningDegrees(p, i) > kWedgeDegrees) {
+        normals[i] = CornerBisector(p, i, orientation);
+      }
     }
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
     for (int s = 0; s < sweeps; ++s) SmoothNormals(normals, sharp.is_corner);

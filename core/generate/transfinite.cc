@@ -10,10 +10,8 @@
 namespace splinegrid {
 namespace {
 
-// Points on either side of a corner whose normals fan towards the corner's bisector.
+// Points on either side of a corner whose normals fan towards the corner's normal.
 constexpr int kCornerFan = 4;
-// Corners turning by more than this (a sharp trailing edge's wedge) are not fanned.
-constexpr double kMaxFanTurning = 120.0;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -95,7 +93,7 @@ absl::StatusOr<StructuredBlock> TransfiniteGrid(const WallLoop& wall,
     const int at = c == n - 1 ? 0 : c;
     // Not at a sharp trailing edge: its neighbours' lines must leave the thin wedge first, and
     // its own line, alone in the exterior angle, bisects it.
-    if (TurningDegrees(w, at) > kMaxFanTurning) {
+    if (TurningDegrees(w, at) > kWedgeDegrees) {
       normals[at] = CornerBisector(w, at, orientation);
       continue;
     }

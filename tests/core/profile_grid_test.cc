@@ -66,8 +66,9 @@ void MeasureOrthogonalityBeyondFans(ProfileGrid* grid) {
 
 // Every cell of the seam's two columns (i = 0 and i = ni - 2, either side of the line leaving
 // the trailing edge) is strictly convex: the bilinear map of the cell has a positive Jacobian at
-// all four corners, so no refinement of it folds (its Jacobian determinant is affine in each
-// parameter, hence positive inside when it is at the corners). At a sharp trailing edge the two
+// all four corners, so no bilinear refinement of it folds (its Jacobian determinant is affine in
+// each parameter, hence positive inside when it is at the corners); a spline through such cells
+// can still fold, which generate_test.cc checks on a fitted grid. At a sharp trailing edge the two
 // seam cells share an exterior angle of 180 degrees plus the edge's turning: a seam line off
 // its bisector by more than half the wedge leaves one of them a reflex angle there.
 void ExpectConvexSeamCells(const ProfileGrid& grid, const std::string& what) {
@@ -240,9 +241,9 @@ INSTANTIATE_TEST_SUITE_P(Airfoils, SharedAirfoilGridTest,
 // normal does only for equal sides), and a cusp continues its arriving side.
 TEST(LoopGeometryTest, CornerBisectorHalvesTheAngleWhateverTheSides) {
   constexpr double kPi = 3.14159265358979323846;
-  // A thin wedge at the origin, counter-clockwise: in along the upper side (length 3), out
-  // along the lower side (length 1), 8 degrees apart; the exterior bisector is +x rotated by
-  // the wedge's tilt.
+  // A thin wedge at the origin, clockwise: out along the lower side (length 1), back in along
+  // the upper side (length 3), 8 degrees apart; the exterior bisector is +x rotated by the
+  // wedge's tilt.
   const double tilt = 0.1, half = 4.0 * kPi / 180.0;
   const Point2 upper = {3.0 * std::cos(kPi + tilt - half), 3.0 * std::sin(kPi + tilt - half)};
   const Point2 lower = {1.0 * std::cos(kPi + tilt + half), 1.0 * std::sin(kPi + tilt + half)};
@@ -252,6 +253,8 @@ TEST(LoopGeometryTest, CornerBisectorHalvesTheAngleWhateverTheSides) {
   const Point2 n = CornerBisector(loop, 0, orientation);
   EXPECT_NEAR(std::hypot(n[0], n[1]), 1.0, 1e-15);
   EXPECT_NEAR(std::atan2(n[1], n[0]), tilt, 1e-12);
+  EXPECT_LT(orientation, 0.0);
+  EXPECT_EQ(CornerBisector(loop, 4, orientation), n);  // the repeated first point
   // The central difference is far off: it is normal to the chord from `upper` to `lower`.
   const Point2 chord = LoopNormals(loop, orientation)[0];
   EXPECT_GT(std::abs(std::atan2(chord[1], chord[0]) - tilt), 0.5);

@@ -210,8 +210,10 @@ TEST_F(GenerateTest, TheSeamOfADefaultOGridFoldsNoSubCell) {
   v1::GenerateGridRequest request;
   request.set_grid_id("rae-seam");
   request.set_airfoil_file(AirfoilText("rae2822.dat"));
-  request.mutable_spec()->mutable_boundary_tolerances();                  // the defaults by kind
-  const v1::GenerateGridResponse r = client_->Generate(request).value();  // no allow_folds
+  request.mutable_spec()->mutable_boundary_tolerances();  // the defaults by kind
+  const absl::StatusOr<v1::GenerateGridResponse> generated = client_->Generate(request);
+  ASSERT_TRUE(generated.ok()) << generated.status();  // no allow_folds: refused if anything folds
+  const v1::GenerateGridResponse& r = *generated;
   ASSERT_EQ(r.fit().blocks_size(), 1);
   EXPECT_EQ(r.fit().blocks(0).quality().folded(), 0);
   EXPECT_EQ(r.fit().blocks(0).quality().max_level(), 2);
