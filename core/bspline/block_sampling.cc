@@ -16,22 +16,6 @@ constexpr char kNames[] = "ijk";
 // The two directions other than d, lower first.
 std::array<int, 2> Others(int d) { return {d == 0 ? 1 : 0, d == 2 ? 1 : 2}; }
 
-// The ratio r of a geometric sequence of `intervals` intervals starting at h whose sum is
-// `length` (h < length): h (r^m - 1) / (r - 1) = length, by bisection (the sum increases with r).
-double GeometricRatio(double h, double length, int intervals) {
-  const auto sum = [&](double r) {
-    return std::abs(r - 1.0) < 1e-12 ? h * intervals
-                                     : h * (std::pow(r, intervals) - 1.0) / (r - 1.0);
-  };
-  double lo = 0.0, hi = 1.0;
-  while (sum(hi) < length) hi *= 2.0;
-  for (int iteration = 0; iteration < 200 && hi - lo > 1e-15 * hi; ++iteration) {
-    const double mid = 0.5 * (lo + hi);
-    (sum(mid) < length ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 // Arc lengths from the line's start of `count` points spread by `distribution` over `length`.
 std::vector<double> TargetLengths(const Distribution& distribution, double length, int count) {
   std::vector<double> s = UniformParameters(0.0, length, count);

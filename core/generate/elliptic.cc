@@ -10,6 +10,7 @@
 #include "core/bspline/evaluation.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/generate/offset_march.h"
+#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -404,7 +405,7 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
   // Coarse level: every second point and layer (the layer heights d_{2j}: first height
   // h0 (1 + r) and growth r^2 add up to the same distance), so the coarse transfinite grid is
   // the fine one at every second point and layer.
-  const double r = GrowthRatio(completion.first_height, completion.distance, completion.layers);
+  const double r = GeometricRatio(completion.first_height, completion.distance, completion.layers);
   CompletionOptions coarse_completion = completion;
   coarse_completion.layers = completion.layers / 2;
   coarse_completion.first_height = completion.first_height * (1.0 + r);

@@ -8,6 +8,7 @@
 #include "core/fit/solve/tensor_fit.h"
 #include "core/generate/loop_geometry.h"
 #include "core/grid/polyline.h"
+#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -223,18 +224,6 @@ absl::Status RefitLayer(const std::vector<Point2>& p, const std::vector<int>& pi
 
 }  // namespace
 
-double GrowthRatio(double first, double distance, int layers) {
-  if (distance <= first * layers) return 1.0;
-  auto total = [&](double r) { return first * (std::pow(r, layers) - 1.0) / (r - 1.0); };
-  double lo = 1.0 + 1e-12, hi = 2.0;
-  while (total(hi) < distance) hi *= 2.0;
-  for (int it = 0; it < 200; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (total(mid) < distance ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
   if (layers < 1 || layers > 100000) {
     return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is outside [1, 100000]"));
@@ -279,7 +268,7 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
   const double orientation = SignedArea2(wall.points) > 0.0 ? 1.0 : -1.0;
 
   OffsetGrid out;
-  out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
+  out.growth_ratio = GeometricRatio(options.first_height, options.distance, options.layers);
   out.block = StructuredBlock({n, options.layers + 1, 1}, 2);
   std::vector<Point2> p = wall.points;
   auto store = [&](int j) {

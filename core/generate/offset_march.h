@@ -74,9 +74,6 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
 // positive, finite, distance >= layers * first_height); INVALID_ARGUMENT naming the field.
 absl::Status ValidateLayerStack(int layers, double first_height, double distance);
 
-// r with first (r^layers - 1) / (r - 1) = distance (1 when distance = layers * first).
-double GrowthRatio(double first, double distance, int layers);
-
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_GENERATE_OFFSET_MARCH_H_

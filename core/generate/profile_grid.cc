@@ -10,6 +10,7 @@
 #include "core/generate/loop_geometry.h"
 #include "core/generate/offset_march.h"
 #include "core/generate/transfinite.h"
+#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -235,7 +236,7 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
       out.fine_seconds = smoothed.fine.seconds;
       out.elliptic_converged = smoothed.fine.converged;
     }
-    out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
+    out.growth_ratio = GeometricRatio(options.first_height, options.distance, options.layers);
   }
   out.layer_seconds = SecondsSince(start);
 

@@ -12,6 +12,7 @@
 #include "core/bspline/evaluation.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/generate/offset_march.h"
+#include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -529,7 +530,7 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
   const std::vector<char> fixed = UnsmoothedPoints(s, collapsed);
 
   SurfaceOffsetGrid out;
-  out.growth_ratio = GrowthRatio(options.first_height, options.distance, options.layers);
+  out.growth_ratio = GeometricRatio(options.first_height, options.distance, options.layers);
   out.block = StructuredBlock({s.ni, s.nj, options.layers + 1}, 3);
   auto store = [&](int k) {
     for (int64_t q = 0; q < s.size(); ++q) {

@@ -4,11 +4,11 @@
 // B-spline X(u, v) (tensor_fit.h, faired with surface_fairing so that noise in the data does
 // not pose as curvature), and layer after layer is offset along the spline's unit normals
 //   N = side (X_u x X_v) / |X_u x X_v|,
-// the step growing geometrically, h_k = first_height r^k with r = GrowthRatio (offset_march.h),
-// so that the layers add up to `distance`. Every layer keeps the surface's parameters and
-// knots: its spline is the previous one plus the spline of the displacement (fitted and faired,
-// fairing.h), and the next layer's normals and curvatures are taken from it. We fair the
-// displacement, not the layer's points: the correction is then a small fraction of the step,
+// the step growing geometrically, h_k = first_height r^k with r = GeometricRatio
+// (core/grid/sampling.h), so that the layers add up to `distance`. Every layer keeps the surface's
+// parameters and knots: its spline is the previous one plus the spline of the displacement (fitted
+// and faired, fairing.h), and the next layer's normals and curvatures are taken from it. We fair
+// the displacement, not the layer's points: the correction is then a small fraction of the step,
 // whereas fairing the points moves them by a fraction of the layer's own size, which folds the
 // thin cells near the wall and shrinks a sphere by far more than a step. A plane's displacement
 // is constant and is reproduced exactly. Per layer:

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/generate/loop_geometry.h"
 #include "core/generate/offset_march.h"
+#include "core/grid/sampling.h"
 
 namespace splinegrid {
 namespace {
@@ -111,7 +112,7 @@ absl::StatusOr<StructuredBlock> TransfiniteGrid(const WallLoop& wall,
     }
   }
   normals.back() = normals.front();
-  const double r = GrowthRatio(options.first_height, options.distance, options.layers);
+  const double r = GeometricRatio(options.first_height, options.distance, options.layers);
   std::vector<double> d(options.layers + 1, 0.0);
   for (int j = 1; j <= options.layers; ++j) {
     d[j] = d[j - 1] + options.first_height * std::pow(r, j - 1);

@@ -102,6 +102,21 @@ std::vector<double> UniformParameters(double begin, double end, int count) {
   return out;
 }
 
+double GeometricRatio(double first, double total, int intervals) {
+  if (std::abs(total - first * intervals) <= 1e-12 * total) return 1.0;
+  const auto sum = [&](double r) {
+    return std::abs(r - 1.0) < 1e-12 ? first * intervals
+                                     : first * (std::pow(r, intervals) - 1.0) / (r - 1.0);
+  };
+  double lo = 0.0, hi = 1.0;
+  while (sum(hi) < total) hi *= 2.0;
+  for (int iteration = 0; iteration < 200 && hi - lo > 1e-15 * hi; ++iteration) {
+    const double mid = 0.5 * (lo + hi);
+    (sum(mid) < total ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 absl::StatusOr<Extents> SampleExtents(const PointDistribution& distribution,
                                       const Resolution& resolution) {
   SG_ASSIGN_OR_RETURN(const IndexBox box, CheckedBox(distribution, resolution));

@@ -83,6 +83,12 @@ absl::StatusOr<std::array<std::vector<double>, 3>> SampleParameters(
 // one is `begin`).
 std::vector<double> UniformParameters(double begin, double end, int count);
 
+// The ratio r of a geometric sequence of `intervals` (>= 1) steps starting at `first` (> 0) that
+// add up to `total` (> first): first (r^intervals - 1) / (r - 1) = total, by bisection (the sum
+// increases with r). Exactly 1 when total is intervals x first to 1e-12; below 1 when total is
+// less. Wall spacings (geometric distributions) and layer growth (the grid generators) use it.
+double GeometricRatio(double first, double total, int intervals);
+
 }  // namespace splinegrid
 
 #endif  // SPLINEGRID_CORE_GRID_SAMPLING_H_
