@@ -21,30 +21,15 @@
 #include "server/ops/watch.h"
 #include "server/store/grid_archive.h"
 #include "server/store/memory_store.h"
-#include "tests/core/test_data.h"
+#include "tests/server/ops_fixture.h"
 
 namespace splinegrid::server {
 namespace {
 
 using ::testing::HasSubstr;
 
-MultiBlockGrid Naca() {
-  return ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value();
-}
-
-class OpsStreamsTest : public ::testing::Test {
+class OpsStreamsTest : public OpsFixture {
  protected:
-  // Imports the NACA 0012 C-grid as grid `id` and fits it `fits` times.
-  void AddNaca(const std::string& id, int fits) {
-    ops::ImportedSource source;
-    source.imported.grid = Naca();
-    source.imported.format = "plot3d";
-    ASSERT_TRUE(ops::StoreImported(ops_, {id, "", ""}, std::move(source)).ok());
-    GridFitOptions options;
-    options.boundary_tolerances = BoundaryTolerances();
-    for (int f = 0; f < fits; ++f) ASSERT_TRUE(ops::Fit(ops_, id, options, {}).ok());
-  }
-
   ops::GridEvaluationRequest Evaluation(int level) {
     ops::GridEvaluationRequest request;
     request.grid_id = "naca";
@@ -54,11 +39,6 @@ class OpsStreamsTest : public ::testing::Test {
     request.chunk_values = 1 << 16;
     return request;
   }
-
-  MemoryStore store_{/*max_deform_revisions=*/4};
-  MemoryBudget budget_{int64_t{1} << 30};
-  DeformerCache deformers_;
-  const ops::OpsContext ops_{store_, budget_, deformers_};
 };
 
 TEST_F(OpsStreamsTest, GridEvaluationChunksCoverTheOutputOnceWithTheKernelsValues) {

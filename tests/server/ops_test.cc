@@ -17,28 +17,16 @@
 #include "server/ops/evaluate_points.h"
 #include "server/ops/fit.h"
 #include "server/ops/wall_curvature.h"
-#include "server/store/memory_store.h"
-#include "tests/core/test_data.h"
+#include "tests/server/ops_fixture.h"
 
 namespace splinegrid::server {
 namespace {
 
 using ::testing::HasSubstr;
 
-class OpsTest : public ::testing::Test {
+class OpsTest : public OpsFixture {
  protected:
-  void SetUp() override {
-    auto grid = std::make_shared<StoredGrid>();
-    grid->id = "naca";
-    grid->create_time = absl::Now();
-    auto source = std::make_shared<SourcePoints>();
-    source->checked =
-        FittableGrid::Check(ReadPlot3dFile(SharedDataPath("grids/n0012_225-65.p2dfmt")).value())
-            .value();
-    source->format = "plot3d";
-    grid->source = std::move(source);
-    ASSERT_TRUE(store_.Create(grid).ok());
-  }
+  void SetUp() override { AddNaca("naca", 0); }
 
   int64_t Latest() { return store_.Get("naca").value()->revisions.back()->number; }
 
@@ -56,11 +44,6 @@ class OpsTest : public ::testing::Test {
     request.step = 7;
     return request;
   }
-
-  MemoryStore store_{/*max_deform_revisions=*/4};
-  MemoryBudget budget_{int64_t{1} << 30};
-  DeformerCache deformers_;
-  const ops::OpsContext ops_{store_, budget_, deformers_};
 };
 
 TEST_F(OpsTest, FitFairAndDeformPublishRevisions) {
