@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/util/check.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid {
 
@@ -104,6 +105,74 @@ absl::StatusOr<KnotVector> KnotVector::Averaged(int order, int num_controls,
       const double a = j * d - i;
       knots[k - 1 + j] = (1.0 - a) * params[i - 1] + a * params[i];
     }
+  }
+  return Create(order, std::move(knots));
+}
+
+std::vector<int> KnotVector::UsableBreaks(int order, int num_controls, int m,
+                                          std::span<const int> candidates) {
+  std::vector<int> kept;
+  int previous = 0;
+  for (int r : candidates) {
+    const int pieces = static_cast<int>(kept.size()) + 2;
+    // m_p >= k on both sides of r, and k controls for each piece: pieces * k <= n + breaks.
+    if (r - previous >= order - 1 && (m - 1) - r >= order - 1 &&
+        pieces * order <= num_controls + pieces - 1) {
+      kept.push_back(r);
+      previous = r;
+    }
+  }
+  return kept;
+}
+
+absl::StatusOr<KnotVector> KnotVector::AveragedWithBreaks(int order, int num_controls,
+                                                          std::span<const double> params,
+                                                          std::span<const int> breaks) {
+  if (breaks.empty()) return Averaged(order, num_controls, params);
+  const int m = static_cast<int>(params.size());
+  const int k = order;
+  if (order < 2) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("breaks: order = ", order, " has no continuity to break; order >= 2 does"));
+  }
+  if (UsableBreaks(order, num_controls, m, breaks).size() != breaks.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("breaks: ", breaks.size(), " breaks at data indices from ", breaks.front(),
+                     " to ", breaks.back(), " do not leave ", k, " of the ", m, " data and ", k,
+                     " of the ", num_controls, " controls to every piece (order ", k, ")"));
+  }
+  // Piece bounds (data indices) and the controls of each piece.
+  std::vector<int> bounds = {0};
+  bounds.insert(bounds.end(), breaks.begin(), breaks.end());
+  bounds.push_back(m - 1);
+  const int pieces = static_cast<int>(bounds.size()) - 1;
+  const int spare = num_controls + pieces - 1 - pieces * k;  // controls beyond k per piece
+  const int surplus = m + pieces - 1 - pieces * k;           // sum of m_p - k
+  std::vector<int> controls(pieces, k);
+  std::vector<std::pair<double, int>> remainders;
+  int given = 0;
+  for (int p = 0; p < pieces; ++p) {
+    const int extra_data = bounds[p + 1] - bounds[p] + 1 - k;
+    const double share = surplus > 0 ? static_cast<double>(spare) * extra_data / surplus : 0.0;
+    controls[p] += static_cast<int>(share);
+    given += static_cast<int>(share);
+    remainders.push_back({share - static_cast<int>(share), p});
+  }
+  std::stable_sort(remainders.begin(), remainders.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (int q = 0; given < spare; ++q, ++given) ++controls[remainders[q].second];
+
+  std::vector<double> knots(k, params.front());
+  for (int p = 0; p < pieces; ++p) {
+    const double u0 = params[bounds[p]], u1 = params[bounds[p + 1]];
+    std::vector<double> local(params.begin() + bounds[p], params.begin() + bounds[p + 1] + 1);
+    for (double& u : local) u = (u - u0) / (u1 - u0);
+    local.front() = 0.0;
+    local.back() = 1.0;
+    SG_ASSIGN_OR_RETURN(const KnotVector piece, Averaged(k, controls[p], local), "breaks: piece ",
+                        p, ": ");
+    for (int j = k; j < controls[p]; ++j) knots.push_back(u0 + piece.knot(j) * (u1 - u0));
+    knots.insert(knots.end(), p + 1 < pieces ? k - 1 : k, u1);
   }
   return Create(order, std::move(knots));
 }

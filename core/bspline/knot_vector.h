@@ -49,6 +49,28 @@ class KnotVector {
   static absl::StatusOr<KnotVector> Averaged(int order, int num_controls,
                                              std::span<const double> params);
 
+  // Averaged knots that break at data indices: at every index r of `breaks` (ascending, in
+  // (0, m - 1)) a knot of multiplicity k - 1 at u_r, so the spline is only C0 there (a kink of
+  // the data, e.g. the corner of a blunt trailing edge, stays a kink instead of being rounded
+  // off by a C2 spline that then swings beside it). Between breaks every piece p of m_p data
+  // (the data at both of its ends included) gets the Averaged knots of its own parameters,
+  // rescaled to [u_first, u_last]. The pieces share one control at each break; they get
+  // n_p = k + a share of the remaining controls in proportion to m_p - k (largest remainders),
+  // adding up to num_controls. With num_controls == m that is n_p = m_p: every piece
+  // interpolates its own data, and the whole is still the interpolation of the m data.
+  // Errors: INVALID_ARGUMENT as Averaged, or if the breaks are not ascending inside (0, m - 1),
+  // leave a piece of fewer than k data, or ask for more than num_controls controls (k per
+  // piece, less one per break); UsableBreaks keeps the breaks that do not.
+  static absl::StatusOr<KnotVector> AveragedWithBreaks(int order, int num_controls,
+                                                       std::span<const double> params,
+                                                       std::span<const int> breaks);
+  // The longest prefix-greedy selection of `candidates` (ascending data indices) that
+  // AveragedWithBreaks accepts for m data: a candidate is kept when it leaves at least k data
+  // to the previous kept break (or the start) and to the end, and the pieces still get k
+  // controls each.
+  static std::vector<int> UsableBreaks(int order, int num_controls, int m,
+                                       std::span<const int> candidates);
+
   int order() const { return order_; }
   int degree() const { return order_ - 1; }
   int num_controls() const { return static_cast<int>(knots_.size()) - order_; }

@@ -2,7 +2,8 @@
 //
 // Two modes:
 //  - control counts (per direction, with per-block overrides): a least-squares fit of every
-//    block on its own (tensor_fit.h), optionally faired with a fixed weight;
+//    block on its own (tensor_fit.h), only C0 at the kinks of its boundary lines (features),
+//    optionally faired with a fixed weight;
 //  - tolerances: a watertight multi-block fit to tolerances by boundary kind (multiblock_fit.h),
 //    from one tolerance for every point or from per-kind tolerances, optionally faired.
 // Either way the result reports, per block, the deviation per boundary kind and the cell
@@ -35,7 +36,7 @@ namespace splinegrid {
 // Which grid lines give a direction its parameters (tolerance mode). A tensor-product spline has
 // one parameter per grid index of a direction, shared by all its lines; a wall fitted at
 // parameters averaged over all lines wriggles between its points, because its own spacing
-// differs from the average (on the NACA 0012 225 x 65 C-grid even an interpolating fit has 37
+// differs from the average (on the NACA 0012 225 x 65 C-grid even an interpolating fit has 47
 // curvature extrema along the wall, where the wall's points have 5). Taking the parameters from
 // the wall lines alone gives smooth walls (RAE 2822: 10 extrema instead of 28, the squared
 // curvature differences 20x smaller), but on some grids the other lines then need many more
@@ -94,7 +95,8 @@ struct GridFitOptions {
   // Share knots and boundary controls across matches (watertight). False fits every block on its
   // own (boundaries are still classified by the connectivity).
   bool watertight = true;
-  // Kink detection: feature points where every line of a direction becomes C0 (refinement.h).
+  // Kink detection, either mode: feature points where every line of a direction becomes C0
+  // (refinement.h).
   FeatureOptions features;
   // Knot refinement rounds before giving up.
   int max_iterations = kDefaultMaxRefinementRounds;

@@ -215,6 +215,51 @@ TEST(FitBlockTest, ReportsSummaryAndInterpolatesWhenCountsEqualPoints) {
       fitted.summary.deviation.max, 1e-14);
 }
 
+// A block whose i-lines run along two straight sides meeting at a right angle (the corner of
+// a blunt base), fitted through its points: with a break at the corner each piece is a cubic
+// through collinear points, so the fitted lines stay on the sides between the points; a C2
+// interpolant swings off them beside the corner.
+TEST(FitBlockTest, BreaksKeepACornerOfTheData) {
+  const int kCorner = 6, ni = 16, nj = 4;
+  StructuredBlock block({ni, nj, 1}, 2);
+  for (int j = 0; j < nj; ++j) {
+    for (int i = 0; i < ni; ++i) {
+      const double s = (i <= kCorner ? i : kCorner + 1.7 * (i - kCorner)) * (1.0 + 0.1 * j);
+      double* p = block.Point(i, j, 0);
+      p[0] = std::min(s, kCorner * (1.0 + 0.1 * j));  // along x, then up along y
+      p[1] = std::max(0.0, s - kCorner * (1.0 + 0.1 * j)) + j;
+    }
+  }
+  // The largest distance of the fitted i-lines, sampled finely, from the two sides.
+  auto off_sides = [&](const FittedBlock& fitted) {
+    double worst = 0.0;
+    for (int j = 0; j < nj; ++j) {
+      const double v = fitted.distribution.params(1)[j], corner_x = kCorner * (1.0 + 0.1 * j);
+      for (int q = 0; q <= 600; ++q) {
+        const Point3 p = EvaluatePoint(fitted.spline, {q / 600.0, v, 0.0});
+        worst = std::max(worst, std::min(std::abs(p[1] - j), std::abs(p[0] - corner_x)) +
+                                    std::max({0.0, p[0] - corner_x, j - p[1]}));
+      }
+    }
+    return worst;
+  };
+  FitOptions options;
+  const FittedBlock smooth = FitBlock(block, options).value();
+  EXPECT_GT(off_sides(smooth), 1e-2);
+  options.breaks[0] = {kCorner};
+  const FittedBlock broken = FitBlock(block, options).value();
+  EXPECT_EQ(broken.spline.control_extents(), (Extents{ni, nj, 1}));  // still interpolation
+  EXPECT_LT(broken.summary.deviation.max, 1e-12);
+  EXPECT_EQ(broken.spline.knots(0).Multiplicity(broken.distribution.params(0)[kCorner]), 3);
+  EXPECT_LT(off_sides(broken), 1e-12);
+  // Breaks are checked like every option.
+  options.breaks[0] = {kCorner, kCorner};
+  EXPECT_THAT(FitBlock(block, options).status().message(),
+              HasSubstr("breaks[0][1] = 6 is not ascending inside [1, 14]"));
+  options.breaks[0] = {0};
+  EXPECT_THAT(FitBlock(block, options).status().message(), HasSubstr("breaks[0][0] = 0"));
+}
+
 TEST(FitBlockTest, RejectsBadOptionsAndData) {
   StructuredBlock block({10, 6, 1}, 3);
   for (size_t i = 0; i < block.coords().size(); ++i) block.coords()[i] = std::sin(double(i));

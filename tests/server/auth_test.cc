@@ -158,8 +158,6 @@ TEST_F(AuthTest, EachRoleMayDoItsClassOfCalls) {
               HasSubstr("needs the role write; the caller has read"));
   // GenerateGrid is a write call too, and makes its caller the owner.
   v1::GenerateGridRequest generate;
-  // The interpolated O-grid folds beside the NACA 0012's blunt base; roles are tested here.
-  generate.set_allow_folds(true);
   generate.set_grid_id("generated");
   generate.set_wall_points(65);
   generate.set_layers(16);

@@ -48,6 +48,10 @@ absl::Status FeatureOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("features.spike_ratio = ", spike_ratio, " is not a finite number >= 1"));
   }
+  if (!(kink_ratio >= 0.0) || !std::isfinite(kink_ratio)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("features.kink_ratio = ", kink_ratio, " is not a finite number >= 0"));
+  }
   return absl::OkStatus();
 }
 
@@ -171,7 +175,7 @@ std::vector<int> DetectFeatures(const StructuredBlock& block, int d,
       }
       for (int64_t r = 1; r + 1 < v.m; ++r) {
         const double neighbours = std::max(angle[r - 1], r + 2 < v.m ? angle[r + 1] : 0.0);
-        if (angle[r] >= absolute ||
+        if ((angle[r] >= absolute && angle[r] >= options.kink_ratio * neighbours) ||
             (angle[r] >= spike && angle[r] >= options.spike_ratio * neighbours)) {
           feature[r] = true;
         }
@@ -256,8 +260,7 @@ int SplitSpans(const std::vector<double>& params, const std::vector<double>& rat
   for (const auto& [worst, knot] : candidates) {
     if (added == max_new) break;
     const auto at = knots.insert(std::upper_bound(knots.begin(), knots.end(), knot), knot);
-    if ((max_single_run <= 0 || SingleDatumRun(params, knots) <= max_single_run) &&
-        well_posed()) {
+    if ((max_single_run <= 0 || SingleDatumRun(params, knots) <= max_single_run) && well_posed()) {
       ++added;
     } else {
       knots.erase(std::find(knots.begin(), knots.end(), knot));

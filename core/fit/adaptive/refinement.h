@@ -47,8 +47,9 @@ absl::StatusOr<std::vector<double>> DirectionResidualRatio(
     std::span<const double> edge_tolerance, const CancelCheck& cancel);
 
 // Kink detection: a grid index r (0 < r < m - 1) of direction d is a feature point when some
-// grid line of d on the block's boundary turns there by at least `angle_degrees`, or by at least
-// `spike_degrees` and `spike_ratio` times the turning at both neighbouring points of that line.
+// grid line of d on the block's boundary turns there by at least `angle_degrees` (and by
+// `kink_ratio` times the turning at both neighbouring points of that line), or by at least
+// `spike_degrees` and `spike_ratio` times the turning at both neighbours.
 // Interior lines are not looked at: a feature makes every line of the direction C0 there, which
 // only pays off for kinks of the boundary (a trailing edge, a corner of the far field). Two
 // features next to each other leave no data between them: only the first is kept.
@@ -57,6 +58,10 @@ struct FeatureOptions {
   double angle_degrees = 30.0;
   double spike_degrees = 4.0;
   double spike_ratio = 4.0;
+  // 0: every turning of angle_degrees is a feature. 2 asks for a tangent discontinuity: a bend
+  // sampled coarsely (a nose at 65 points turns by 45 degrees at two points in a row) turns by
+  // about as much at the neighbours, a corner by far more.
+  double kink_ratio = 0.0;
 
   // INVALID_ARGUMENT naming the field unless the angles are in [0, 180] and spike_ratio >= 1.
   absl::Status Validate() const;

@@ -90,6 +90,22 @@ absl::Status FitOptions::Validate(const Extents& points) const {
     return absl::InvalidArgumentError(
         absl::StrCat("fairing = ", fairing, " is not a finite number >= 0"));
   }
+  for (int d = 0; d < 3; ++d) {
+    if (breaks[d].empty()) continue;
+    if (knot_placement != KnotPlacement::kAveraged) {
+      return absl::InvalidArgumentError(absl::StrCat("breaks[", d, "] has ", breaks[d].size(),
+                                                     " breaks; breaks need averaged knots"));
+    }
+    for (size_t q = 0; q < breaks[d].size(); ++q) {
+      const int r = breaks[d][q];
+      if (r < 1 || r > points[d] - 2 || (q > 0 && r <= breaks[d][q - 1])) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("breaks[", d, "][", q, "] = ", r, " is not ascending inside [1, ",
+                         points[d] - 2, "] (the block has ", points[d], " points in ",
+                         std::string(1, kDirectionNames[d]), ")"));
+      }
+    }
+  }
   return ValidateControlCounts(control_counts, order, points, "control_counts", "the block");
 }
 
@@ -235,7 +251,10 @@ absl::StatusOr<FittedBlock> FitBlock(const StructuredBlock& block, const FitOpti
     if (options.knot_placement == KnotPlacement::kUniform) {
       knots[d] = KnotVector::Uniform(shape.order, shape.controls);
     } else {
-      SG_ASSIGN_OR_RETURN(knots[d], KnotVector::Averaged(shape.order, shape.controls, params[d]));
+      const std::vector<int> breaks =
+          KnotVector::UsableBreaks(shape.order, shape.controls, m[d], options.breaks[d]);
+      SG_ASSIGN_OR_RETURN(
+          knots[d], KnotVector::AveragedWithBreaks(shape.order, shape.controls, params[d], breaks));
     }
   }
   const EndCondition ends =

@@ -43,6 +43,12 @@ struct FitOptions {
   Extents control_counts = {0, 0, 0};
   Parametrization parametrization = kDefaultParametrization;
   KnotPlacement knot_placement = KnotPlacement::kAveraged;
+  // Per direction, data indices (ascending) where every line of the direction is only C0: kinks
+  // of the block's boundary lines (DetectFeatures). Knots of multiplicity order - 1 there
+  // (KnotVector::AveragedWithBreaks), with the direction's control count unchanged; a break
+  // that would leave fewer than `order` points or controls to a piece is not used
+  // (KnotVector::UsableBreaks). Needs kAveraged placement.
+  std::array<std::vector<int>, 3> breaks;
   // Fix the end controls of every direction to the data (corners exact, boundaries from the
   // boundary data alone); see the file comment.
   bool interpolate_ends = true;
