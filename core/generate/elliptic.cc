@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -19,6 +20,26 @@ namespace {
 // |phi|, |psi| at most this (neighbour weights e^3 = 20 apart); reached only at a few points by
 // the seam, where the algebraic grid's lines fan out from a trailing-edge corner.
 constexpr double kMaxControl = 3.0;
+
+// Multigrid cycles (V-cycles): one sweep on each level before and after its coarse-level
+// correction (the line relaxation already damps what a coarser level cannot see, and a sweep of
+// level l costs 4^-l of a fine one); on the coarsest level, at least kCoarsestPoints x
+// kCoarsestLayers points, sweeps until one moves no point by the tolerance, at most
+// kCoarsestSweeps.
+constexpr int kPreSweeps = 1;
+constexpr int kPostSweeps = 1;
+constexpr int kCoarsestSweeps = 20;
+constexpr int kCoarsestPoints = 17;
+constexpr int kCoarsestLayers = 9;
+// Levels, the finest included. Two: V-cycles over 3-5 levels diverged on the coarser ones (on
+// 33 x 17 points and below the held boundary layer is one or two layers, and the corrected
+// coarse grids folded) or stalled; one coarse level halves the work of the far-field mode.
+constexpr int kMaxLevels = 2;
+// Cycles without a new low of the largest fine move: the cycles have stalled (seen when the
+// first free layer is a thin wall layer, which the coarse level cannot resolve: RAE 2822 65 x 33
+// with a 1e-3 first layer and only the wall held) and the rest is relaxation alone from the
+// initial grid, which converges there.
+constexpr int kStallCycles = 20;
 
 // B(z) = z / (e^z - 1), B(0) = 1: the weights of the exponentially fitted (Allen-Southwell,
 // Il'in) difference of x'' + c x': B(c) x_{i-1} + B(-c) x_{i+1} - (B(c) + B(-c)) x_i, exact
@@ -175,8 +196,33 @@ class LineRelaxation {
   // Unknowns j = first .. nj - 2 per line of constant i.
   int rows() const { return rows_; }
 
+  // Relax N(x) = source instead of N(x) = 0 (two values per point, point order; empty: 0),
+  // N(x) the discrete equation of the file comment: at (i, j)
+  //   N(x) = we x_e + ww x_w + wn x_n + ws x_s - 2 beta x_xieta - (we + ww + wn + ws) x.
+  void SetSource(std::vector<double> source) { source_ = std::move(source); }
+
+  // source - N(x) at every free point (2 values per point, point order), 0 at held points, the
+  // outer loop and the repeated line i = ni - 1.
+  std::vector<double> Residual() const {
+    std::vector<double> out(2 * g_.num_points(), 0.0);
+    for (int j = first_; j + 1 < nj_; ++j) {
+      for (int i = 0; i < cols_; ++i) {
+        double lower, diag, upper;
+        Vec rest;  // with the source: rest - lower x_s - upper x_n - diag x = N(x) - source
+        Stencil(i, j, true, &lower, &diag, &upper, &rest);
+        const Vec c = At(g_, i, j), n = At(g_, i, j + 1), s = At(g_, i, j - 1);
+        const int64_t p = g_.Index(i, j, 0);
+        out[2 * p] = -(rest.x - lower * s.x - upper * n.x - diag * c.x);
+        out[2 * p + 1] = -(rest.y - lower * s.y - upper * n.y - diag * c.y);
+      }
+    }
+    return out;
+  }
+
   // One sweep over both line directions; the largest move relative to the moved point's
   // smallest spacing to its neighbours (infinity when a move is not finite).
+  double largest() const { return largest_; }
+
   double Sweep() {
     largest_ = 0.0;
     SweepLinesAlongJ();
@@ -186,8 +232,8 @@ class LineRelaxation {
 
  private:
   // The discrete equation at (i, j), split into the neighbours along the line and the rest.
-  void Stencil(int i, int j, bool along_j, double* lower, double* diag, double* upper,
-               Vec* rest) const {
+  void Stencil(int i, int j, bool along_j, double* lower, double* diag, double* upper, Vec* rest,
+               bool with_source = true) const {
     const Neighbourhood h = Around(g_, i, j);
     const Vec &e = h.e, &w = h.w, &n = h.n, &s = h.s, &cross = h.cross;
     const double alpha = h.alpha, beta = h.beta, gamma = h.gamma;
@@ -199,6 +245,10 @@ class LineRelaxation {
     *diag = we + ww + wn + ws;
     rest->x = -2.0 * beta * cross.x;
     rest->y = -2.0 * beta * cross.y;
+    if (!source_.empty()) {
+      rest->x -= source_[2 * p];
+      rest->y -= source_[2 * p + 1];
+    }
     if (along_j) {
       *lower = -ws;
       *upper = -wn;
@@ -272,9 +322,28 @@ class LineRelaxation {
   const int cols_;   // unknowns i = 0 .. ni - 2 (periodic)
   const double omega_;
   const std::vector<double> weights_;
+  std::vector<double> source_;
   LineSystem line_;
   double largest_ = 0.0;
 };
+
+// Full weighting of the fine values `fine` (2 per point of an ni x nj O-grid, periodic in i)
+// at the coarse point (I, J) = fine (2 I, 2 J): (4 c + 2 (e + w + n + s) + ne + nw + se + sw) / 16.
+Vec FullWeighting(const std::vector<double>& fine, int ni, int i, int j) {
+  Vec sum = {0.0, 0.0};
+  for (int dj = -1; dj <= 1; ++dj) {
+    for (int di = -1; di <= 1; ++di) {
+      int f = i + di;
+      if (f < 0) f += ni - 1;
+      if (f > ni - 2) f -= ni - 1;
+      const double w = (di == 0 ? 2.0 : 1.0) * (dj == 0 ? 2.0 : 1.0) / 16.0;
+      const int64_t p = static_cast<int64_t>(j + dj) * ni + f;
+      sum.x += w * fine[2 * p];
+      sum.y += w * fine[2 * p + 1];
+    }
+  }
+  return sum;
+}
 
 }  // namespace
 
@@ -387,6 +456,185 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
   return result;
 }
 
+namespace {
+
+// One level of the multigrid cycles: its iterate, its relaxation (with the source of the
+// cycle), and the iterate as injected from the finer level at the cycle's start.
+struct Level {
+  Level(StructuredBlock g, const ControlFunctions& control, int first, double omega)
+      : grid(std::move(g)), relax(grid, control, first, omega), first(first) {}
+  StructuredBlock grid;
+  LineRelaxation relax;
+  std::vector<double> injected;
+  int first;  // the first free layer
+  int sweeps = 0;
+};
+
+// Every second point and layer of `grid`.
+StructuredBlock Inject(const StructuredBlock& grid) {
+  StructuredBlock coarse({(grid.extent(0) + 1) / 2, (grid.extent(1) + 1) / 2, 1}, 2);
+  for (int j = 0; j < coarse.extent(1); ++j) {
+    for (int i = 0; i < coarse.extent(0); ++i) {
+      std::copy_n(grid.Point(2 * i, 2 * j, 0), 2, coarse.Point(i, j, 0));
+    }
+  }
+  return coarse;
+}
+
+class Multigrid {
+ public:
+  Multigrid(std::vector<std::unique_ptr<Level>> levels, const EllipticOptions& options)
+      : levels_(std::move(levels)), options_(options) {}
+
+  // One sweep of level l; true once it moved no point by the tolerance.
+  absl::StatusOr<bool> Sweep(int l) {
+    Level& level = *levels_[l];
+    ++level.sweeps;
+    const double largest = level.relax.Sweep();
+    if (!std::isfinite(largest)) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("elliptic smoothing diverged in sweep ", level.sweeps, " of level ", l));
+    }
+    return largest < options_.tolerance;
+  }
+
+  // The coarse-level correction of level l - 1 by level l (file comment): its problem from
+  // level l - 1's residual, solved by a cycle of its own (or by sweeps on the coarsest level),
+  // and the correction interpolated onto level l - 1's free points.
+  absl::Status Correct(int l) {
+    Level& fine = *levels_[l - 1];
+    Level& coarse = *levels_[l];
+    const int ni = fine.grid.extent(0), nj = fine.grid.extent(1);
+    const int nic = coarse.grid.extent(0), njc = coarse.grid.extent(1);
+    const std::vector<double> residual = fine.relax.Residual();
+    for (int J = 0; J < njc; ++J) {
+      for (int I = 0; I < nic; ++I) {
+        std::copy_n(fine.grid.Point(2 * I, 2 * J, 0), 2, coarse.grid.Point(I, J, 0));
+      }
+    }
+    coarse.injected.assign(coarse.grid.coords().begin(), coarse.grid.coords().end());
+    coarse.relax.SetSource({});
+    std::vector<double> source = coarse.relax.Residual();  // -N_c(I x)
+    for (double& v : source) v = -v;
+    for (int J = coarse.first; J + 1 < njc; ++J) {
+      for (int I = 0; I + 1 < nic; ++I) {
+        const Vec r = FullWeighting(residual, ni, 2 * I, 2 * J);
+        const int64_t p = coarse.grid.Index(I, J, 0);
+        source[2 * p] += 16.0 * r.x;
+        source[2 * p + 1] += 16.0 * r.y;
+      }
+    }
+    coarse.relax.SetSource(std::move(source));
+    if (l + 1 == static_cast<int>(levels_.size())) {
+      for (int k = 0; k < kCoarsestSweeps; ++k) {
+        SG_ASSIGN_OR_RETURN(const bool still, Sweep(l));
+        if (still) break;
+      }
+    } else {
+      for (int k = 0; k < kPreSweeps; ++k) SG_RETURN_IF_ERROR(Sweep(l).status());
+      SG_RETURN_IF_ERROR(Correct(l + 1));
+      for (int k = 0; k < kPostSweeps; ++k) SG_RETURN_IF_ERROR(Sweep(l).status());
+    }
+    // The correction, bilinear in index space (periodic in i), on the free points.
+    auto correction = [&](int I, int J) -> Vec {
+      const int64_t p = coarse.grid.Index(I % (nic - 1), J, 0);
+      return {coarse.grid.coords()[2 * p] - coarse.injected[2 * p],
+              coarse.grid.coords()[2 * p + 1] - coarse.injected[2 * p + 1]};
+    };
+    for (int j = fine.first; j + 1 < nj; ++j) {
+      for (int i = 0; i + 1 < ni; ++i) {
+        const int I0 = i / 2, I1 = (i + 1) / 2, J0 = j / 2, J1 = (j + 1) / 2;
+        const Vec a = correction(I0, J0), b = correction(I1, J0), c = correction(I0, J1),
+                  d = correction(I1, J1);
+        double* x = fine.grid.Point(i, j, 0);
+        x[0] += 0.25 * (a.x + b.x + c.x + d.x);
+        x[1] += 0.25 * (a.y + b.y + c.y + d.y);
+        if (i == 0) std::copy_n(x, 2, fine.grid.Point(ni - 1, j, 0));
+      }
+    }
+    return absl::OkStatus();
+  }
+
+  Level& level(int l) { return *levels_[l]; }
+  int num_levels() const { return static_cast<int>(levels_.size()); }
+
+ private:
+  std::vector<std::unique_ptr<Level>> levels_;
+  const EllipticOptions& options_;
+};
+
+}  // namespace
+
+absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
+                                               const StructuredBlock& algebraic, int held_layers,
+                                               const EllipticOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SG_RETURN_IF_ERROR(options.Validate());
+  SG_RETURN_IF_ERROR(CheckOGrid(initial));
+  SG_RETURN_IF_ERROR(CheckOGrid(algebraic));
+  if (algebraic.extents() != initial.extents()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the algebraic grid has ", algebraic.extent(0), " x ", algebraic.extent(1),
+                     " points; the initial grid ", initial.extent(0), " x ", initial.extent(1)));
+  }
+  // Levels: halve while both extents are odd and the coarser level keeps at least
+  // kCoarsestPoints x kCoarsestLayers points. Held layers: level l + 1 holds (h_l + 1) / 2, so
+  // its held layers are level l's at even j and its first free layer is above level l's.
+  std::vector<std::unique_ptr<Level>> levels;
+  StructuredBlock algebraic_l = algebraic;
+  StructuredBlock grid_l = initial;
+  int held = std::clamp(held_layers, 1, initial.extent(1) - 2);
+  for (;;) {
+    const ControlFunctions control = TrackingControls(algebraic_l, held - 1);
+    levels.push_back(std::make_unique<Level>(grid_l, control, held, options.relaxation));
+    const int ni = algebraic_l.extent(0), nj = algebraic_l.extent(1);
+    const int coarse_held = (held + 1) / 2;
+    if (static_cast<int>(levels.size()) == kMaxLevels || ni % 2 == 0 || nj % 2 == 0 ||
+        (ni + 1) / 2 < kCoarsestPoints || (nj + 1) / 2 < kCoarsestLayers ||
+        coarse_held + 1 >= (nj + 1) / 2) {
+      break;
+    }
+    algebraic_l = Inject(algebraic_l);
+    grid_l = Inject(grid_l);
+    held = coarse_held;
+  }
+  Multigrid multigrid(std::move(levels), options);
+  EllipticResult result;
+  Level& fine = multigrid.level(0);
+  // The largest move of the cycles' fine sweeps, and the cycle it last fell to a new low.
+  double lowest = std::numeric_limits<double>::infinity();
+  int cycle = 0, lowest_cycle = 0;
+  bool cycling = multigrid.num_levels() > 1;
+  while (fine.sweeps < options.max_sweeps && fine.relax.rows() > 0) {
+    SG_RETURN_IF_ERROR(PollCancel(options.cancel));
+    SG_ASSIGN_OR_RETURN(result.converged, multigrid.Sweep(0));
+    if (result.converged || fine.sweeps >= options.max_sweeps) break;
+    if (!cycling) continue;
+    SG_RETURN_IF_ERROR(multigrid.Correct(1));
+    SG_ASSIGN_OR_RETURN(result.converged, multigrid.Sweep(0));
+    if (result.converged) break;
+    ++cycle;
+    if (fine.relax.largest() < lowest) {
+      lowest = fine.relax.largest();
+      lowest_cycle = cycle;
+    } else if (cycle - lowest_cycle >= kStallCycles) {
+      // Stalled: relaxation alone, from the initial grid (the stalled iterate can be a worse
+      // start than that), within the same sweep budget.
+      cycling = false;
+      result.stalled = true;
+      std::copy(initial.coords().begin(), initial.coords().end(), fine.grid.coords().begin());
+    }
+  }
+  result.sweeps = fine.sweeps;
+  for (int l = 1; l < multigrid.num_levels(); ++l) {
+    result.coarse_work += multigrid.level(l).sweeps / std::pow(4.0, l);
+  }
+  result.levels = multigrid.num_levels();
+  result.grid = std::move(fine.grid);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
 absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
                                                 const CompletionOptions& completion,
                                                 const EllipticOptions& options, bool compare) {
@@ -445,7 +693,7 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
       std::copy(from, from + 2, guess.Point(i, j, 0));  // periodic: the last line is the first
     }
   }
-  SG_ASSIGN_OR_RETURN(out.fine, SmoothElliptic(guess, fine_control, out.held_layers, options));
+  SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, fine_tfi, out.held_layers, options));
   if (compare) {
     SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,
                         SmoothElliptic(fine_tfi, fine_control, out.held_layers, options));

@@ -34,7 +34,22 @@
 // smoothed from its own transfinite grid, interpolated by a B-spline surface (tensor_fit.h) and
 // evaluated at refinement level 1 of its point distribution, which gives as many points as the
 // fine grid; with the fine held layers and outer loop put back, that is the fine level's initial
-// guess.
+// guess. The fine level is then solved by multigrid cycles (below): the relaxation alone loses
+// a far-field mode at about 0.99 a sweep, the same from either start, so the guess alone saved
+// only 2x at the default tolerance.
+//
+// Multigrid cycles: the full approximation scheme (A. Brandt, Math. Comp. 31(138), 1977;
+// U. Trottenberg, C. W. Oosterlee, A. Schueller, "Multigrid", 2001, sec. 5.3.4) for the
+// nonlinear equations N(x) = s (s = 0 on the finest level), in V-cycles: a sweep; the next
+// coarser level (every second point and layer) takes
+//   N_c(x_c) = N_c(I x) + 16 R (s - N(x))
+// from x_c = I x (I: injection, the coarse point (I, J) is the fine (2 I, 2 J); R: full
+// weighting; 16 because N is in index units: on half the points the metric terms and the
+// differences of a smooth grid are 4 times as large each) and is corrected the same way by the
+// level below it; its correction x_c - I x, interpolated bilinearly in index space, is added
+// to the free points; a sweep. The smooth far-field error the relaxation hardly reduces is what
+// the coarser levels remove. The control functions of each level are those of the algebraic
+// grid at its points.
 #ifndef SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
 #define SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
 
@@ -73,6 +88,11 @@ struct EllipticOptions {
 struct EllipticResult {
   StructuredBlock grid;
   int sweeps = 0;
+  // SmoothMultigrid: the levels, and the sweeps of the coarser levels in units of a fine sweep
+  // (a sweep of level l counts 4^-l).
+  int levels = 1;
+  double coarse_work = 0.0;
+  bool stalled = false;  // the cycles stopped helping, and relaxation alone went on
   bool converged = false;
   double seconds = 0.0;
 };
@@ -85,10 +105,21 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
                                               const ControlFunctions& control, int held_layers,
                                               const EllipticOptions& options);
 
+// Smooths `initial` by the multigrid cycles of the file comment: levels of every second point
+// and layer while both extents are odd (down to 17 x 9 points), each with the control functions
+// of `algebraic` (the algebraic grid, same points) at its points, the held layers halved. As
+// SmoothElliptic, converged when a fine sweep moves no point by more than the tolerance of its
+// spacing; `sweeps` counts the fine sweeps, `coarse_work` the rest. Errors as SmoothElliptic,
+// and INVALID_ARGUMENT if `algebraic` is not an O-grid of the same points.
+absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
+                                               const StructuredBlock& algebraic, int held_layers,
+                                               const EllipticOptions& options);
+
 struct CoarseToFine {
   EllipticResult coarse;  // the coarse level from its transfinite grid
-  EllipticResult fine;    // the fine level from the coarse grid's spline
-  // The fine level from its own transfinite grid (with `compare`): the sweeps saved.
+  EllipticResult fine;    // the fine level from the coarse grid's spline, two-level cycles
+  // The fine level from its own transfinite grid by relaxation alone (with `compare`): the
+  // baseline of the work saved.
   EllipticResult fine_from_transfinite;
   int held_layers = 1;  // of the fine level
 };

@@ -81,7 +81,9 @@ struct ProfileGrid {
   std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;
   int retries = 0;  // kOffsets: extra normal smoothing rounds over all layers
-  // kElliptic: sweeps and seconds of the coarse and the fine level, whether the fine converged.
+  // kElliptic: sweeps and seconds of the coarse level (from its transfinite grid) and of the
+  // fine level (its multigrid cycles: fine sweeps, and the seconds of all levels); whether the
+  // fine level converged.
   int coarse_sweeps = 0, fine_sweeps = 0;
   double coarse_seconds = 0.0, fine_seconds = 0.0;
   bool elliptic_converged = false;
