@@ -64,7 +64,7 @@ class KnotVector {
   static absl::StatusOr<KnotVector> AveragedWithBreaks(int order, int num_controls,
                                                        std::span<const double> params,
                                                        std::span<const int> breaks);
-  // The longest prefix-greedy selection of `candidates` (ascending data indices) that
+  // The greedy selection, in order, of the `candidates` (ascending data indices) that
   // AveragedWithBreaks accepts for m data: a candidate is kept when it leaves at least k data
   // to the previous kept break (or the start) and to the end, and the pieces still get k
   // controls each.

@@ -38,10 +38,11 @@ FitOptions BlockOptions(const GridFitOptions& options, int b) {
 // Control-count mode: every block on its own (`result` holds the kinds already).
 // Every line of a direction is C0 at the kinks of the block's boundary lines, so that a spline
 // through a corner (a blunt trailing edge's base) keeps it instead of swinging beside it: the
-// interpolating fit of a generated NACA 0012 O-grid folded 101 sub-cells there without. Only
-// tangent discontinuities count (kink_ratio 2): with its knots fixed by the counts, this mode
-// has no tolerance to win back a coarse smooth bend made C0, which changes the curve between
-// its points (RAE 2822 at 65 wall points: its nose folded a sub-cell far out).
+// interpolating fit of a generated NACA 0012 O-grid folded 101 sub-cells there without. Of the
+// 30-degree turnings only tangent discontinuities count (kink_ratio 2; the spike rule stays): with
+// its knots fixed by the counts, this mode has no tolerance to win back a coarse smooth bend made
+// C0, which changes the curve between its points (RAE 2822 at 65 wall points: its nose folded a
+// sub-cell far out).
 absl::Status FitBlocks(const MultiBlockGrid& grid, const Connectivity& connectivity,
                        const GridFitOptions& options, const CancelCheck& cancel, GridFit& result) {
   FeatureOptions features = options.features;

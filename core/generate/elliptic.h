@@ -109,7 +109,8 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
 // and layer while both extents are odd (down to 17 x 9 points), each with the control functions
 // of `algebraic` (the algebraic grid, same points) at its points, the held layers halved. As
 // SmoothElliptic, converged when a fine sweep moves no point by more than the tolerance of its
-// spacing; `sweeps` counts the fine sweeps, `coarse_work` the rest. Errors as SmoothElliptic,
+// spacing; `sweeps` counts the fine sweeps, `coarse_work` the coarser levels' sweeps (each a
+// quarter of a fine one per level down). Errors as SmoothElliptic,
 // and INVALID_ARGUMENT if `algebraic` is not an O-grid of the same points.
 absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
                                                const StructuredBlock& algebraic, int held_layers,

@@ -329,7 +329,7 @@ TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
   // No --allow_folds: the interpolation is C0 on the corner lines of the blunt base, and the
   // grid is stored only because nothing folds at levels 0-2.
   ASSERT_EQ(offset.exit_code, 0) << offset.out;
-  EXPECT_THAT(offset.out, HasSubstr("0 folded sub-cells"));
+  EXPECT_THAT(offset.out, HasSubstr("levels 0-2: 0 folded sub-cells"));
   EXPECT_THAT(offset.out, HasSubstr("grids/naca-og: offsets O-grid 129x33x1 around 'Naca 0012"));
   EXPECT_THAT(offset.out, HasSubstr("quality: 0 negative cells"));
   EXPECT_THAT(offset.out, HasSubstr("grids/naca-og revision 1: 4257 points"));
