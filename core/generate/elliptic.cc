@@ -33,7 +33,7 @@ constexpr int kCoarsestPoints = 17;
 constexpr int kCoarsestLayers = 9;
 // Levels, the finest included. Two: V-cycles over 3-5 levels diverged on the coarser ones (on
 // 33 x 17 points and below the held boundary layer is one or two layers, and the corrected
-// coarse grids folded) or stalled; one coarse level halves the work of the far-field mode.
+// coarse grids folded) or stalled; one coarse level already gives 12-19x at 1e-3.
 constexpr int kMaxLevels = 2;
 // Cycles without a new low of the largest fine move: the cycles have stalled (seen when the
 // first free layer is a thin wall layer, which the coarse level cannot resolve: RAE 2822 65 x 33
