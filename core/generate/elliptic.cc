@@ -21,17 +21,14 @@ namespace {
 // the seam, where the algebraic grid's lines fan out from a trailing-edge corner.
 constexpr double kMaxControl = 3.0;
 
-// Multigrid cycles (V-cycles): one sweep on each level before and after its coarse-level
-// correction (the line relaxation already damps what a coarser level cannot see, and a sweep of
-// level l costs 4^-l of a fine one); on the coarsest level, at least kCoarsestPoints x
-// kCoarsestLayers points, sweeps until one moves no point by the tolerance, at most
-// kCoarsestSweeps.
-constexpr int kPreSweeps = 1;
-constexpr int kPostSweeps = 1;
+// Multigrid cycles: one fine sweep before and after the coarse level's correction (the line
+// relaxation already damps what the coarse level cannot see, and a coarse sweep costs a quarter
+// of a fine one); on the coarse level, at least kCoarsestPoints x kCoarsestLayers points, sweeps
+// until one moves no point by the tolerance, at most kCoarsestSweeps.
 constexpr int kCoarsestSweeps = 20;
 constexpr int kCoarsestPoints = 17;
 constexpr int kCoarsestLayers = 9;
-// Levels, the finest included. Two: V-cycles over 3-5 levels diverged on the coarser ones (on
+// Levels, the finest included: two. V-cycles over 3-5 levels diverged on the coarser ones (on
 // 33 x 17 points and below the held boundary layer is one or two layers, and the corrected
 // coarse grids folded) or stalled; one coarse level already gives 12-19x at 1e-3.
 constexpr int kMaxLevels = 2;
@@ -470,14 +467,18 @@ struct Level {
   int sweeps = 0;
 };
 
-// Every second point and layer of `grid`.
-StructuredBlock Inject(const StructuredBlock& grid) {
-  StructuredBlock coarse({(grid.extent(0) + 1) / 2, (grid.extent(1) + 1) / 2, 1}, 2);
+// Every second point and layer of `grid` into `coarse` (of those extents).
+void InjectInto(const StructuredBlock& grid, StructuredBlock& coarse) {
   for (int j = 0; j < coarse.extent(1); ++j) {
     for (int i = 0; i < coarse.extent(0); ++i) {
       std::copy_n(grid.Point(2 * i, 2 * j, 0), 2, coarse.Point(i, j, 0));
     }
   }
+}
+
+StructuredBlock Inject(const StructuredBlock& grid) {
+  StructuredBlock coarse({(grid.extent(0) + 1) / 2, (grid.extent(1) + 1) / 2, 1}, 2);
+  InjectInto(grid, coarse);
   return coarse;
 }
 
@@ -498,20 +499,16 @@ class Multigrid {
     return largest < options_.tolerance;
   }
 
-  // The coarse-level correction of level l - 1 by level l (file comment): its problem from
-  // level l - 1's residual, solved by a cycle of its own (or by sweeps on the coarsest level),
-  // and the correction interpolated onto level l - 1's free points.
+  // The coarse-level correction of level l - 1 by level l, the coarsest (file comment): its
+  // problem from level l - 1's residual, solved by sweeps, and the correction interpolated onto
+  // level l - 1's free points.
   absl::Status Correct(int l) {
     Level& fine = *levels_[l - 1];
     Level& coarse = *levels_[l];
     const int ni = fine.grid.extent(0), nj = fine.grid.extent(1);
     const int nic = coarse.grid.extent(0), njc = coarse.grid.extent(1);
     const std::vector<double> residual = fine.relax.Residual();
-    for (int J = 0; J < njc; ++J) {
-      for (int I = 0; I < nic; ++I) {
-        std::copy_n(fine.grid.Point(2 * I, 2 * J, 0), 2, coarse.grid.Point(I, J, 0));
-      }
-    }
+    InjectInto(fine.grid, coarse.grid);
     coarse.injected.assign(coarse.grid.coords().begin(), coarse.grid.coords().end());
     coarse.relax.SetSource({});
     std::vector<double> source = coarse.relax.Residual();  // -N_c(I x)
@@ -525,15 +522,9 @@ class Multigrid {
       }
     }
     coarse.relax.SetSource(std::move(source));
-    if (l + 1 == static_cast<int>(levels_.size())) {
-      for (int k = 0; k < kCoarsestSweeps; ++k) {
-        SG_ASSIGN_OR_RETURN(const bool still, Sweep(l));
-        if (still) break;
-      }
-    } else {
-      for (int k = 0; k < kPreSweeps; ++k) SG_RETURN_IF_ERROR(Sweep(l).status());
-      SG_RETURN_IF_ERROR(Correct(l + 1));
-      for (int k = 0; k < kPostSweeps; ++k) SG_RETURN_IF_ERROR(Sweep(l).status());
+    for (int k = 0; k < kCoarsestSweeps; ++k) {
+      SG_ASSIGN_OR_RETURN(const bool still, Sweep(l));
+      if (still) break;
     }
     // The correction, bilinear in index space (periodic in i), on the free points.
     auto correction = [&](int I, int J) -> Vec {

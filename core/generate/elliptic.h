@@ -40,16 +40,16 @@
 //
 // Multigrid cycles: the full approximation scheme (A. Brandt, Math. Comp. 31(138), 1977;
 // U. Trottenberg, C. W. Oosterlee, A. Schueller, "Multigrid", 2001, sec. 5.3.4) for the
-// nonlinear equations N(x) = s (s = 0 on the finest level), in V-cycles: a sweep; the next
-// coarser level (every second point and layer) takes
-//   N_c(x_c) = N_c(I x) + 16 R (s - N(x))
+// nonlinear equations N(x) = 0 on two levels: a fine sweep; the coarse level (every second
+// point and layer) takes
+//   N_c(x_c) = N_c(I x) + 16 R (-N(x))
 // from x_c = I x (I: injection, the coarse point (I, J) is the fine (2 I, 2 J); R: full
 // weighting; 16 because N is in index units: on half the points the metric terms and the
-// differences of a smooth grid are 4 times as large each) and is corrected the same way by the
-// level below it; its correction x_c - I x, interpolated bilinearly in index space, is added
-// to the free points; a sweep. The smooth far-field error the relaxation hardly reduces is what
-// the coarser levels remove. The control functions of each level are those of the algebraic
-// grid at its points.
+// differences of a smooth grid are 4 times as large each) and is relaxed; its correction
+// x_c - I x, interpolated bilinearly in index space, is added to the fine free points; a fine
+// sweep. The smooth far-field error the relaxation hardly reduces is what the coarse level
+// removes. The control functions of each level are those of the algebraic grid at its points.
+// (Three to five levels diverged or stalled on the coarser ones.)
 #ifndef SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
 #define SPLINEGRID_CORE_GENERATE_ELLIPTIC_H_
 
@@ -105,12 +105,13 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
                                               const ControlFunctions& control, int held_layers,
                                               const EllipticOptions& options);
 
-// Smooths `initial` by the multigrid cycles of the file comment: levels of every second point
-// and layer while both extents are odd (down to 17 x 9 points), each with the control functions
+// Smooths `initial` by the multigrid cycles of the file comment: a coarse level of every second
+// point and layer if both extents are odd (and it has at least 17 x 9 points; else relaxation
+// alone), each level with the control functions
 // of `algebraic` (the algebraic grid, same points) at its points, the held layers halved. As
 // SmoothElliptic, converged when a fine sweep moves no point by more than the tolerance of its
-// spacing; `sweeps` counts the fine sweeps, `coarse_work` the coarser levels' sweeps (each a
-// quarter of a fine one per level down). Errors as SmoothElliptic,
+// spacing; `sweeps` counts the fine sweeps, `coarse_work` the coarse ones (a quarter each).
+// Errors as SmoothElliptic,
 // and INVALID_ARGUMENT if `algebraic` is not an O-grid of the same points.
 absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
                                                const StructuredBlock& algebraic, int held_layers,
