@@ -19,13 +19,10 @@ namespace splinegrid {
 namespace {
 
 using Vec = Eigen::Vector3d;
-// The points (or normals) of one layer, i fastest.
+// Per block point (i fastest) or per vertex of the surface (surface_topology.h).
 using Layer = std::vector<Vec>;
-// Point indices of the block edges that collapse to one point.
-using EdgeGroups = std::vector<std::vector<int64_t>>;
 
-// A derivative shorter than this times the surface's size has vanished (a collapsed edge), and
-// an edge whose points all lie this close to its first point is collapsed.
+// A derivative shorter than this times the surface's size has vanished (a collapsed edge).
 constexpr double kCollapsed = 1e-9;
 // A cell edge shorter than this times the cell's longest edge is collapsed: the Jacobians at
 // its corners vanish and are not checked.
@@ -41,6 +38,7 @@ struct Shape {
   int64_t size() const { return int64_t{ni} * nj; }
 };
 
+// The layer's block points as an ni x nj x 1 block.
 StructuredBlock ToBlock(const Layer& p, const Shape& s) {
   StructuredBlock block({s.ni, s.nj, 1}, 3);
   for (int64_t q = 0; q < s.size(); ++q)
@@ -48,49 +46,12 @@ StructuredBlock ToBlock(const Layer& p, const Shape& s) {
   return block;
 }
 
-// The four block edges (j = 0, j = nj - 1, i = 0, i = ni - 1) whose points all coincide.
-EdgeGroups CollapsedEdges(const Layer& p, const Shape& s, double tolerance) {
-  std::vector<std::vector<int64_t>> edges(4);
-  for (int i = 0; i < s.ni; ++i) {
-    edges[0].push_back(s.At(i, 0));
-    edges[1].push_back(s.At(i, s.nj - 1));
-  }
-  for (int j = 0; j < s.nj; ++j) {
-    edges[2].push_back(s.At(0, j));
-    edges[3].push_back(s.At(s.ni - 1, j));
-  }
-  EdgeGroups collapsed;
-  for (auto& edge : edges) {
-    const bool one_point = std::all_of(edge.begin(), edge.end(), [&](int64_t q) {
-      return (p[q] - p[edge.front()]).norm() <= tolerance;
-    });
-    if (one_point) collapsed.push_back(std::move(edge));
-  }
-  return collapsed;
-}
-
-// Every collapsed edge's points replaced by their mean.
-void Unite(Layer& values, const EdgeGroups& collapsed) {
-  for (const auto& edge : collapsed) {
-    Vec mean = Vec::Zero();
-    for (int64_t q : edge) mean += values[q];
-    mean /= static_cast<double>(edge.size());
-    for (int64_t q : edge) values[q] = mean;
-  }
-}
-
-// Unit normals (oriented by `side`) and largest principal curvatures against them (positive
-// where the surface is concave towards the normal) of a fitted layer at its data parameters.
-struct Geometry {
-  Layer normal;
-  std::vector<double> kappa;
-};
-
-// The normals and curvatures of `g` at the regular points; at singular ones (X_u x X_v
-// vanishes) `known` is cleared and `lhopital` holds the l'Hopital normal direction.
-void RegularGeometry(const TensorSpline& spline, const std::array<std::vector<double>, 3>& params,
-                     const Shape& s, int side, double scale, Geometry& g, std::vector<char>& known,
-                     Layer& lhopital) {
+// The unit normals (oriented by `side`) of a fitted layer at its regular points (at its data
+// parameters); at singular ones (X_u x X_v vanishes) `known` is cleared and `lhopital` holds the
+// l'Hopital normal direction.
+void RegularNormals(const TensorSpline& spline, const std::array<std::vector<double>, 3>& params,
+                    const Shape& s, int side, double scale, Layer& normal, std::vector<char>& known,
+                    Layer& lhopital) {
   const std::vector<double>& u = params[0];
   const std::vector<double>& v = params[1];
   for (int j = 0; j < s.nj; ++j) {
@@ -107,22 +68,15 @@ void RegularGeometry(const TensorSpline& spline, const std::array<std::vector<do
         if (b <= kCollapsed * scale && a > kCollapsed * scale) lhopital[q] = xu.cross(xuv);
         continue;
       }
-      const Vec n = side * c.normalized();
-      // Shape operator I^-1 II: mean and Gauss curvature, the larger principal curvature.
-      const double e = a * a, f = xu.dot(xv), gg = b * b, det = c.squaredNorm();
-      const double l = ToVec(d(2, 0, 0)).dot(n), m = xuv.dot(n), nn = ToVec(d(0, 2, 0)).dot(n);
-      const double h = (e * nn - 2.0 * f * m + gg * l) / (2.0 * det);
-      const double k = (l * nn - m * m) / det;
-      g.normal[q] = n;
-      g.kappa[q] = h + std::sqrt(std::max(h * h - k, 0.0));
+      normal[q] = side * c.normalized();
     }
   }
 }
 
 // Singular points: the l'Hopital normal oriented like the regular neighbours (or their mean
-// normal when it vanishes too), their largest curvature; filled inwards from the regular ones
-// (`known`), as far as they reach.
-void FillSingular(const Shape& s, const Layer& lhopital, Geometry& g, std::vector<char>& known) {
+// normal when it vanishes too); filled inwards from the regular ones (`known`), as far as they
+// reach.
+void FillSingular(const Shape& s, const Layer& lhopital, Layer& normal, std::vector<char>& known) {
   for (bool changed = true; changed;) {
     changed = false;
     const std::vector<char> before = known;
@@ -131,20 +85,17 @@ void FillSingular(const Shape& s, const Layer& lhopital, Geometry& g, std::vecto
         const int64_t q = s.At(i, j);
         if (before[q]) continue;
         Vec mean = Vec::Zero();
-        double kappa = -HUGE_VAL;
         for (int dj = -1; dj <= 1; ++dj) {
           for (int di = -1; di <= 1; ++di) {
             const int ii = i + di, jj = j + dj;
             if (ii < 0 || jj < 0 || ii >= s.ni || jj >= s.nj || !before[s.At(ii, jj)]) continue;
-            mean += g.normal[s.At(ii, jj)];
-            kappa = std::max(kappa, g.kappa[s.At(ii, jj)]);
+            mean += normal[s.At(ii, jj)];
           }
         }
         if (!(mean.norm() > 0.0)) continue;
         const Vec& c = lhopital[q];
-        g.normal[q] =
+        normal[q] =
             c.norm() > 0.0 ? (c.dot(mean) >= 0.0 ? c : Vec(-c)).normalized() : mean.normalized();
-        g.kappa[q] = kappa;
         known[q] = 1;
         changed = true;
       }
@@ -152,52 +103,145 @@ void FillSingular(const Shape& s, const Layer& lhopital, Geometry& g, std::vecto
   }
 }
 
-// Every collapsed edge's points given one normal (the normalised mean, unless it vanishes) and
-// their largest curvature.
-void ShareOverCollapsedEdges(const EdgeGroups& collapsed, Geometry& g) {
-  for (const auto& edge : collapsed) {
-    Vec mean = Vec::Zero();
-    double kappa = -HUGE_VAL;
-    for (int64_t q : edge) {
-      mean += g.normal[q];
-      kappa = std::max(kappa, g.kappa[q]);
-    }
-    for (int64_t q : edge) {
-      if (mean.norm() > 0.0) g.normal[q] = mean.normalized();
-      g.kappa[q] = kappa;
+// One surface block's share of the march: its shape, orientation, the surface spline's
+// parameters, the spline of the current layer, and the vertex of each point.
+struct BlockMarch {
+  Shape s;
+  int side = 1;
+  std::array<std::vector<double>, 3> params;
+  TensorSpline fit;
+  const std::vector<int64_t>* vertex = nullptr;
+
+  int64_t V(int i, int j) const { return (*vertex)[s.At(i, j)]; }
+  // The block's points of a per-vertex layer.
+  Layer Points(const Layer& values) const {
+    Layer out(s.size());
+    for (int64_t q = 0; q < s.size(); ++q) out[q] = values[(*vertex)[q]];
+    return out;
+  }
+};
+
+// What the layers share: the options, the topology, the blocks, the surface's size.
+struct March {
+  const SurfaceOffsetOptions& options;
+  const SurfaceTopology& topology;
+  std::vector<BlockMarch> blocks;
+  double scale = 0.0;
+  int64_t num_vertices() const { return topology.num_vertices; }
+};
+
+// Normals kept parallel to the symmetry planes their vertices lie on.
+void ProjectNormals(const March& m, Layer& normals) {
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const int p = m.topology.plane[v];
+    if (p < 0) continue;
+    Vec n = normals[v];
+    n[m.topology.planes[p].axis] = 0.0;
+    if (n.norm() > 0.0) normals[v] = n.normalized();
+  }
+}
+
+// Points kept on the symmetry planes their vertices lie on.
+void ProjectPoints(const March& m, Layer& points) {
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const int p = m.topology.plane[v];
+    if (p >= 0) points[v][m.topology.planes[p].axis] = m.topology.planes[p].value;
+  }
+}
+
+// Near a symmetry plane a normal that leans towards it has that lean scaled by
+// min(1, d / height), d the vertex's distance to the plane and `height` the layer's total height
+// above the surface: the front meets the plane at right angles, and the vertices' distances to
+// the plane map by d -> d - h c min(1, d / height) (c the lean, h <= height the step), which is
+// monotone in d, so no row of the layer overtakes another towards the plane.
+void LeanTowardsPlanes(const March& m, const Layer& p, double height, Layer& normals) {
+  for (const SymmetryPlane& plane : m.topology.planes) {
+    for (int64_t v = 0; v < m.num_vertices(); ++v) {
+      const double d = p[v][plane.axis] - plane.value;  // signed: the surface's side
+      Vec& n = normals[v];
+      if (m.topology.plane[v] >= 0 || !(n[plane.axis] * d < 0.0)) continue;
+      n[plane.axis] *= std::min(1.0, std::abs(d) / height);
+      n.normalize();
     }
   }
 }
 
-// The Geometry of the layer `spline` at its data parameters `params`: regular points, then the
-// singular ones filled in, then the collapsed edges made to agree; INVALID_ARGUMENT when no
-// point is regular.
-absl::StatusOr<Geometry> LayerGeometry(const TensorSpline& spline,
-                                       const std::array<std::vector<double>, 3>& params,
-                                       const Shape& s, int side, double scale,
-                                       const EdgeGroups& collapsed) {
-  Geometry g{Layer(s.size(), Vec::Zero()), std::vector<double>(s.size(), 0.0)};
-  std::vector<char> known(s.size(), 1);
-  Layer lhopital(s.size(), Vec::Zero());
-  RegularGeometry(spline, params, s, side, scale, g, known, lhopital);
-  FillSingular(s, lhopital, g, known);
-  if (std::find(known.begin(), known.end(), 0) != known.end()) {
-    return absl::InvalidArgumentError(
-        "surface: the fitted surface has no regular point (X_u x X_v vanishes everywhere)");
+// Per vertex: the normalised mean of its block points' normals (from each block's layer
+// spline); INVALID_ARGUMENT when a block's fitted layer has no regular point.
+absl::StatusOr<Layer> VertexNormals(const March& m) {
+  Layer normal(m.num_vertices(), Vec::Zero());
+  for (size_t b = 0; b < m.blocks.size(); ++b) {
+    const BlockMarch& block = m.blocks[b];
+    const Shape& s = block.s;
+    Layer local(s.size(), Vec::Zero());
+    std::vector<char> known(s.size(), 1);
+    Layer lhopital(s.size(), Vec::Zero());
+    RegularNormals(block.fit, block.params, s, block.side, m.scale, local, known, lhopital);
+    FillSingular(s, lhopital, local, known);
+    if (std::find(known.begin(), known.end(), 0) != known.end()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("surface block ", b,
+                       ": the fitted surface has no regular point (X_u x X_v vanishes "
+                       "everywhere)"));
+    }
+    for (int64_t q = 0; q < s.size(); ++q) {
+      const int64_t v = (*block.vertex)[q];
+      normal[v] += local[q];
+    }
   }
-  ShareOverCollapsedEdges(collapsed, g);
-  return g;
+  for (Vec& n : normal) {
+    if (n.norm() > 0.0) n.normalize();
+  }
+  ProjectNormals(m, normal);
+  return normal;
 }
 
-// The curvature each point's step is limited by: the spline's largest principal curvature
-// `kappa`, or, if larger, how fast the normals in use converge along a grid edge at the point,
-//   kappa_e = -(n_b - n_a).(x_b - x_a) / |x_b - x_a|^2,
-// the discrete 1 - h kappa (the edge's extent along itself vanishes at h = 1 / kappa_e). The
-// second catches what smoothing or a distorted layer does to the normals that the spline's
-// curvature does not see.
-std::vector<double> LimitingCurvature(const Layer& p, const Layer& normals,
-                                      const std::vector<double>& kappa, const Shape& s) {
-  std::vector<double> out = kappa;
+// One Jacobi sweep over the vertices (surface_topology.h's kinds): a shared vertex takes the
+// normalised sum of the (1 2 1) x (1 2 1) stencils of all its block points (each cut off at its
+// block's edges); a free-edge vertex the (1 2 1) mean along its edge; fixed ones keep theirs.
+void SmoothNormals(const March& m, Layer& normals) {
+  Layer sum(m.num_vertices(), Vec::Zero());
+  for (const BlockMarch& block : m.blocks) {
+    const Shape& s = block.s;
+    for (int j = 0; j < s.nj; ++j) {
+      for (int i = 0; i < s.ni; ++i) {
+        const int64_t v = block.V(i, j);
+        switch (m.topology.kind[v]) {
+          case VertexKind::kFixed:
+            break;
+          case VertexKind::kFreeEdge:
+            if (j == 0 || j == s.nj - 1) {
+              sum[v] = normals[block.V(i - 1, j)] + 2.0 * normals[v] + normals[block.V(i + 1, j)];
+            } else {
+              sum[v] = normals[block.V(i, j - 1)] + 2.0 * normals[v] + normals[block.V(i, j + 1)];
+            }
+            break;
+          case VertexKind::kShared:
+            for (int dj = -1; dj <= 1; ++dj) {
+              for (int di = -1; di <= 1; ++di) {
+                const int ii = i + di, jj = j + dj;
+                if (ii < 0 || jj < 0 || ii >= s.ni || jj >= s.nj) continue;
+                sum[v] += static_cast<double>((2 - std::abs(di)) * (2 - std::abs(dj))) *
+                          normals[block.V(ii, jj)];
+              }
+            }
+            break;
+        }
+      }
+    }
+  }
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    if (sum[v].norm() > 0.0) normals[v] = sum[v].normalized();
+  }
+  ProjectNormals(m, normals);
+}
+
+// The curvature each vertex's step is limited by (file comment): the fastest convergence of the
+// normals in use along a grid edge at the vertex, over the grid edges of every block,
+//   kappa_e = -(n_b - n_a).(x_b - x_a) / |x_b - x_a|^2;
+// zero where they diverge everywhere (convex).
+std::vector<double> LimitingCurvature(const March& m, const Layer& p, const Layer& normals) {
+  std::vector<double> out(m.num_vertices(), 0.0);
   auto edge = [&](int64_t a, int64_t b) {
     const Vec dx = p[b] - p[a];
     const double length2 = dx.squaredNorm();
@@ -206,72 +250,55 @@ std::vector<double> LimitingCurvature(const Layer& p, const Layer& normals,
     out[a] = std::max(out[a], converge);
     out[b] = std::max(out[b], converge);
   };
-  for (int j = 0; j < s.nj; ++j) {
-    for (int i = 0; i < s.ni; ++i) {
-      if (i + 1 < s.ni) edge(s.At(i, j), s.At(i + 1, j));
-      if (j + 1 < s.nj) edge(s.At(i, j), s.At(i, j + 1));
+  for (const BlockMarch& block : m.blocks) {
+    for (int j = 0; j < block.s.nj; ++j) {
+      for (int i = 0; i < block.s.ni; ++i) {
+        if (i + 1 < block.s.ni) edge(block.V(i, j), block.V(i + 1, j));
+        if (j + 1 < block.s.nj) edge(block.V(i, j), block.V(i, j + 1));
+      }
     }
   }
   return out;
 }
 
-// One Jacobi sweep: every normal not `fixed` becomes the normalised (1 2 1) x (1 2 1) weighted
-// mean of its 3 x 3 neighbourhood, on block edges the (1 2 1) mean along the edge.
-void SmoothNormals(Layer& normals, const Shape& s, const std::vector<char>& fixed) {
-  Layer next = normals;
-  for (int j = 0; j < s.nj; ++j) {
-    for (int i = 0; i < s.ni; ++i) {
-      const int64_t q = s.At(i, j);
-      if (fixed[q]) continue;
-      const bool edge_i = i == 0 || i == s.ni - 1, edge_j = j == 0 || j == s.nj - 1;
-      Vec m = Vec::Zero();
-      if (edge_j) {
-        m = normals[q - 1] + 2.0 * normals[q] + normals[q + 1];
-      } else if (edge_i) {
-        m = normals[q - s.ni] + 2.0 * normals[q] + normals[q + s.ni];
-      } else {
-        for (int dj = -1; dj <= 1; ++dj) {
-          for (int di = -1; di <= 1; ++di) {
-            m += static_cast<double>((2 - std::abs(di)) * (2 - std::abs(dj))) *
-                 normals[s.At(i + di, j + dj)];
-          }
-        }
-      }
-      if (m.norm() > 0.0) next[q] = m.normalized();
-    }
-  }
-  normals = std::move(next);
-}
-
-// The cells between layers p (below) and q (above): the smallest scaled corner Jacobian
+// A check of the cells between two layers: the smallest scaled corner Jacobian
 // side det[x_i, x_j, x_k] / (|x_i| |x_j| |x_k|) and the first cell with one <= 0.
 struct CellCheck {
   double min_scaled = 1.0;
   bool folded = false;
-  int i = 0, j = 0;
+  int block = 0, i = 0, j = 0;
 };
 
-CellCheck CheckCells(const Layer& p, const Layer& q, const Shape& s, int side) {
+// The cells of every block between vertex layers p (below) and q (above), each block with its
+// side: the smallest scaled corner Jacobian and the first block and cell with one <= 0.
+CellCheck CheckCells(const March& m, const Layer& p, const Layer& q) {
   CellCheck check;
   std::array<Vec, 8> x;
   std::array<std::array<Vec, 3>, 8> e;
-  for (int j = 0; j + 1 < s.nj; ++j) {
-    for (int i = 0; i + 1 < s.ni; ++i) {
-      for (int c = 0; c < 8; ++c) x[c] = (c & 4 ? q : p)[s.At(i + (c & 1), j + ((c >> 1) & 1))];
-      double longest = 0.0;
-      for (int c = 0; c < 8; ++c) {
-        e[c] = {x[c | 1] - x[c & ~1], x[c | 2] - x[c & ~2], x[c | 4] - x[c & ~4]};
-        for (const Vec& edge : e[c]) longest = std::max(longest, edge.norm());
-      }
-      for (int c = 0; c < 8; ++c) {
-        const double a = e[c][0].norm(), b = e[c][1].norm(), h = e[c][2].norm();
-        if (std::min({a, b, h}) <= kCollapsedCellEdge * longest) continue;
-        const double scaled = side * e[c][0].dot(e[c][1].cross(e[c][2])) / (a * b * h);
-        check.min_scaled = std::min(check.min_scaled, scaled);
-        if (!(scaled > 0.0) && !check.folded) {
-          check.folded = true;
-          check.i = i;
-          check.j = j;
+  for (size_t b = 0; b < m.blocks.size(); ++b) {
+    const BlockMarch& block = m.blocks[b];
+    const Shape& s = block.s;
+    for (int j = 0; j + 1 < s.nj; ++j) {
+      for (int i = 0; i + 1 < s.ni; ++i) {
+        for (int c = 0; c < 8; ++c) {
+          x[c] = (c & 4 ? q : p)[block.V(i + (c & 1), j + ((c >> 1) & 1))];
+        }
+        double longest = 0.0;
+        for (int c = 0; c < 8; ++c) {
+          e[c] = {x[c | 1] - x[c & ~1], x[c | 2] - x[c & ~2], x[c | 4] - x[c & ~4]};
+          for (const Vec& edge : e[c]) longest = std::max(longest, edge.norm());
+        }
+        for (int c = 0; c < 8; ++c) {
+          const double a = e[c][0].norm(), bb = e[c][1].norm(), h = e[c][2].norm();
+          if (std::min({a, bb, h}) <= kCollapsedCellEdge * longest) continue;
+          const double scaled = block.side * e[c][0].dot(e[c][1].cross(e[c][2])) / (a * bb * h);
+          check.min_scaled = std::min(check.min_scaled, scaled);
+          if (!(scaled > 0.0) && !check.folded) {
+            check.folded = true;
+            check.block = static_cast<int>(b);
+            check.i = i;
+            check.j = j;
+          }
         }
       }
     }
@@ -310,178 +337,235 @@ absl::StatusOr<TensorSpline> AddSplines(const TensorSpline& a, const TensorSplin
   return TensorSpline::Create(a.all_knots(), a.spatial_dim(), std::move(control));
 }
 
-// The size checks of OffsetSurface's input: a finite 3D surface block of at least 4 x 4 points.
-absl::Status CheckSurface(const StructuredBlock& surface) {
+// The size checks of a surface block: a finite 3D surface block of at least 4 x 4 points.
+absl::Status CheckSurface(const StructuredBlock& surface, const std::string& name) {
   const Extents& n = surface.extents();
   if (surface.spatial_dim() != 3) {
     return absl::InvalidArgumentError(
-        absl::StrCat("surface: spatial_dim = ", surface.spatial_dim(), "; a 3D surface is needed"));
+        absl::StrCat(name, ": spatial_dim = ", surface.spatial_dim(), "; a 3D surface is needed"));
   }
   if (n[2] != 1) {
-    return absl::InvalidArgumentError(absl::StrCat("surface: nk = ", n[2],
+    return absl::InvalidArgumentError(absl::StrCat(name, ": nk = ", n[2],
                                                    "; a surface block has nk = 1 (", n[0], " x ",
                                                    n[1], " x ", n[2], " given)"));
   }
   if (n[0] < 4 || n[1] < 4) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "surface: ", n[0], " x ", n[1], " points; at least 4 x 4 are needed for a cubic fit"));
+        name, ": ", n[0], " x ", n[1], " points; at least 4 x 4 are needed for a cubic fit"));
   }
-  return ValidateFinite(surface, "surface");
+  return ValidateFinite(surface, name);
 }
 
-// The points of `surface` as a layer, and into `*scale` its size (the bounding-box diagonal).
-absl::StatusOr<Layer> SurfacePoints(const StructuredBlock& surface, const Shape& s, double* scale) {
-  Layer p(s.size());
+// The k = 0 vertex layer: the mean of each vertex's block points (matched points may differ by
+// the matches' gap), on its symmetry plane; into `*scale` the surface's size (the bounding-box
+// diagonal).
+absl::StatusOr<Layer> SurfaceVertices(const MultiBlockGrid& surface, const SurfaceTopology& t,
+                                      double* scale) {
+  Layer sum(t.num_vertices, Vec::Zero());
+  std::vector<int> count(t.num_vertices, 0);
   Vec lo = Vec::Constant(HUGE_VAL), hi = Vec::Constant(-HUGE_VAL);
-  for (int64_t q = 0; q < s.size(); ++q) {
-    const double* x = surface.Point(q % s.ni, q / s.ni, 0);
-    p[q] = Vec(x[0], x[1], x[2]);
-    lo = lo.cwiseMin(p[q]);
-    hi = hi.cwiseMax(p[q]);
+  for (size_t b = 0; b < surface.blocks.size(); ++b) {
+    const StructuredBlock& block = surface.blocks[b];
+    for (int64_t q = 0; q < block.num_points(); ++q) {
+      const double* x = block.coords().data() + 3 * q;
+      const Vec point(x[0], x[1], x[2]);
+      sum[t.vertex[b][q]] += point;
+      ++count[t.vertex[b][q]];
+      lo = lo.cwiseMin(point);
+      hi = hi.cwiseMax(point);
+    }
   }
   *scale = (hi - lo).norm();
   if (!(*scale > 0.0)) {
     return absl::InvalidArgumentError("surface: all points coincide; there is no surface");
   }
-  return p;
+  for (int64_t v = 0; v < t.num_vertices; ++v) sum[v] /= static_cast<double>(count[v]);
+  return sum;
 }
 
-// The points whose normals are not smoothed: corners (no neighbours on both sides along an
-// edge) and collapsed edges.
-std::vector<char> UnsmoothedPoints(const Shape& s, const EdgeGroups& collapsed) {
-  std::vector<char> fixed(s.size(), 0);
-  for (int64_t q : {s.At(0, 0), s.At(s.ni - 1, 0), s.At(0, s.nj - 1), s.At(s.ni - 1, s.nj - 1)}) {
-    fixed[q] = 1;
-  }
-  for (const auto& edge : collapsed) {
-    for (int64_t q : edge) fixed[q] = 1;
-  }
-  return fixed;
-}
-
-// What OffsetSurface's layers share: the options, the layer shape, the collapsed edges, the
-// points not smoothed and the surface spline's parameters.
-struct MarchContext {
-  const SurfaceOffsetOptions& options;
-  Shape s;
-  const EdgeGroups& collapsed;
-  const std::vector<char>& fixed;
-  const std::array<std::vector<double>, 3>& params;
-};
-
-// One layer's steps: wanted (h plus the height denied earlier), taken (curvature limited), and
-// the curvature that limited them.
+// One layer's steps per vertex: wanted (h plus the height denied earlier), taken (curvature
+// limited), and the curvature that limited them.
 struct LayerSteps {
   std::vector<double> want, step, kappa;
 };
 
-// The steps of the layer above p along `normals` (LimitingCurvature with the spline's `kappa`),
-// the points of a collapsed edge all taking the smallest of theirs.
-void LimitedSteps(const Layer& p, const Layer& normals, const std::vector<double>& kappa, double h,
-                  const std::vector<double>& deficit, const MarchContext& c, LayerSteps& steps) {
-  // Curvature limit, with the height denied earlier carried over.
-  steps.kappa = LimitingCurvature(p, normals, kappa, c.s);
-  for (int64_t i = 0; i < c.s.size(); ++i) {
-    steps.want[i] = h + deficit[i];
-    steps.step[i] = steps.kappa[i] > 0.0
-                        ? std::min(steps.want[i], c.options.max_curvature_step / steps.kappa[i])
-                        : steps.want[i];
-  }
-  for (const auto& edge : c.collapsed) {
-    double common = HUGE_VAL;
-    for (int64_t i : edge) common = std::min(common, steps.step[i]);
-    for (int64_t i : edge) steps.step[i] = common;
+// The steps of the layer above p along `normals` (LimitingCurvature).
+void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h,
+                  const std::vector<double>& deficit, LayerSteps& steps) {
+  steps.kappa = LimitingCurvature(m, p, normals);
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    steps.want[v] = h + deficit[v];
+    steps.step[v] = steps.kappa[v] > 0.0
+                        ? std::min(steps.want[v], m.options.max_curvature_step / steps.kappa[v])
+                        : steps.want[v];
   }
 }
 
-// The layer q above p, its normals smoothed two more sweeps per retry (counted in `*retries`)
-// until its cells do not fold or max_retries is spent; the check of the last attempt.
-CellCheck OffsetWithRetries(const Layer& p, Geometry& geometry, double h,
-                            const std::vector<double>& deficit, const MarchContext& c,
-                            LayerSteps& steps, Layer& q, int* retries) {
-  Layer& normals = geometry.normal;
+// The layer q above p (at `height` above the surface, step h), its normals smoothed two more
+// sweeps per retry (counted in `*retries`) until its cells do not fold or max_retries is spent;
+// the check of the last attempt.
+CellCheck OffsetWithRetries(const March& m, const Layer& p, Layer& normals, double height, double h,
+                            const std::vector<double>& deficit, LayerSteps& steps, Layer& q,
+                            int* retries) {
   CellCheck check;
-  for (int attempt = 0; attempt <= c.options.max_retries; ++attempt) {
+  for (int attempt = 0; attempt <= m.options.max_retries; ++attempt) {
     if (attempt > 0) {
-      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(normals, c.s, c.fixed);
+      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(m, normals);
       ++*retries;
     }
-    LimitedSteps(p, normals, geometry.kappa, h, deficit, c, steps);
-    for (int64_t i = 0; i < c.s.size(); ++i) q[i] = p[i] + steps.step[i] * normals[i];
-    Unite(q, c.collapsed);
-    check = CheckCells(p, q, c.s, c.options.side);
+    LeanTowardsPlanes(m, p, height, normals);
+    LimitedSteps(m, p, normals, h, deficit, steps);
+    for (int64_t v = 0; v < m.num_vertices(); ++v) q[v] = p[v] + steps.step[v] * normals[v];
+    ProjectPoints(m, q);
+    check = CheckCells(m, p, q);
     if (!check.folded) break;
   }
   return check;
 }
 
+// "block 3 cell (4, 5)", or "cell (4, 5)" for a one-block surface.
+std::string CellName(const March& m, int block, int i, int j) {
+  return absl::StrCat(m.blocks.size() > 1 ? absl::StrCat("block ", block, " ") : "", "cell (", i,
+                      ", ", j, ")");
+}
+
 // The error for layer k + 1 (step h) folding at `check` after every retry: the curvature limit
 // is named when it held steps back.
-absl::Status FoldedLayerError(const CellCheck& check, int k, double h, const LayerSteps& steps,
-                              const SurfaceOffsetOptions& options) {
+absl::Status FoldedLayerError(const March& m, const CellCheck& check, int k, double h,
+                              const LayerSteps& steps) {
+  const SurfaceOffsetOptions& options = m.options;
   double held_back = 0.0;
-  for (size_t i = 0; i < steps.want.size(); ++i) {
-    held_back = std::max(held_back, steps.want[i] - steps.step[i]);
+  for (size_t v = 0; v < steps.want.size(); ++v) {
+    held_back = std::max(held_back, steps.want[v] - steps.step[v]);
   }
+  const std::string cell = CellName(m, check.block, check.i, check.j);
   if (held_back > 0.0) {
     return absl::FailedPreconditionError(absl::StrCat(
         "distance = ", options.distance, " is not reachable on the concave side: layer ", k + 1,
-        " folds at cell (", check.i, ", ", check.j,
-        ") while the curvature limit (max_curvature_step = ", options.max_curvature_step,
+        " folds at ", cell,
+        " while the curvature limit (max_curvature_step = ", options.max_curvature_step,
         ") holds its steps up to ", held_back, " short; lower the distance"));
   }
-  return absl::FailedPreconditionError(absl::StrCat(
-      "layer ", k + 1, " folds at cell (", check.i, ", ", check.j,
-      ") even with smoothed normals (step ", h, ", max_retries = ", options.max_retries,
-      "); use more layers, a smaller growth or a smoother surface"));
+  return absl::FailedPreconditionError(
+      absl::StrCat("layer ", k + 1, " folds at ", cell, " even with smoothed normals (step ", h,
+                   ", max_retries = ", options.max_retries,
+                   "); use more layers, a smaller growth or a smoother surface"));
 }
 
-// Fairs the displacement p -> q with weight `lambda` and adds its spline to `fit` (file
-// comment); q and `check` become the faired layer's unless it folds a cell, in which case the
-// interpolating displacement is added instead (counted in `*refits_dropped`).
-absl::Status FairLayer(const Layer& p, double lambda, const MarchContext& c, Layer& q,
-                       CellCheck& check, TensorSpline& fit, int* refits_dropped) {
-  const Shape& s = c.s;
-  Layer d(s.size());
-  for (int64_t i = 0; i < s.size(); ++i) d[i] = q[i] - p[i];
-  SG_ASSIGN_OR_RETURN(Displacement faired,
-                      FitDisplacement(d, s, c.params, fit.all_knots(), lambda, c.options.cancel));
-  for (int64_t i = 0; i < s.size(); ++i) faired.moved[i] += p[i];
-  Unite(faired.moved, c.collapsed);
-  if (const CellCheck faired_check = CheckCells(p, faired.moved, s, c.options.side);
-      !faired_check.folded) {
-    q = std::move(faired.moved);
+// Fairs the displacement p -> q of every block with weight `lambda` and adds its spline to the
+// block's (file comment); q becomes the mean of the blocks' faired points (so the blocks stay
+// watertight) unless a cell folds, in which case q stays and every block adds its interpolating
+// displacement instead (counted in `*refits_dropped`).
+absl::Status FairLayer(March& m, const Layer& p, double lambda, Layer& q, CellCheck& check,
+                       int* refits_dropped) {
+  std::vector<Displacement> faired;
+  Layer sum(m.num_vertices(), Vec::Zero());
+  std::vector<int> count(m.num_vertices(), 0);
+  for (const BlockMarch& block : m.blocks) {
+    Layer d(block.s.size());
+    for (int64_t i = 0; i < block.s.size(); ++i) {
+      const int64_t v = (*block.vertex)[i];
+      d[i] = q[v] - p[v];
+    }
+    SG_ASSIGN_OR_RETURN(
+        Displacement fit,
+        FitDisplacement(d, block.s, block.params, block.fit.all_knots(), lambda, m.options.cancel));
+    for (int64_t i = 0; i < block.s.size(); ++i) {
+      const int64_t v = (*block.vertex)[i];
+      sum[v] += p[v] + fit.moved[i];
+      ++count[v];
+    }
+    faired.push_back(std::move(fit));
+  }
+  for (int64_t v = 0; v < m.num_vertices(); ++v) sum[v] /= static_cast<double>(count[v]);
+  ProjectPoints(m, sum);
+  if (const CellCheck faired_check = CheckCells(m, p, sum); !faired_check.folded) {
+    q = std::move(sum);
     check = faired_check;
   } else {
     ++*refits_dropped;
-    SG_ASSIGN_OR_RETURN(faired,
-                        FitDisplacement(d, s, c.params, fit.all_knots(), 0.0, c.options.cancel));
+    for (size_t b = 0; b < m.blocks.size(); ++b) {
+      const BlockMarch& block = m.blocks[b];
+      Layer d(block.s.size());
+      for (int64_t i = 0; i < block.s.size(); ++i) {
+        const int64_t v = (*block.vertex)[i];
+        d[i] = q[v] - p[v];
+      }
+      SG_ASSIGN_OR_RETURN(faired[b], FitDisplacement(d, block.s, block.params,
+                                                     block.fit.all_knots(), 0.0, m.options.cancel));
+    }
   }
-  SG_ASSIGN_OR_RETURN(fit, AddSplines(fit, faired.spline));
+  for (size_t b = 0; b < m.blocks.size(); ++b) {
+    SG_ASSIGN_OR_RETURN(m.blocks[b].fit, AddSplines(m.blocks[b].fit, faired[b].spline));
+  }
   return absl::OkStatus();
 }
 
 // Counts the limited steps and carries the height they held back into `deficit`; refused as
 // soon as the height held back anywhere exceeds what the last layer may miss: towards a centre
 // of curvature it is not given back, and marching on only distorts the layers there.
-absl::Status CarryDeficit(const LayerSteps& steps, int k, const MarchContext& c,
+absl::Status CarryDeficit(const March& m, const LayerSteps& steps, int k,
                           std::vector<double>& deficit, SurfaceOffsetGrid& out) {
-  const SurfaceOffsetOptions& options = c.options;
-  for (int64_t i = 0; i < c.s.size(); ++i) {
-    if (steps.step[i] < steps.want[i]) ++out.limited_steps;
+  const SurfaceOffsetOptions& options = m.options;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    if (steps.step[v] < steps.want[v]) ++out.limited_steps;
+    deficit[v] = steps.want[v] - steps.step[v];
   }
-  for (int64_t i = 0; i < c.s.size(); ++i) deficit[i] = steps.want[i] - steps.step[i];
   const auto worst = std::max_element(deficit.begin(), deficit.end());
   out.shortfall = *worst;
   if (out.shortfall > options.max_shortfall * options.distance) {
     const int64_t at = worst - deficit.begin();
+    // The first block point of the vertex, to name it.
+    std::string point;
+    for (size_t b = 0; b < m.blocks.size() && point.empty(); ++b) {
+      const std::vector<int64_t>& vertex = *m.blocks[b].vertex;
+      const auto found = std::find(vertex.begin(), vertex.end(), at);
+      if (found == vertex.end()) continue;
+      const int64_t q = found - vertex.begin();
+      point =
+          absl::StrCat(m.blocks.size() > 1 ? absl::StrCat("block ", b, " ") : "", "surface point (",
+                       q % m.blocks[b].s.ni, ", ", q / m.blocks[b].s.ni, ")");
+    }
     return absl::FailedPreconditionError(absl::StrCat(
-        "distance = ", options.distance,
-        " cannot be reached on the concave side: at surface point (", at % c.s.ni, ", ",
-        at / c.s.ni, ") layer ", k + 1, " is ", out.shortfall,
+        "distance = ", options.distance, " cannot be reached on the concave side: at ", point,
+        " layer ", k + 1, " is ", out.shortfall,
         " short, its steps limited to max_curvature_step = ", options.max_curvature_step,
         " of the radius of curvature (", 1.0 / steps.kappa[at],
         " there); allowed: max_shortfall = ", options.max_shortfall, " of the distance"));
+  }
+  return absl::OkStatus();
+}
+
+// The sides of the blocks: the topology's times options.side, or outward.
+absl::StatusOr<std::vector<int>> BlockSides(const MultiBlockGrid& surface,
+                                            SurfaceTopology& topology,
+                                            const SurfaceOffsetOptions& options) {
+  if (options.outward) {
+    SG_RETURN_IF_ERROR(OrientOutward(surface, topology));
+    return topology.side;
+  }
+  std::vector<int> sides = topology.side;
+  for (int& side : sides) side *= options.side;
+  return sides;
+}
+
+// The surface spline of every block (faired: for normals and curvatures only, k = 0 is the
+// surface as given), whose parameters and knots every layer keeps.
+absl::Status FitSurfaceBlocks(const MultiBlockGrid& surface, const SurfaceTopology& topology,
+                              const std::vector<int>& sides, March& m) {
+  FitOptions fit_options;
+  fit_options.cancel = m.options.cancel;
+  fit_options.fairing = m.options.surface_fairing;
+  for (size_t b = 0; b < surface.blocks.size(); ++b) {
+    const StructuredBlock& block = surface.blocks[b];
+    SG_ASSIGN_OR_RETURN(const FittedBlock fitted, FitBlock(block, fit_options));
+    BlockMarch march;
+    march.s = Shape{block.extent(0), block.extent(1)};
+    march.side = sides[b];
+    march.params = {fitted.distribution.params(0), fitted.distribution.params(1), {0.0}};
+    march.fit = fitted.spline;
+    march.vertex = &topology.vertex[b];
+    m.blocks.push_back(std::move(march));
   }
   return absl::OkStatus();
 }
@@ -519,60 +603,78 @@ absl::Status SurfaceOffsetOptions::Validate() const {
   return absl::OkStatus();
 }
 
-absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
-                                                const SurfaceOffsetOptions& options) {
+absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surface,
+                                                    const Connectivity& connectivity,
+                                                    const SurfaceOffsetOptions& options) {
   SG_RETURN_IF_ERROR(options.Validate());
-  SG_RETURN_IF_ERROR(CheckSurface(surface));
-  const Shape s{surface.extent(0), surface.extent(1)};
-  double scale = 0.0;
-  SG_ASSIGN_OR_RETURN(Layer p, SurfacePoints(surface, s, &scale));
-  const EdgeGroups collapsed = CollapsedEdges(p, s, kCollapsed * scale);
-  const std::vector<char> fixed = UnsmoothedPoints(s, collapsed);
+  if (surface.blocks.empty()) return absl::InvalidArgumentError("surface: no blocks");
+  for (size_t b = 0; b < surface.blocks.size(); ++b) {
+    SG_RETURN_IF_ERROR(CheckSurface(surface.blocks[b], surface.blocks.size() > 1
+                                                           ? absl::StrCat("surface block ", b)
+                                                           : std::string("surface")));
+  }
+  SG_ASSIGN_OR_RETURN(SurfaceTopology topology,
+                      BuildSurfaceTopology(surface, connectivity, options.symmetry_planes));
+  SG_ASSIGN_OR_RETURN(const std::vector<int> sides, BlockSides(surface, topology, options));
+  March m{options, topology, {}, 0.0};
+  SG_ASSIGN_OR_RETURN(Layer p, SurfaceVertices(surface, topology, &m.scale));
+  ProjectPoints(m, p);
+  SG_RETURN_IF_ERROR(FitSurfaceBlocks(surface, topology, sides, m));
 
   SurfaceOffsetGrid out;
+  out.sides = sides;
+  out.symmetry_planes = topology.planes;
+  out.surface_gap = topology.max_gap;
+  out.components = topology.components;
   out.growth_ratio = GeometricRatio(options.first_height, options.distance, options.layers);
-  out.block = StructuredBlock({s.ni, s.nj, options.layers + 1}, 3);
+  for (const BlockMarch& block : m.blocks) {
+    out.blocks.emplace_back(Extents{block.s.ni, block.s.nj, options.layers + 1}, 3);
+  }
   auto store = [&](int k) {
-    for (int64_t q = 0; q < s.size(); ++q) {
-      std::copy(p[q].data(), p[q].data() + 3, out.block.Point(q % s.ni, q / s.ni, k));
+    for (size_t b = 0; b < m.blocks.size(); ++b) {
+      const BlockMarch& block = m.blocks[b];
+      for (int64_t q = 0; q < block.s.size(); ++q) {
+        const Vec& x = p[(*block.vertex)[q]];
+        std::copy(x.data(), x.data() + 3, out.blocks[b].Point(q % block.s.ni, q / block.s.ni, k));
+      }
     }
   };
   store(0);
-  // The surface's (faired) spline, for normals and curvatures only: k = 0 is the surface as
-  // given, and every layer keeps its parameters and knots.
-  FitOptions fit_options;
-  fit_options.cancel = options.cancel;
-  fit_options.fairing = options.surface_fairing;
-  SG_ASSIGN_OR_RETURN(const FittedBlock surface_fit, FitBlock(surface, fit_options));
-  const std::array<std::vector<double>, 3> params = {
-      surface_fit.distribution.params(0), surface_fit.distribution.params(1), {0.0}};
-  const MarchContext c{options, s, collapsed, fixed, params};
-  TensorSpline fit = surface_fit.spline;
-  std::vector<double> deficit(s.size(), 0.0);
-  LayerSteps steps{std::vector<double>(s.size()), std::vector<double>(s.size()),
-                   std::vector<double>(s.size(), 0.0)};
-  Layer q(s.size());
+  const int64_t nv = m.num_vertices();
+  std::vector<double> deficit(nv, 0.0);
+  LayerSteps steps{std::vector<double>(nv), std::vector<double>(nv), std::vector<double>(nv, 0.0)};
+  Layer q(nv);
+  double height = 0.0;  // of layer k above the surface (nominal)
   for (int k = 0; k < options.layers; ++k) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     const double h = options.first_height * std::pow(out.growth_ratio, k);
     out.steps.push_back(h);
     const double fraction = static_cast<double>(k + 1) / options.layers;
-    SG_ASSIGN_OR_RETURN(Geometry geometry,
-                        LayerGeometry(fit, params, s, options.side, scale, collapsed));
+    SG_ASSIGN_OR_RETURN(Layer normals, VertexNormals(m));
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
-    for (int t = 0; t < sweeps; ++t) SmoothNormals(geometry.normal, s, fixed);
-    CellCheck check = OffsetWithRetries(p, geometry, h, deficit, c, steps, q, &out.retries);
-    if (check.folded) return FoldedLayerError(check, k, h, steps, options);
+    for (int t = 0; t < sweeps; ++t) SmoothNormals(m, normals);
+    CellCheck check =
+        OffsetWithRetries(m, p, normals, height + h, h, deficit, steps, q, &out.retries);
+    if (check.folded) return FoldedLayerError(m, check, k, h, steps);
     // Fair the displacement and add its spline to the layer's (file comment); a faired
     // displacement that folds a cell is dropped for the interpolating one.
-    SG_RETURN_IF_ERROR(
-        FairLayer(p, options.fairing * fraction, c, q, check, fit, &out.refits_dropped));
+    SG_RETURN_IF_ERROR(FairLayer(m, p, options.fairing * fraction, q, check, &out.refits_dropped));
     out.min_scaled_jacobian = std::min(out.min_scaled_jacobian, check.min_scaled);
-    SG_RETURN_IF_ERROR(CarryDeficit(steps, k, c, deficit, out));
+    SG_RETURN_IF_ERROR(CarryDeficit(m, steps, k, deficit, out));
+    height += h;
     std::swap(p, q);
     store(k + 1);
   }
   return out;
+}
+
+absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
+                                                const SurfaceOffsetOptions& options) {
+  SG_RETURN_IF_ERROR(CheckSurface(surface, "surface"));
+  MultiBlockGrid grid;
+  grid.blocks.push_back(surface);
+  SG_ASSIGN_OR_RETURN(const Connectivity connectivity, FindConnectivity(grid));
+  return OffsetSurfaceGrid(grid, connectivity, options);
 }
 
 }  // namespace splinegrid
