@@ -105,14 +105,20 @@ std::vector<CommandSpec> MakeCommands() {
         "check_level", "propagation", "decay_radius", "rigid_radius", "smoothing"},
        {"A fold is FAILED_PRECONDITION (exit 1), nothing stored."}},
       {"offset",
-       "offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] [--points 257] "
-       "[--method offsets|transfinite|elliptic] [--tol T | --kinds ... | --ctl a,b,c] "
+       "offset FILE.dat|SURFACE [--name N] [--layers 128] [--first 1e-5] [--far 50] "
+       "[--points 257] [--method offsets|transfinite|elliptic] [--side outward|along|against] "
+       "[--normal_smoothing 80] [--symmetry=false] [--tol T | --kinds ... | --ctl a,b,c] "
        "[-o OUT.{vts,vtm,x,xyz,cgns}]",
-       "an O-grid around an airfoil file (GenerateGrid), stored and fitted",
+       "an O-grid around an airfoil file, or a volume grid off a stored surface grid "
+       "(GenerateGrid), stored and fitted",
        /*client=*/true,
        {"name", "o", "layers", "first", "far", "points", "method", "orthogonalize", "profile_tol",
-        SG_FIT_SPEC_FLAGS},
-       {"The profile file is Selig or Lednicer; -o writes the grid at level 0."}},
+        "side", "normal_smoothing", "symmetry", SG_FIT_SPEC_FLAGS},
+       {"The profile file is Selig or Lednicer. An argument that is no file (or grids/NAME) names "
+        "a "
+        "stored grid of 3D surface blocks: hexahedral layers are marched off all its blocks (k "
+        "outward), "
+        "watertight; the new grid is NAME-volume unless --name. -o writes the grid at level 0."}},
       {"watch",
        "watch NAME [--after R]",
        "one line per new revision of a grid until ^C or its deletion",

@@ -43,12 +43,12 @@ std::string DescribeFlag(const std::string& name) {
 }  // namespace
 
 std::string OverviewHelp(absl::string_view version) {
-  std::string out = absl::StrCat(
-      "splinegrid ", version,
-      ": structured CFD grids as B-spline mappings, served over gRPC.\n\n"
-      "usage: splinegrid COMMAND [ARGUMENTS] [FLAGS]\n"
-      "       splinegrid help COMMAND   (or splinegrid COMMAND --help): its flags\n"
-      "       splinegrid --version\n\nCommands:\n");
+  std::string out =
+      absl::StrCat("splinegrid ", version,
+                   ": structured CFD grids as B-spline mappings, served over gRPC.\n\n"
+                   "usage: splinegrid COMMAND [ARGUMENTS] [FLAGS]\n"
+                   "       splinegrid help COMMAND   (or splinegrid COMMAND --help): its flags\n"
+                   "       splinegrid --version\n\nCommands:\n");
   size_t width = 0;
   for (const CommandSpec& command : Commands()) width = std::max(width, command.name.size());
   for (const CommandSpec& command : Commands()) {
@@ -67,8 +67,8 @@ std::string OverviewHelp(absl::string_view version) {
 }
 
 std::string CommandHelp(const CommandSpec& command) {
-  std::string out = absl::StrCat("usage: splinegrid ", command.usage, "\n",
-                                 Wrap(command.summary, "  "));
+  std::string out =
+      absl::StrCat("usage: splinegrid ", command.usage, "\n", Wrap(command.summary, "  "));
   for (const std::string& note : command.notes) absl::StrAppend(&out, Wrap(note, "  "));
   if (!command.flags.empty()) absl::StrAppend(&out, "\nFlags:\n");
   for (const std::string& name : command.flags) absl::StrAppend(&out, DescribeFlag(name));

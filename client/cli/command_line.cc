@@ -59,9 +59,8 @@ absl::Status ForeignOrUnknownFlag(const GivenFlag& flag, const CommandSpec& comm
       whose = Contains(owners, "serve") ? "the commands that talk to a server, and serve"
                                         : "the commands that talk to a server";
     }
-    return absl::InvalidArgumentError(absl::StrCat(flag.spelled, " is not a flag of ",
-                                                   command.name, "; it belongs to ", whose,
-                                                   help));
+    return absl::InvalidArgumentError(absl::StrCat(flag.spelled, " is not a flag of ", command.name,
+                                                   "; it belongs to ", whose, help));
   }
   std::string message = absl::StrCat("unknown flag ", flag.spelled, " for ", command.name);
   if (const std::string close = ClosestName(flag.name, AcceptedFlags(command)); !close.empty()) {

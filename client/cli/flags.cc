@@ -119,11 +119,12 @@ ABSL_FLAG(double, rigid_radius, 0.0,
 ABSL_FLAG(int, smoothing, 0, "deform: Laplacian smoothing sweeps of the interior (0: none)");
 
 ABSL_FLAG(std::optional<int>, layers, std::nullopt,
-          "offset: cells outward from the wall (default: the server's, 128)");
+          "offset: cells outward from the wall (default: the server's, 128; a surface 32)");
 ABSL_FLAG(std::optional<double>, first, std::nullopt,
-          "offset: height of the first layer, in the profile's unit (default 1e-5)");
+          "offset: height of the first layer, in the profile's unit (default 1e-5; a surface "
+          "1e-3)");
 ABSL_FLAG(std::optional<double>, far, std::nullopt,
-          "offset: distance of the outermost layer from the wall (default 50)");
+          "offset: distance of the outermost layer from the wall (default 50; a surface 0.5)");
 ABSL_FLAG(std::optional<int>, points, std::nullopt,
           "offset: wall points around the profile, the first repeated as the last (default 257)");
 ABSL_FLAG(std::string, method, "",
@@ -132,6 +133,13 @@ ABSL_FLAG(std::optional<bool>, orthogonalize, std::nullopt,
           "offset --method transfinite: grid lines leave the wall normally (default true)");
 ABSL_FLAG(std::optional<double>, profile_tol, std::nullopt,
           "offset: largest distance of the profile spline from the file's points (default 1e-4)");
+ABSL_FLAG(std::string, side, "",
+          "offset SURFACE: outward (default: away from the volume the surface bounds), along or "
+          "against (the first block's i x j normal)");
+ABSL_FLAG(std::optional<int>, normal_smoothing, std::nullopt,
+          "offset SURFACE: smoothing sweeps of the normals at the last layer (default 80)");
+ABSL_FLAG(std::optional<bool>, symmetry, std::nullopt,
+          "offset SURFACE: free edges on a coordinate plane stay on it (default true)");
 
 ABSL_FLAG(int64_t, after, 0,
           "watch: send the revisions after this one (0: every stored one, -1: only new ones)");

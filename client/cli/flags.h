@@ -81,6 +81,9 @@ ABSL_DECLARE_FLAG(std::optional<int>, points);
 ABSL_DECLARE_FLAG(std::string, method);
 ABSL_DECLARE_FLAG(std::optional<bool>, orthogonalize);
 ABSL_DECLARE_FLAG(std::optional<double>, profile_tol);
+ABSL_DECLARE_FLAG(std::string, side);
+ABSL_DECLARE_FLAG(std::optional<int>, normal_smoothing);
+ABSL_DECLARE_FLAG(std::optional<bool>, symmetry);
 // watch
 ABSL_DECLARE_FLAG(int64_t, after);
 // health

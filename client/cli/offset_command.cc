@@ -1,4 +1,5 @@
-// `splinegrid offset`: an O-grid generated around an airfoil file's profile (GenerateGrid).
+// `splinegrid offset`: an O-grid generated around an airfoil file's profile, or a volume grid
+// marched off a stored surface grid (GenerateGrid).
 #include <filesystem>
 
 #include "absl/flags/flag.h"
@@ -16,22 +17,51 @@
 
 namespace splinegrid::cli {
 
+namespace {
+
+// The profile (an airfoil file) or, for an argument that is no file (or starts with grids/),
+// the stored surface grid;
+// the new grid's id (--name, else from the file or the surface's id) and display name.
+absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& request) {
+  const std::string& name = absl::GetFlag(FLAGS_name);
+  if (!argument.starts_with("grids/") && std::filesystem::is_regular_file(argument)) {
+    request.set_grid_id(name.empty() ? IdFromPath(argument) : client::GridName(name).substr(6));
+    request.set_display_name(std::filesystem::path(argument).filename().string());
+    SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(argument));
+    return absl::OkStatus();
+  }
+  const std::string surface = client::GridName(argument);
+  request.mutable_stored_surface()->set_name(surface);
+  request.set_grid_id(name.empty() ? absl::StrCat(surface.substr(6), "-volume")
+                                   : client::GridName(name).substr(6));
+  const std::string side = absl::AsciiStrToLower(absl::GetFlag(FLAGS_side));
+  if (side == "along") {
+    request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);
+  } else if (side == "against") {
+    request.set_side(v1::MARCH_SIDE_AGAINST_NORMAL);
+  } else if (!side.empty() && side != "outward") {
+    return Usage(
+        absl::StrCat("--side = '", absl::GetFlag(FLAGS_side), "': give outward, along or against"));
+  }
+  if (const auto v = absl::GetFlag(FLAGS_normal_smoothing)) request.set_normal_smoothing(*v);
+  if (const auto v = absl::GetFlag(FLAGS_symmetry)) request.set_symmetry_planes(*v);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status Offset(const Args& args) {
   constexpr char kUsage[] =
-      "usage: splinegrid offset FILE.dat [--name N] [--layers 128] [--first 1e-5] [--far 50] "
-      "[--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
-      "[--profile_tol T] "
+      "usage: splinegrid offset FILE.dat|SURFACE [--name N] [--layers 128] [--first 1e-5] "
+      "[--far 50] [--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
+      "[--profile_tol T] [--side outward|along|against] [--normal_smoothing 80] "
+      "[--symmetry=false] "
       "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,vtm,x,xyz,cgns}]";
   if (args.size() != 1) return Usage(kUsage);
-  const std::string& path = args[0];
   const std::string out = absl::GetFlag(FLAGS_o);
   if (!out.empty()) SG_RETURN_IF_ERROR(CheckGridOutput(out));
   v1::GenerateGridRequest request;
-  request.set_grid_id(absl::GetFlag(FLAGS_name).empty()
-                          ? IdFromPath(path)
-                          : client::GridName(absl::GetFlag(FLAGS_name)).substr(6));
-  request.set_display_name(std::filesystem::path(path).filename().string());
-  SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(path));
+  SG_RETURN_IF_ERROR(SetSource(args[0], request));
   const std::string method = absl::AsciiStrToLower(absl::GetFlag(FLAGS_method));
   if (method == "offsets") {
     request.set_method(v1::LAYER_METHOD_OFFSETS);
@@ -60,7 +90,8 @@ absl::Status Offset(const Args& args) {
   request.set_allow_folds(absl::GetFlag(FLAGS_allow_folds));
   auto client = Connect();
   SG_ASSIGN_OR_RETURN(const v1::GenerateGridResponse response, client->Generate(request));
-  std::string human = FormatGenerate(response);
+  std::string human =
+      request.has_stored_surface() ? FormatGenerateVolume(response) : FormatGenerate(response);
   if (!out.empty()) {
     v1::EvaluateGridRequest evaluate;
     evaluate.set_name(response.grid().name());

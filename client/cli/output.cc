@@ -99,8 +99,8 @@ std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c)
 // "wall 0.000137 <= 0.00015 met, interface ..., interior 0.205 (no tolerance)": the largest
 // deviation of each kind over `blocks`, against the tolerance the fit was held to where one was
 // asked (FitReport.tolerances); "met" only there.
-std::string FormatKindDeviations(const v1::FitReport& r,
-                                 const google::protobuf::RepeatedPtrField<v1::BlockFitSummary>& blocks) {
+std::string FormatKindDeviations(
+    const v1::FitReport& r, const google::protobuf::RepeatedPtrField<v1::BlockFitSummary>& blocks) {
   struct Kind {
     const char* name;
     bool has = false;
@@ -129,11 +129,12 @@ std::string FormatKindDeviations(const v1::FitReport& r,
     if (!out.empty()) absl::StrAppend(&out, ", ");
     if (k.tolerance > 0.0) {
       const bool met = k.deviation <= k.tolerance;
-      absl::StrAppend(&out, absl::StrFormat("%s %.3g %s %.3g %s", k.name, k.deviation,
-                                            met ? "<=" : ">", k.tolerance, met ? "met" : "NOT MET"));
+      absl::StrAppend(&out,
+                      absl::StrFormat("%s %.3g %s %.3g %s", k.name, k.deviation, met ? "<=" : ">",
+                                      k.tolerance, met ? "met" : "NOT MET"));
     } else {
-      absl::StrAppend(&out, absl::StrFormat("%s %.3g%s", k.name, k.deviation,
-                                            held ? " (no tolerance)" : ""));
+      absl::StrAppend(
+          &out, absl::StrFormat("%s %.3g%s", k.name, k.deviation, held ? " (no tolerance)" : ""));
     }
   }
   return out;
@@ -253,6 +254,43 @@ std::string FormatGenerate(const v1::GenerateGridResponse& response) {
                                         "ms, measure %.1f ms\n",
                                         1e3 * r.fit_seconds(), 1e3 * r.wall_seconds(),
                                         1e3 * r.layer_seconds(), 1e3 * r.measure_seconds()));
+  absl::StrAppend(&out, FormatFit(response.grid().name(), response.fit()));
+  return out;
+}
+
+std::string FormatGenerateVolume(const v1::GenerateGridResponse& response) {
+  const v1::GenerationReport& r = response.report();
+  const v1::GenerateGridRequest& p = r.parameters();
+  const v1::VolumeReport& v = r.volume();
+  int64_t points = 0;
+  for (const v1::Extents& e : v.block_extents()) points += int64_t{e.i()} * e.j() * e.k();
+  std::string out =
+      absl::StrFormat("%s: volume grid of %d blocks, %d points, marched %s, %.1f ms\n",
+                      response.grid().name(), v.blocks(), points,
+                      p.side() == v1::MARCH_SIDE_OUTWARD        ? "outward"
+                      : p.side() == v1::MARCH_SIDE_ALONG_NORMAL ? "along the normals"
+                                                                : "against the normals",
+                      1e3 * r.seconds());
+  std::string planes;
+  for (const v1::SymmetryPlane& plane : v.symmetry_planes()) {
+    absl::StrAppend(&planes, planes.empty() ? "" : ", ", plane.axis(), " = ", plane.value());
+  }
+  int reversed = 0;
+  for (bool b : v.reversed_i()) reversed += b ? 1 : 0;
+  absl::StrAppend(&out,
+                  absl::StrFormat("  layers: %d, first height %.3g, distance %.4g, growth "
+                                  "ratio %.5f, normal smoothing %d, %d retries, %.1f ms\n",
+                                  p.layers(), p.first_height(), p.distance(), r.growth_ratio(),
+                                  p.normal_smoothing(), r.retries(), 1e3 * r.layer_seconds()));
+  absl::StrAppend(
+      &out,
+      absl::StrFormat("  surface: %d connected, gap %.3g, symmetry planes: %s; %d blocks "
+                      "with i reversed (right-handed cells)\n",
+                      v.components(), v.surface_gap(), planes.empty() ? "none" : planes, reversed));
+  absl::StrAppend(&out, absl::StrFormat("  quality: min scaled Jacobian %.3g, %d limited steps, "
+                                        "shortfall %.3g, %d faired layers dropped\n",
+                                        v.min_scaled_jacobian(), v.limited_steps(), v.shortfall(),
+                                        v.refits_dropped()));
   absl::StrAppend(&out, FormatFit(response.grid().name(), response.fit()));
   return out;
 }

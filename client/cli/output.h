@@ -22,6 +22,8 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit);
 // A generated grid: the generation report (profile fit, layers, quality, stage times), then
 // its revision 1 as FormatFit prints it.
 std::string FormatGenerate(const v1::GenerateGridResponse& response);
+// A volume grid marched off a stored surface.
+std::string FormatGenerateVolume(const v1::GenerateGridResponse& response);
 
 // One grid: source, revisions, blocks.
 std::string FormatGrid(const v1::Grid& grid);

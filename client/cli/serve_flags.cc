@@ -19,7 +19,7 @@ constexpr int64_t kMaxBudgetMb = int64_t{1} << 30;  // 1 PiB; << 20 stays below 
 constexpr int64_t kMaxCount = int64_t{1} << 40;
 constexpr int64_t kMaxPerPrincipal = 1'000'000;
 constexpr int64_t kMaxDecoderMb = int64_t{1} << 20;  // 1 TiB of address space
-constexpr int64_t kMaxSeconds = 24 * 3600;            // a day of CPU or wall time
+constexpr int64_t kMaxSeconds = 24 * 3600;           // a day of CPU or wall time
 
 absl::Status CheckRange(const char* flag, int64_t value, int64_t lo, int64_t hi,
                         const char* meaning = "") {
@@ -56,8 +56,7 @@ absl::Status CheckServeFlags(server::LogFormat* format) {
   SG_RETURN_IF_ERROR(CheckRange("cgns_decoder_cpu_seconds",
                                 absl::GetFlag(FLAGS_cgns_decoder_cpu_seconds), 1, kMaxSeconds));
   SG_RETURN_IF_ERROR(CheckRange("cgns_decoder_timeout_seconds",
-                                absl::GetFlag(FLAGS_cgns_decoder_timeout_seconds), 1,
-                                kMaxSeconds));
+                                absl::GetFlag(FLAGS_cgns_decoder_timeout_seconds), 1, kMaxSeconds));
   SG_RETURN_IF_ERROR(
       CheckRange("max_output_points", absl::GetFlag(FLAGS_max_output_points), 1, kMaxCount));
   SG_RETURN_IF_ERROR(
@@ -78,8 +77,7 @@ absl::Status CheckServeFlags(server::LogFormat* format) {
   SG_RETURN_IF_ERROR(CheckDuration("import_idle_timeout", absl::GetFlag(FLAGS_import_idle_timeout),
                                    absl::Hours(24 * 365)));
   if (const std::string metrics = absl::GetFlag(FLAGS_metrics_address); !metrics.empty()) {
-    SG_RETURN_IF_ERROR(
-        server::CheckMetricsAddress(metrics, absl::GetFlag(FLAGS_metrics_insecure)));
+    SG_RETURN_IF_ERROR(server::CheckMetricsAddress(metrics, absl::GetFlag(FLAGS_metrics_insecure)));
   }
   const std::string log_format = absl::GetFlag(FLAGS_log_format);
   if (log_format == "text") {

@@ -1,6 +1,8 @@
 #include "proto/convert/generate_convert.h"
 
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
@@ -106,6 +108,77 @@ void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int
   out->set_wall_seconds(grid.wall_seconds);
   out->set_layer_seconds(grid.layer_seconds);
   out->set_measure_seconds(grid.measure_seconds);
+}
+
+absl::StatusOr<SurfaceOffsetOptions> ParseSurfaceOffsetOptions(
+    const v1::GenerateGridRequest& request) {
+  if (request.method() != v1::LAYER_METHOD_UNSPECIFIED &&
+      request.method() != v1::LAYER_METHOD_OFFSETS) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "method = ", v1::LayerMethod_Name(request.method()),
+        ": layers off a surface are marched (OFFSETS); transfinite and elliptic grids are made "
+        "around profiles only"));
+  }
+  for (const auto& [set, field] : {std::pair{request.has_wall_points(), "wall_points"},
+                                   std::pair{request.has_orthogonalize(), "orthogonalize"},
+                                   std::pair{request.has_fit_tolerance(), "fit_tolerance"}}) {
+    if (set) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, " is set: it applies to profiles; a stored_surface keeps its own points"));
+    }
+  }
+  SurfaceOffsetOptions options;
+  if (request.has_layers()) options.layers = request.layers();
+  if (request.has_first_height()) options.first_height = request.first_height();
+  if (request.has_distance()) options.distance = request.distance();
+  switch (request.side()) {
+    case v1::MARCH_SIDE_OUTWARD:
+      options.outward = true;
+      break;
+    case v1::MARCH_SIDE_ALONG_NORMAL:
+      options.side = +1;
+      break;
+    case v1::MARCH_SIDE_AGAINST_NORMAL:
+      options.side = -1;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("side = ", static_cast<int>(request.side()), " is not a known value"));
+  }
+  if (request.has_normal_smoothing()) options.normal_smoothing = request.normal_smoothing();
+  if (request.has_symmetry_planes()) options.symmetry_planes = request.symmetry_planes();
+  SG_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
+
+void EncodeSurfaceOffsetOptions(const SurfaceOffsetOptions& options, v1::GenerateGridRequest* out) {
+  out->set_method(v1::LAYER_METHOD_OFFSETS);
+  out->set_layers(options.layers);
+  out->set_first_height(options.first_height);
+  out->set_distance(options.distance);
+  out->set_side(options.outward    ? v1::MARCH_SIDE_OUTWARD
+                : options.side > 0 ? v1::MARCH_SIDE_ALONG_NORMAL
+                                   : v1::MARCH_SIDE_AGAINST_NORMAL);
+  out->set_normal_smoothing(options.normal_smoothing);
+  out->set_symmetry_planes(options.symmetry_planes);
+}
+
+void EncodeVolumeReport(const SurfaceOffsetGrid& grid, const std::vector<Extents>& extents,
+                        const std::vector<bool>& reversed_i, v1::VolumeReport* out) {
+  out->set_blocks(static_cast<int32_t>(extents.size()));
+  for (const Extents& e : extents) EncodeExtents(e, out->add_block_extents());
+  for (bool reversed : reversed_i) out->add_reversed_i(reversed);
+  for (const SymmetryPlane& plane : grid.symmetry_planes) {
+    v1::SymmetryPlane* p = out->add_symmetry_planes();
+    p->set_axis(std::string(1, "xyz"[plane.axis]));
+    p->set_value(plane.value);
+  }
+  out->set_components(grid.components);
+  out->set_surface_gap(grid.surface_gap);
+  out->set_refits_dropped(grid.refits_dropped);
+  out->set_limited_steps(grid.limited_steps);
+  out->set_shortfall(grid.shortfall);
+  out->set_min_scaled_jacobian(grid.min_scaled_jacobian);
 }
 
 }  // namespace splinegrid

@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/generate/profile_grid.h"
+#include "core/generate/surface_offset.h"
 #include "core/grid/structured_grid.h"
 #include "splinegrid/v1/splinegrid_service.pb.h"
 
@@ -29,6 +30,20 @@ absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& poin
 // apart from `parameters` and `seconds`.
 void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int64_t profile_points,
                             v1::GenerationReport* out);
+
+// The march parameters of a stored_surface request (layers, first_height, distance, side,
+// normal_smoothing, symmetry_planes): unset fields keep the kernel's defaults; INVALID_ARGUMENT
+// naming the field for a bad value or a field that applies to profiles only (method other than
+// OFFSETS, wall_points, orthogonalize, fit_tolerance).
+absl::StatusOr<SurfaceOffsetOptions> ParseSurfaceOffsetOptions(
+    const v1::GenerateGridRequest& request);
+
+// The march parameters actually used, as the request fields.
+void EncodeSurfaceOffsetOptions(const SurfaceOffsetOptions& options, v1::GenerateGridRequest* out);
+
+// The march's report (`grid`'s blocks may have been moved on: their extents are `extents`).
+void EncodeVolumeReport(const SurfaceOffsetGrid& grid, const std::vector<Extents>& extents,
+                        const std::vector<bool>& reversed_i, v1::VolumeReport* out);
 
 }  // namespace splinegrid
 

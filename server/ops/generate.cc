@@ -9,8 +9,7 @@
 #include "core/grid/connectivity.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
-#include "server/grid_id.h"
-#include "server/ops/fit.h"
+#include "server/ops/generated_grid.h"
 
 namespace splinegrid::server::ops {
 namespace {
@@ -100,30 +99,14 @@ int64_t GeneratedPoints(const ProfileGridOptions& options) {
   return int64_t{options.wall_points} * (int64_t{options.layers} + 1);
 }
 
-// The checks that need no work: the id, the name, the size.
-absl::Status CheckRequest(const OpsContext& context, const GenerateRequest& request) {
-  const std::string& id = request.grid_id;
-  SG_RETURN_IF_ERROR(CheckRequestedGridId(id, "grid_id"));
-  if (request.display_name.size() > 1024) {
-    return absl::InvalidArgumentError("display_name is longer than 1024 bytes");
-  }
-  if (!id.empty() && context.store.Get(id).ok()) {  // fail early; Create decides in the end
-    return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
-  }
-  const int64_t points = GeneratedPoints(request.options);
-  if (points > request.max_points) {
-    return absl::OutOfRangeError(absl::StrCat("wall_points * (layers + 1) = ", points,
-                                              " points, more than the server's cap of ",
-                                              request.max_points, " (flag --max_output_points)"));
-  }
-  return absl::OkStatus();
-}
-
 }  // namespace
 
 absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateRequest request,
                                         const CancelCheck& cancel) {
-  SG_RETURN_IF_ERROR(CheckRequest(context, request));
+  const NewGridHeader header{request.grid_id, request.display_name, request.owner};
+  const int64_t points = GeneratedPoints(request.options);
+  SG_RETURN_IF_ERROR(
+      CheckNewGrid(context, header, points, "wall_points * (layers + 1)", request.max_points));
   const GridFitOptions fit_options = GeneratedFitOptions(request);
   const bool bare_points = std::holds_alternative<ProfilePoints>(request.profile) &&
                            std::get<ProfilePoints>(request.profile).name.empty();
@@ -137,7 +120,6 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
   // The generated block, as the source points of the new grid.
   GenerateResult result;
   auto source = std::make_shared<SourcePoints>();
-  const int64_t points = GeneratedPoints(request.options);
   SG_ASSIGN_OR_RETURN(source->memory, context.budget.Reserve(points * 2 * int64_t{sizeof(double)},
                                                              "the generated grid"));
   request.options.cancel = cancel;
@@ -157,20 +139,8 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
                                    bare_points ? "points" : absl::StrCat("'", profile.name, "'"));
   MultiBlockGrid generated_grid;
   generated_grid.blocks.push_back(std::move(result.generated.block));
-  SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(generated_grid)));
-
-  SG_ASSIGN_OR_RETURN(GridRevision revision,
-                      FitRevision(context, *source, fit_options, RevisionOrigin::kFit, 0, cancel));
-  revision.number = 1;
-  auto grid = std::make_shared<StoredGrid>();
-  grid->display_name = request.display_name.empty() ? profile.name : request.display_name;
-  grid->owner = request.owner;
-  grid->create_time = absl::Now();
-  grid->source = std::move(source);
-  grid->revisions.push_back(std::make_shared<const GridRevision>(std::move(revision)));
-  SG_RETURN_IF_ERROR(PollCancel(cancel));
-  SG_RETURN_IF_ERROR(CreateGrid(context.store, request.grid_id, grid));
-  result.grid = std::move(grid);
+  SG_ASSIGN_OR_RETURN(result.grid, StoreGenerated(context, header, profile.name, std::move(source),
+                                                  std::move(generated_grid), fit_options, cancel));
   result.options = request.options;
   result.options.cancel = {};
   result.profile_name = std::move(profile.name);

@@ -1,0 +1,45 @@
+// What both GenerateGrid operations (generate.h: around a profile; generate_volume.h: off a
+// surface) do with their new grid: check the request's id, name and size before the work, and
+// afterwards store the generated blocks as the new grid's source points, fitted as revision 1.
+#ifndef SPLINEGRID_SERVER_OPS_GENERATED_GRID_H_
+#define SPLINEGRID_SERVER_OPS_GENERATED_GRID_H_
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/fit/grid_fit.h"
+#include "core/grid/structured_grid.h"
+#include "core/util/cancellation.h"
+#include "server/grid_store.h"
+#include "server/ops/ops_context.h"
+
+namespace splinegrid::server::ops {
+
+// Who and what the new grid is.
+struct NewGridHeader {
+  std::string grid_id;  // "": the store picks one
+  std::string display_name;
+  std::string owner;
+};
+
+// The checks that need no work: the id (INVALID_ARGUMENT, ALREADY_EXISTS), the display name's
+// length and `points` against the server's cap (OUT_OF_RANGE naming `points_what`, e.g.
+// "wall_points * (layers + 1)").
+absl::Status CheckNewGrid(const OpsContext& context, const NewGridHeader& header, int64_t points,
+                          const std::string& points_what, int64_t max_points);
+
+// Stores `blocks` (whose bytes `source` already holds in the budget, described by `format`) as
+// the new grid's source points and fits them as revision 1; `default_name` names the grid when
+// the header does not. FAILED_PRECONDITION when the fit folds (and options.allow_folds is
+// false), ALREADY_EXISTS, CANCELLED; nothing is stored on an error.
+absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreGenerated(
+    const OpsContext& context, const NewGridHeader& header, const std::string& default_name,
+    std::shared_ptr<SourcePoints> source, MultiBlockGrid blocks, const GridFitOptions& options,
+    const CancelCheck& cancel);
+
+}  // namespace splinegrid::server::ops
+
+#endif  // SPLINEGRID_SERVER_OPS_GENERATED_GRID_H_
