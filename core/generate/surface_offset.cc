@@ -47,29 +47,30 @@ StructuredBlock ToBlock(const Layer& p, const Shape& s) {
 }
 
 // The unit normals (oriented by `side`) of a fitted layer at its regular points (at its data
-// parameters); at singular ones (X_u x X_v vanishes) `known` is cleared and `lhopital` holds the
-// l'Hopital normal direction.
+// parameters; X_u and X_v on the whole grid by sum factorisation); at singular ones (X_u x X_v
+// vanishes) `known` is cleared and `lhopital` holds the l'Hopital normal direction.
 void RegularNormals(const TensorSpline& spline, const std::array<std::vector<double>, 3>& params,
                     const Shape& s, int side, double scale, Layer& normal, std::vector<char>& known,
                     Layer& lhopital) {
-  const std::vector<double>& u = params[0];
-  const std::vector<double>& v = params[1];
-  for (int j = 0; j < s.nj; ++j) {
-    for (int i = 0; i < s.ni; ++i) {
-      const int64_t q = s.At(i, j);
-      const PartialDerivatives d = EvaluateDerivatives(spline, {u[i], v[j], 0.0}, 2);
-      const Vec xu = ToVec(d(1, 0, 0)), xv = ToVec(d(0, 1, 0)), xuv = ToVec(d(1, 1, 0));
-      const double a = xu.norm(), b = xv.norm();
-      const Vec c = xu.cross(xv);
-      if (a <= kCollapsed * scale || b <= kCollapsed * scale || c.norm() <= 1e-12 * a * b) {
-        // Singular: on a pole X_u ~ t X_uv (or X_v ~ t X_uv), t the parameter distance.
-        known[q] = 0;
-        if (a <= kCollapsed * scale && b > kCollapsed * scale) lhopital[q] = xuv.cross(xv);
-        if (b <= kCollapsed * scale && a > kCollapsed * scale) lhopital[q] = xu.cross(xuv);
-        continue;
-      }
-      normal[q] = side * c.normalized();
+  GridEvaluator evaluator(spline, params, /*first_derivatives=*/true);
+  std::vector<double> points(3 * s.size()), du(3 * s.size()), dv(3 * s.size()), dw(3 * s.size());
+  evaluator.EvaluateLines(0, evaluator.num_lines(), points.data(), du.data(), dv.data(), dw.data());
+  for (int64_t q = 0; q < s.size(); ++q) {
+    const Vec xu(du[3 * q], du[3 * q + 1], du[3 * q + 2]);
+    const Vec xv(dv[3 * q], dv[3 * q + 1], dv[3 * q + 2]);
+    const double a = xu.norm(), b = xv.norm();
+    const Vec c = xu.cross(xv);
+    if (a <= kCollapsed * scale || b <= kCollapsed * scale || c.norm() <= 1e-12 * a * b) {
+      // Singular: on a pole X_u ~ t X_uv (or X_v ~ t X_uv), t the parameter distance.
+      known[q] = 0;
+      const PartialDerivatives d =
+          EvaluateDerivatives(spline, {params[0][q % s.ni], params[1][q / s.ni], 0.0}, 2);
+      const Vec xuv = ToVec(d(1, 1, 0));
+      if (a <= kCollapsed * scale && b > kCollapsed * scale) lhopital[q] = xuv.cross(xv);
+      if (b <= kCollapsed * scale && a > kCollapsed * scale) lhopital[q] = xu.cross(xuv);
+      continue;
     }
+    normal[q] = side * c.normalized();
   }
 }
 
@@ -113,20 +114,26 @@ struct BlockMarch {
   const std::vector<int64_t>* vertex = nullptr;
 
   int64_t V(int i, int j) const { return (*vertex)[s.At(i, j)]; }
-  // The block's points of a per-vertex layer.
-  Layer Points(const Layer& values) const {
-    Layer out(s.size());
-    for (int64_t q = 0; q < s.size(); ++q) out[q] = values[(*vertex)[q]];
-    return out;
-  }
 };
 
-// What the layers share: the options, the topology, the blocks, the surface's size.
+// The weights of the normal smoothing (surface_topology.h's kinds), per vertex the
+// neighbouring vertices and their weights (rows in CSR form, built once): a shared vertex takes
+// the sum of the (1 2 1) x (1 2 1) stencils of all its block points (each cut off at its
+// block's edges); a free-edge vertex the (1 2 1) stencil along its edge; a fixed one none.
+struct SmoothingStencil {
+  std::vector<int64_t> start;  // row v is [start[v], start[v + 1])
+  std::vector<int64_t> neighbour;
+  std::vector<double> weight;
+};
+
+// What the layers share: the options, the topology, the blocks, the surface's size, the
+// smoothing weights.
 struct March {
   const SurfaceOffsetOptions& options;
   const SurfaceTopology& topology;
   std::vector<BlockMarch> blocks;
   double scale = 0.0;
+  SmoothingStencil stencil;
   int64_t num_vertices() const { return topology.num_vertices; }
 };
 
@@ -196,33 +203,31 @@ absl::StatusOr<Layer> VertexNormals(const March& m) {
   return normal;
 }
 
-// One Jacobi sweep over the vertices (surface_topology.h's kinds): a shared vertex takes the
-// normalised sum of the (1 2 1) x (1 2 1) stencils of all its block points (each cut off at its
-// block's edges); a free-edge vertex the (1 2 1) mean along its edge; fixed ones keep theirs.
-void SmoothNormals(const March& m, Layer& normals) {
-  Layer sum(m.num_vertices(), Vec::Zero());
+// The stencil of the march's blocks and vertex kinds.
+SmoothingStencil BuildSmoothingStencil(const March& m) {
+  std::vector<std::vector<std::pair<int64_t, double>>> rows(m.num_vertices());
   for (const BlockMarch& block : m.blocks) {
     const Shape& s = block.s;
     for (int j = 0; j < s.nj; ++j) {
       for (int i = 0; i < s.ni; ++i) {
         const int64_t v = block.V(i, j);
+        auto& row = rows[v];
         switch (m.topology.kind[v]) {
           case VertexKind::kFixed:
             break;
-          case VertexKind::kFreeEdge:
-            if (j == 0 || j == s.nj - 1) {
-              sum[v] = normals[block.V(i - 1, j)] + 2.0 * normals[v] + normals[block.V(i + 1, j)];
-            } else {
-              sum[v] = normals[block.V(i, j - 1)] + 2.0 * normals[v] + normals[block.V(i, j + 1)];
-            }
+          case VertexKind::kFreeEdge: {  // one block point: the row is its own
+            const bool along_i = j == 0 || j == s.nj - 1;
+            row = {{along_i ? block.V(i - 1, j) : block.V(i, j - 1), 1.0},
+                   {v, 2.0},
+                   {along_i ? block.V(i + 1, j) : block.V(i, j + 1), 1.0}};
             break;
+          }
           case VertexKind::kShared:
             for (int dj = -1; dj <= 1; ++dj) {
               for (int di = -1; di <= 1; ++di) {
                 const int ii = i + di, jj = j + dj;
                 if (ii < 0 || jj < 0 || ii >= s.ni || jj >= s.nj) continue;
-                sum[v] += static_cast<double>((2 - std::abs(di)) * (2 - std::abs(dj))) *
-                          normals[block.V(ii, jj)];
+                row.emplace_back(block.V(ii, jj), (2 - std::abs(di)) * (2 - std::abs(dj)));
               }
             }
             break;
@@ -230,9 +235,30 @@ void SmoothNormals(const March& m, Layer& normals) {
       }
     }
   }
-  for (int64_t v = 0; v < m.num_vertices(); ++v) {
-    if (sum[v].norm() > 0.0) normals[v] = sum[v].normalized();
+  SmoothingStencil stencil;
+  stencil.start.push_back(0);
+  for (const auto& row : rows) {
+    for (const auto& [neighbour, weight] : row) {
+      stencil.neighbour.push_back(neighbour);
+      stencil.weight.push_back(weight);
+    }
+    stencil.start.push_back(static_cast<int64_t>(stencil.neighbour.size()));
   }
+  return stencil;
+}
+
+// One Jacobi sweep: every vertex with a stencil row takes the normalised weighted sum of its
+// neighbours' normals, kept parallel to its symmetry plane.
+void SmoothNormals(const March& m, const SmoothingStencil& stencil, Layer& normals) {
+  Layer next = normals;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    Vec sum = Vec::Zero();
+    for (int64_t e = stencil.start[v]; e < stencil.start[v + 1]; ++e) {
+      sum += stencil.weight[e] * normals[stencil.neighbour[e]];
+    }
+    if (sum.norm() > 0.0) next[v] = sum.normalized();
+  }
+  normals = std::move(next);
   ProjectNormals(m, normals);
 }
 
@@ -410,7 +436,7 @@ CellCheck OffsetWithRetries(const March& m, const Layer& p, Layer& normals, doub
   CellCheck check;
   for (int attempt = 0; attempt <= m.options.max_retries; ++attempt) {
     if (attempt > 0) {
-      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(m, normals);
+      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(m, m.stencil, normals);
       ++*retries;
     }
     LeanTowardsPlanes(m, p, height, normals);
@@ -616,10 +642,11 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
   SG_ASSIGN_OR_RETURN(SurfaceTopology topology,
                       BuildSurfaceTopology(surface, connectivity, options.symmetry_planes));
   SG_ASSIGN_OR_RETURN(const std::vector<int> sides, BlockSides(surface, topology, options));
-  March m{options, topology, {}, 0.0};
+  March m{options, topology, {}, 0.0, {}};
   SG_ASSIGN_OR_RETURN(Layer p, SurfaceVertices(surface, topology, &m.scale));
   ProjectPoints(m, p);
   SG_RETURN_IF_ERROR(FitSurfaceBlocks(surface, topology, sides, m));
+  m.stencil = BuildSmoothingStencil(m);
 
   SurfaceOffsetGrid out;
   out.sides = sides;
@@ -652,7 +679,7 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
     const double fraction = static_cast<double>(k + 1) / options.layers;
     SG_ASSIGN_OR_RETURN(Layer normals, VertexNormals(m));
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
-    for (int t = 0; t < sweeps; ++t) SmoothNormals(m, normals);
+    for (int t = 0; t < sweeps; ++t) SmoothNormals(m, m.stencil, normals);
     CellCheck check =
         OffsetWithRetries(m, p, normals, height + h, h, deficit, steps, q, &out.retries);
     if (check.folded) return FoldedLayerError(m, check, k, h, steps);

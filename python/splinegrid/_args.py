@@ -32,6 +32,12 @@ _KINDS = {"wall": grid_pb2.BOUNDARY_KIND_WALL, "interface": grid_pb2.BOUNDARY_KI
 _FACE_HELP = ("give BLOCK:FACE=KIND or {(block, face): kind}, FACE imin, imax, jmin, jmax, kmin "
               "or kmax, KIND wall, interface or outer")
 
+_MARCH_SIDES = {
+    "outward": service_pb2.MARCH_SIDE_OUTWARD,
+    "along": service_pb2.MARCH_SIDE_ALONG_NORMAL,
+    "against": service_pb2.MARCH_SIDE_AGAINST_NORMAL,
+}
+
 _LAYER_METHODS = {
     "offsets": service_pb2.LAYER_METHOD_OFFSETS,
     "transfinite": service_pb2.LAYER_METHOD_TRANSFINITE,

@@ -1,6 +1,6 @@
-"""Generation of an O-grid around a profile (GenerateGrid): the request built from the Client's
-arguments (the profile, the layers, the fit of revision 1; checked before any call), and the
-call."""
+"""Generation of an O-grid around a profile, or of a volume grid off a stored surface grid
+(GenerateGrid): the request built from the Client's arguments (the profile or surface, the
+layers, the fit of revision 1; checked before any call), and the call."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
-from splinegrid._args import (_LAYER_METHODS, Triple, _airfoil_text, _fit_spec, _grid_id,
+from splinegrid._args import (_LAYER_METHODS, _MARCH_SIDES, Triple, _airfoil_text, _fit_spec, _grid_id,
                               _integer, _non_negative_int, grid_name)
 from splinegrid._calls import _Calls
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
@@ -66,6 +66,28 @@ def _layers(request: service_pb2.GenerateGridRequest, method: Optional[str],
         request.orthogonalize = bool(orthogonalize)
 
 
+def _volume_request(name: str, surface: str, revision: int, display_name: str,
+                    layers: Optional[int], first_height: Optional[float],
+                    distance: Optional[float], side: str, normal_smoothing: Optional[int],
+                    symmetry_planes: Optional[bool],
+                    allow_folds: bool) -> service_pb2.GenerateGridRequest:
+    """The GenerateGrid request of :meth:`_GenerateCalls.generate_volume` without its fit;
+    ValueError naming the argument."""
+    if side not in _MARCH_SIDES:
+        raise ValueError(f"side = {side!r}; give one of {sorted(_MARCH_SIDES)}")
+    request = service_pb2.GenerateGridRequest(grid_id=_grid_id(name), display_name=display_name,
+                                              allow_folds=bool(allow_folds),
+                                              side=_MARCH_SIDES[side])
+    request.stored_surface.name = grid_name(surface)
+    request.stored_surface.revision = _non_negative_int(revision, "revision")
+    _layers(request, None, None, layers, first_height, distance, None, None)
+    if normal_smoothing is not None:
+        request.normal_smoothing = _integer(normal_smoothing, "normal_smoothing")
+    if symmetry_planes is not None:
+        request.symmetry_planes = bool(symmetry_planes)
+    return request
+
+
 class _GenerateCalls(_Calls):
     """The Client's grid generation (GenerateGrid)."""
 
@@ -119,6 +141,45 @@ class _GenerateCalls(_Calls):
         _profile(request, airfoil, points, stored_wall)
         _layers(request, method, wall_points, layers, first_height, distance, orthogonalize,
                 fit_tolerance)
+        if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
+            request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
+                                            boundary_tolerances, fairing))
+            if not request.spec.HasField("resolution"):
+                request.spec.boundary_tolerances.SetInParent()
+        return self._unary(self.stub.GenerateGrid, request,
+                           service_pb2.GenerateGridResponse)
+
+    def generate_volume(self, name: str, surface: str, revision: int = 0,
+                        display_name: str = "", layers: Optional[int] = None,
+                        first_height: Optional[float] = None, distance: Optional[float] = None,
+                        side: str = "outward", normal_smoothing: Optional[int] = None,
+                        symmetry_planes: Optional[bool] = None,
+                        control_counts: Optional[Triple] = None,
+                        tolerance: Optional[float] = None, order: int = 4, max_controls: int = 0,
+                        boundary_tolerances: Optional[dict[str, float]] = None,
+                        fairing: Union[None, str, float] = None, allow_folds: bool = False
+                        ) -> service_pb2.GenerateGridResponse:
+        """Marches hexahedral layers off every block of the stored surface grid ``surface``
+        (revision ``revision``, 0 = latest; blocks ni x nj x 1 in 3-D), stores the volume grid
+        as ``name`` ("" lets the server pick an id) and fits it as revision 1. The blocks march
+        together: points they share stay shared (watertight), k = 0 is the surface, k = max the
+        outer layer. Nothing is stored on an error.
+
+        Layers (None: the server's defaults, core/generate/surface_offset.h): ``layers`` (32),
+        ``first_height`` (1e-3), ``distance`` (0.5, of the last layer from the surface), ``side``
+        ``"outward"`` (away from the volume the surface bounds), ``"along"`` or ``"against"``
+        (the first block's i x j normal), ``normal_smoothing`` (80 sweeps at the last layer),
+        ``symmetry_planes`` (True: free edges on a coordinate plane stay on it, e.g. a half
+        wing's root).
+
+        The fit takes :meth:`fit`'s arguments; with none the server interpolates with uniform
+        parameters (exact, and watertight at every level). Returns the GenerateGridResponse:
+        ``report.volume`` (VolumeReport: ``block_extents``, ``reversed_i``,
+        ``symmetry_planes``, ``min_scaled_jacobian``, ...), ``report.parameters``, ``grid`` and
+        ``fit``.
+        """
+        request = _volume_request(name, surface, revision, display_name, layers, first_height,
+                                  distance, side, normal_smoothing, symmetry_planes, allow_folds)
         if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
             request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
                                             boundary_tolerances, fairing))

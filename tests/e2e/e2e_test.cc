@@ -377,6 +377,48 @@ TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/bad")));
 }
 
+// The issue's command: a volume grid off the stored M6 wing surface, written as multi-block
+// Plot3D; its hexahedra are checked here.
+TEST_F(EndToEndTest, CliMarchesAVolumeGridOffAStoredSurface) {
+  const Result fit =
+      Cli(absl::StrCat("fit ", SharedDataPath("surfaces/m6_small.fmt"), " --name=m6"));
+  ASSERT_EQ(fit.exit_code, 0) << fit.out;
+  const std::string x = (dir_ / "m6.x").string();
+  const Result offset = Cli(absl::StrCat("offset m6 --layers 32 --first 1e-4 --far 5 -o ", x));
+  ASSERT_EQ(offset.exit_code, 0) << offset.out;
+  EXPECT_THAT(offset.out, HasSubstr("grids/m6-volume: volume grid of 9 blocks, 528033 points, "
+                                    "marched outward"));
+  EXPECT_THAT(offset.out, HasSubstr("symmetry planes: z = 0"));
+  EXPECT_THAT(offset.out, HasSubstr("levels 0-2: 0 folded sub-cells"));
+  const MultiBlockGrid grid = ReadPlot3dFile(x).value();
+  ASSERT_EQ(grid.blocks.size(), 9u);
+  int64_t non_positive = 0;
+  for (const StructuredBlock& g : grid.blocks) {
+    ASSERT_EQ(g.extent(2), 33);
+    for (int k = 0; k + 1 < g.extent(2); ++k) {
+      for (int j = 0; j + 1 < g.extent(1); ++j) {
+        for (int i = 0; i + 1 < g.extent(0); ++i) {
+          const double* o = g.Point(i, j, k);
+          const double* a = g.Point(i + 1, j, k);
+          const double* b = g.Point(i, j + 1, k);
+          const double* c = g.Point(i, j, k + 1);
+          const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+          const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+          const double w[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
+          const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) -
+                             u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                             u[2] * (v[0] * w[1] - v[1] * w[0]);
+          non_positive += !(det > 0.0);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(non_positive, 0);  // right-handed everywhere
+  const Result planar = Cli("offset grids/nothing --layers 8");
+  EXPECT_EQ(planar.exit_code, 1);
+  EXPECT_THAT(planar.out, HasSubstr("NOT_FOUND"));
+}
+
 TEST_F(EndToEndTest, PythonGeneratesOGrids) {
   const std::string script = (dir_ / "generate.py").string();
   ASSERT_TRUE(WriteFileAtomically(script, R"(
