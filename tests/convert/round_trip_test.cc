@@ -187,5 +187,29 @@ TEST(ConvertRoundTripTest, ProfileGridParameters) {
   EXPECT_EQ(back.fit_tolerance, options.fit_tolerance);
 }
 
+TEST(ConvertRoundTripTest, SurfaceMarchParameters) {
+  for (const auto& [outward, side] :
+       {std::pair{true, 1}, std::pair{false, 1}, std::pair{false, -1}}) {
+    SurfaceOffsetOptions options;
+    options.layers = 24;
+    options.first_height = 2e-4;
+    options.distance = 3.0;
+    options.outward = outward;
+    options.side = side;
+    options.normal_smoothing = 40;
+    options.symmetry_planes = false;
+    v1::GenerateGridRequest request;
+    EncodeSurfaceOffsetOptions(options, &request);
+    const SurfaceOffsetOptions back = ParseSurfaceOffsetOptions(request).value();
+    EXPECT_EQ(back.layers, options.layers);
+    EXPECT_EQ(back.first_height, options.first_height);
+    EXPECT_EQ(back.distance, options.distance);
+    EXPECT_EQ(back.outward, options.outward);
+    if (!outward) EXPECT_EQ(back.side, options.side);
+    EXPECT_EQ(back.normal_smoothing, options.normal_smoothing);
+    EXPECT_EQ(back.symmetry_planes, options.symmetry_planes);
+  }
+}
+
 }  // namespace
 }  // namespace splinegrid
