@@ -455,6 +455,52 @@ TEST(SurfaceOffsetTest, M6WingToTheFarFieldIsWatertightAndPositive) {
             << seconds << " s\n";
 }
 
+// Two 33 x 33 unit squares meeting at a right angle along a shared edge (an L in x-z, y along
+// the edge): z = 0 for x in [0, 1] and x = 0 for z in [0, 1].
+MultiBlockGrid RightAngle() {
+  MultiBlockGrid grid;
+  for (int b = 0; b < 2; ++b) {
+    StructuredBlock block({33, 33, 1}, 3);
+    for (int j = 0; j < 33; ++j) {
+      for (int i = 0; i < 33; ++i) {
+        const double u = i / 32.0, v = j / 32.0;
+        double* x = block.Point(i, j, 0);
+        x[0] = b == 0 ? u : 0.0;
+        x[1] = v;
+        x[2] = b == 0 ? 0.0 : 1.0 - u;
+      }
+    }
+    grid.blocks.push_back(std::move(block));
+  }
+  return grid;
+}
+
+// The convex side of a crease fans out; the concave side (a junction) is a known limit: its
+// crease lags behind its neighbours and the layers fold back over it within a few cells' height,
+// which is refused by name rather than stored.
+TEST(SurfaceOffsetTest, RightAngleCreaseConvexFansOutConcaveIsRefused) {
+  const MultiBlockGrid l = RightAngle();
+  const absl::StatusOr<Connectivity> connectivity = FindConnectivity(l);
+  ASSERT_TRUE(connectivity.ok());
+  ASSERT_EQ(connectivity->matches.size(), 1u);
+  SurfaceOffsetOptions options;
+  options.layers = 16;
+  options.first_height = 1e-3;
+  options.distance = 0.3;
+  options.symmetry_planes = false;
+  options.side = -1;  // away from the inside of the L: the convex side
+  const absl::StatusOr<SurfaceOffsetGrid> convex = OffsetSurfaceGrid(l, *connectivity, options);
+  ASSERT_TRUE(convex.ok()) << convex.status();
+  for (int b = 0; b < 2; ++b) {
+    EXPECT_GT(CheckCells(convex->blocks[b], convex->sides[b]).min_scaled_jacobian, 0.0);
+  }
+  EXPECT_GT(ExpectWatertight(*connectivity, *convex), 0);
+  options.side = +1;
+  const absl::StatusOr<SurfaceOffsetGrid> concave = OffsetSurfaceGrid(l, *connectivity, options);
+  EXPECT_EQ(concave.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(concave.status().message(), HasSubstr("folds at block 0 cell (0, "));
+}
+
 TEST(SurfaceOffsetTest, OutwardNeedsAnEnclosedVolume) {
   MultiBlockGrid plane;
   plane.blocks.push_back(TiltedPlane({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}));
