@@ -19,21 +19,12 @@ namespace splinegrid::cli {
 
 namespace {
 
-// The profile (an airfoil file) or, for an argument that is no file (or starts with grids/),
-// the stored surface grid;
+// The profile (an airfoil file) or, for an argument that is no file and no path (or starts
+// with grids/), the stored surface grid;
 // the new grid's id (--name, else from the file or the surface's id) and display name.
 absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& request) {
   const std::string& name = absl::GetFlag(FLAGS_name);
-  if (!argument.starts_with("grids/") && std::filesystem::is_regular_file(argument)) {
-    request.set_grid_id(name.empty() ? IdFromPath(argument) : client::GridName(name).substr(6));
-    request.set_display_name(std::filesystem::path(argument).filename().string());
-    SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(argument));
-    return absl::OkStatus();
-  }
-  const std::string surface = client::GridName(argument);
-  request.mutable_stored_surface()->set_name(surface);
-  request.set_grid_id(name.empty() ? absl::StrCat(surface.substr(6), "-volume")
-                                   : client::GridName(name).substr(6));
+  // The surface flags: a profile request that sets them is refused by the server, by name.
   const std::string side = absl::AsciiStrToLower(absl::GetFlag(FLAGS_side));
   if (side == "along") {
     request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);
@@ -45,6 +36,20 @@ absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& req
   }
   if (const auto v = absl::GetFlag(FLAGS_normal_smoothing)) request.set_normal_smoothing(*v);
   if (const auto v = absl::GetFlag(FLAGS_symmetry)) request.set_symmetry_planes(*v);
+  // A grid id has no '.' or '/': anything else is a path (a mistyped one is "no such file").
+  const bool path =
+      !argument.starts_with("grids/") && (std::filesystem::is_regular_file(argument) ||
+                                          argument.find_first_of("./") != std::string::npos);
+  if (path) {
+    request.set_grid_id(name.empty() ? IdFromPath(argument) : client::GridName(name).substr(6));
+    request.set_display_name(std::filesystem::path(argument).filename().string());
+    SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(argument));
+    return absl::OkStatus();
+  }
+  const std::string surface = client::GridName(argument);
+  request.mutable_stored_surface()->set_name(surface);
+  request.set_grid_id(name.empty() ? absl::StrCat(surface.substr(6), "-volume")
+                                   : client::GridName(name).substr(6));
   return absl::OkStatus();
 }
 

@@ -140,10 +140,11 @@ struct March {
 // Normals kept parallel to the symmetry planes their vertices lie on.
 void ProjectNormals(const March& m, Layer& normals) {
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
-    const int p = m.topology.plane[v];
-    if (p < 0) continue;
+    if (m.topology.plane[v] == 0) continue;
     Vec n = normals[v];
-    n[m.topology.planes[p].axis] = 0.0;
+    for (size_t p = 0; p < m.topology.planes.size(); ++p) {
+      if (m.topology.plane[v] >> p & 1) n[m.topology.planes[p].axis] = 0.0;
+    }
     if (n.norm() > 0.0) normals[v] = n.normalized();
   }
 }
@@ -151,8 +152,11 @@ void ProjectNormals(const March& m, Layer& normals) {
 // Points kept on the symmetry planes their vertices lie on.
 void ProjectPoints(const March& m, Layer& points) {
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
-    const int p = m.topology.plane[v];
-    if (p >= 0) points[v][m.topology.planes[p].axis] = m.topology.planes[p].value;
+    for (size_t p = 0; p < m.topology.planes.size(); ++p) {
+      if (m.topology.plane[v] >> p & 1) {
+        points[v][m.topology.planes[p].axis] = m.topology.planes[p].value;
+      }
+    }
   }
 }
 
@@ -162,11 +166,12 @@ void ProjectPoints(const March& m, Layer& points) {
 // the plane map by d -> d - h c min(1, d / height) (c the lean, h <= height the step), which is
 // monotone in d, so no row of the layer overtakes another towards the plane.
 void LeanTowardsPlanes(const March& m, const Layer& p, double height, Layer& normals) {
-  for (const SymmetryPlane& plane : m.topology.planes) {
+  for (size_t index = 0; index < m.topology.planes.size(); ++index) {
+    const SymmetryPlane& plane = m.topology.planes[index];
     for (int64_t v = 0; v < m.num_vertices(); ++v) {
       const double d = p[v][plane.axis] - plane.value;  // signed: the surface's side
       Vec& n = normals[v];
-      if (m.topology.plane[v] >= 0 || !(n[plane.axis] * d < 0.0)) continue;
+      if ((m.topology.plane[v] >> index & 1) || !(n[plane.axis] * d < 0.0)) continue;
       n[plane.axis] *= std::min(1.0, std::abs(d) / height);
       n.normalize();
     }
@@ -260,6 +265,15 @@ void SmoothNormals(const March& m, const SmoothingStencil& stencil, Layer& norma
   }
   normals = std::move(next);
   ProjectNormals(m, normals);
+}
+
+// `sweeps` Jacobi sweeps, polling the cancel check between them.
+absl::Status Smooth(const March& m, int sweeps, Layer& normals) {
+  for (int t = 0; t < sweeps; ++t) {
+    SG_RETURN_IF_ERROR(PollCancel(m.options.cancel));
+    SmoothNormals(m, m.stencil, normals);
+  }
+  return absl::OkStatus();
 }
 
 // The curvature each vertex's step is limited by (file comment): the fastest convergence of the
@@ -430,18 +444,20 @@ void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h
 // The layer q above p (at `height` above the surface, step h), its normals smoothed two more
 // sweeps per retry (counted in `*retries`) until its cells do not fold or max_retries is spent;
 // the check of the last attempt.
-CellCheck OffsetWithRetries(const March& m, const Layer& p, Layer& normals, double height, double h,
-                            const std::vector<double>& deficit, LayerSteps& steps, Layer& q,
-                            int* retries) {
+absl::StatusOr<CellCheck> OffsetWithRetries(const March& m, const Layer& p, Layer& normals,
+                                            double height, double h,
+                                            const std::vector<double>& deficit, LayerSteps& steps,
+                                            Layer& q, int* retries) {
   CellCheck check;
   for (int attempt = 0; attempt <= m.options.max_retries; ++attempt) {
     if (attempt > 0) {
-      for (int t = 0; t < 2 * attempt; ++t) SmoothNormals(m, m.stencil, normals);
+      SG_RETURN_IF_ERROR(Smooth(m, 2 * attempt, normals));
       ++*retries;
     }
-    LeanTowardsPlanes(m, p, height, normals);
-    LimitedSteps(m, p, normals, h, deficit, steps);
-    for (int64_t v = 0; v < m.num_vertices(); ++v) q[v] = p[v] + steps.step[v] * normals[v];
+    Layer leaning = normals;  // the lean is taken afresh from the smoothed normals each attempt
+    LeanTowardsPlanes(m, p, height, leaning);
+    LimitedSteps(m, p, leaning, h, deficit, steps);
+    for (int64_t v = 0; v < m.num_vertices(); ++v) q[v] = p[v] + steps.step[v] * leaning[v];
     ProjectPoints(m, q);
     check = CheckCells(m, p, q);
     if (!check.folded) break;
@@ -603,9 +619,9 @@ absl::Status SurfaceOffsetOptions::Validate() const {
   if (side != 1 && side != -1) {
     return absl::InvalidArgumentError(absl::StrCat("side = ", side, " is neither +1 nor -1"));
   }
-  if (normal_smoothing < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("normal_smoothing = ", normal_smoothing, " is negative"));
+  if (normal_smoothing < 0 || normal_smoothing > kMaxNormalSmoothing) {
+    return absl::InvalidArgumentError(absl::StrCat("normal_smoothing = ", normal_smoothing,
+                                                   " is outside [0, ", kMaxNormalSmoothing, "]"));
   }
   if (!(fairing >= 0.0) || !std::isfinite(fairing)) {
     return absl::InvalidArgumentError(
@@ -623,8 +639,9 @@ absl::Status SurfaceOffsetOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("max_shortfall = ", max_shortfall, " is outside [0, 1]"));
   }
-  if (max_retries < 0) {
-    return absl::InvalidArgumentError(absl::StrCat("max_retries = ", max_retries, " is negative"));
+  if (max_retries < 0 || max_retries > kMaxRetries) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_retries = ", max_retries, " is outside [0, ", kMaxRetries, "]"));
   }
   return absl::OkStatus();
 }
@@ -679,9 +696,9 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
     const double fraction = static_cast<double>(k + 1) / options.layers;
     SG_ASSIGN_OR_RETURN(Layer normals, VertexNormals(m));
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
-    for (int t = 0; t < sweeps; ++t) SmoothNormals(m, m.stencil, normals);
-    CellCheck check =
-        OffsetWithRetries(m, p, normals, height + h, h, deficit, steps, q, &out.retries);
+    SG_RETURN_IF_ERROR(Smooth(m, sweeps, normals));
+    SG_ASSIGN_OR_RETURN(CellCheck check, OffsetWithRetries(m, p, normals, height + h, h, deficit,
+                                                           steps, q, &out.retries));
     if (check.folded) return FoldedLayerError(m, check, k, h, steps);
     // Fair the displacement and add its spline to the layer's (file comment); a faired
     // displacement that folds a cell is dropped for the interpolating one.

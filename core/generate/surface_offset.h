@@ -82,6 +82,11 @@
 
 namespace splinegrid {
 
+// Bounds of the options below: a sweep costs about a microsecond per vertex, and more sweeps
+// than this smooth a grid's normals flat; each retry smooths 2 * attempt sweeps more.
+inline constexpr int kMaxNormalSmoothing = 1000;
+inline constexpr int kMaxRetries = 100;
+
 struct SurfaceOffsetOptions {
   int layers = 32;
   double first_height = 1e-3;  // of the first layer above the surface, in the surface's unit

@@ -93,8 +93,19 @@ void ForEachMatchedPoint(const BoundaryMatch& match, F f) {
   }
 }
 
-// Orients the blocks alike (file comment of the header): BFS over the matches, each telling
-// whether its two blocks' grid normals agree at the shared points.
+// The direction in which the counter-clockwise boundary loop of a block's (i, j) parameter
+// square runs along `face`'s tangential direction: +i along j = 0, +j along i = max, -i along
+// j = max, -j along i = 0.
+int LoopDirection(const Face& face) {
+  if (face.normal == 1) return face.upper ? -1 : +1;
+  return face.upper ? +1 : -1;
+}
+
+// Orients the blocks alike (file comment of the header): BFS over the matches. Two blocks are
+// oriented alike when their counter-clockwise boundary loops run along the shared edge in
+// opposite directions (as two faces of a polyhedron share an edge), a question of the match's
+// indices alone: the normals of blocks meeting at a sharp crease point almost opposite ways and
+// cannot tell.
 absl::Status OrientBlocks(const MultiBlockGrid& surface, const Connectivity& connectivity,
                           SurfaceTopology& out) {
   const int num_blocks = static_cast<int>(surface.blocks.size());
@@ -104,17 +115,14 @@ absl::Status OrientBlocks(const MultiBlockGrid& surface, const Connectivity& con
   };
   std::vector<std::vector<Link>> links(num_blocks);
   for (const BoundaryMatch& match : connectivity.matches) {
-    const StructuredBlock& a = surface.blocks[match.a.face.block];
-    const StructuredBlock& b = surface.blocks[match.b.face.block];
-    double agreement = 0.0;
-    ForEachMatchedPoint(match, [&](const Extents& x, const Extents& y) {
-      const Vec na = GridNormal(a, a.Index(x[0], x[1], 0));
-      const Vec nb = GridNormal(b, b.Index(y[0], y[1], 0));
-      if (na.norm() > 0.0 && nb.norm() > 0.0) agreement += na.normalized().dot(nb.normalized());
-    });
-    const int sign = agreement >= 0.0 ? 1 : -1;
+    // The edge's tangential direction in a (the one with more than one point, or i).
+    const int t = match.a.face.normal == 0 ? 1 : 0;
+    const int along = match.reversed[t] ? -1 : +1;
+    const int sign = -LoopDirection(match.a.face) * LoopDirection(match.b.face) * along;
     links[match.a.face.block].push_back({match.b.face.block, sign});
-    links[match.b.face.block].push_back({match.a.face.block, sign});
+    if (match.b.face.block != match.a.face.block) {
+      links[match.b.face.block].push_back({match.a.face.block, sign});
+    }
   }
   out.side.assign(num_blocks, 0);
   out.component.assign(num_blocks, -1);
@@ -179,6 +187,7 @@ int FindPlane(const MultiBlockGrid& surface, int b, const std::vector<int64_t>& 
         return static_cast<int>(p);
       }
     }
+    if (out.planes.size() >= kMaxSymmetryPlanes) return -1;
     out.planes.push_back({axis, value});
     return static_cast<int>(out.planes.size()) - 1;
   }
@@ -259,19 +268,19 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
       corner[v] = corner[v] || (edge_i && edge_j);
     }
   }
-  out.plane.assign(out.num_vertices, -1);
+  out.plane.assign(out.num_vertices, 0);
   if (find_symmetry_planes) {
     for (int b = 0; b < num_blocks; ++b) {
       const StructuredBlock& block = surface.blocks[b];
       for (int e = 0; e < 4; ++e) {
         const std::vector<int64_t> points = EdgePoints(block.extent(0), block.extent(1), e);
-        if (std::any_of(points.begin(), points.end(),
+        if (std::all_of(points.begin(), points.end(),
                         [&](int64_t q) { return on_pole[numbering.base[b] + q] != 0; })) {
-          continue;
+          continue;  // a pole, no edge
         }
         const int p = FindPlane(surface, b, points, copies, box, out);
         if (p < 0) continue;
-        for (int64_t q : points) out.plane[out.vertex[b][q]] = p;
+        for (int64_t q : points) out.plane[out.vertex[b][q]] |= uint8_t{1} << p;
       }
     }
   }
@@ -279,7 +288,7 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
   for (int64_t v = 0; v < out.num_vertices; ++v) {
     if (pole[v]) {
       out.kind[v] = VertexKind::kFixed;
-    } else if (copies[v] > 1 || interior[v] || out.plane[v] >= 0) {
+    } else if (copies[v] > 1 || interior[v] || out.plane[v] != 0) {
       out.kind[v] = VertexKind::kShared;
     } else {
       out.kind[v] = corner[v] ? VertexKind::kFixed : VertexKind::kFreeEdge;

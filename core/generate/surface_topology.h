@@ -7,9 +7,9 @@
 //    vertex through its edges) and where a block edge collapses to one point (a pole). A marcher
 //    that moves every vertex once keeps the blocks watertight.
 //  - Orientation: block b's normal is side[b] (X_u x X_v); the sides are chosen so that blocks
-//    sharing an edge agree (their normals at the shared points point the same way), starting
-//    from +1 at the first block of each connected component. A surface whose blocks cannot agree
-//    (a Moebius strip, or blocks matched back to front) is refused.
+//    sharing an edge agree (their parameter squares' counter-clockwise loops run along it in
+//    opposite directions, as two faces of a polyhedron), starting from +1 at the first block of
+//    each connected component. A surface whose blocks cannot agree (a Moebius strip) is refused.
 //  - Symmetry planes: a block edge matched to nothing whose points all lie in a coordinate plane
 //    x, y or z = c, with the whole surface on one side of that plane and leaving it steeply (the
 //    surface normals along the edge within kSymmetryTiltDegrees of parallel to the plane), is a
@@ -32,6 +32,9 @@
 
 namespace splinegrid {
 
+// At most this many symmetry planes (two per axis, the surface between them, is six).
+inline constexpr size_t kMaxSymmetryPlanes = 8;
+
 // The surface normals along a symmetry plane's edge lean at most this far out of the plane.
 inline constexpr double kSymmetryTiltDegrees = 60.0;
 
@@ -52,8 +55,8 @@ struct SurfaceTopology {
   // vertex[b][q]: the vertex of block b's point q (i fastest).
   std::vector<std::vector<int64_t>> vertex;
   std::vector<VertexKind> kind;  // per vertex
-  // Per vertex: the index into `planes` of the symmetry plane it lies on, or -1.
-  std::vector<int> plane;
+  // Per vertex: bit p set when it lies on planes[p] (the corner of a quarter model on two).
+  std::vector<uint8_t> plane;
   std::vector<SymmetryPlane> planes;
   std::vector<int> side;       // per block, +1 or -1 (file comment)
   std::vector<int> component;  // per block: its connected group of blocks, from 0

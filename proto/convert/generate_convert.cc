@@ -27,6 +27,14 @@ absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGri
       return absl::InvalidArgumentError(
           absl::StrCat("method = ", static_cast<int>(request.method()), " is not a known value"));
   }
+  for (const auto& [set, field] : {std::pair{request.side() != v1::MARCH_SIDE_OUTWARD, "side"},
+                                   std::pair{request.has_normal_smoothing(), "normal_smoothing"},
+                                   std::pair{request.has_symmetry_planes(), "symmetry_planes"}}) {
+    if (set) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, " is set: it applies to a stored_surface, not to a profile"));
+    }
+  }
   if (request.has_wall_points()) options.wall_points = request.wall_points();
   if (request.has_layers()) options.layers = request.layers();
   if (request.has_first_height()) options.first_height = request.first_height();

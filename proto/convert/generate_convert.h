@@ -15,7 +15,8 @@ namespace splinegrid {
 
 // The layer parameters of `request` (method, wall_points, layers, first_height, distance,
 // orthogonalize, fit_tolerance): unset fields keep the kernel's defaults, set ones are taken as
-// given; validated by ProfileGridOptions::Validate (INVALID_ARGUMENT naming the field).
+// given; validated by ProfileGridOptions::Validate (INVALID_ARGUMENT naming the field, also for
+// a field of surfaces only: side, normal_smoothing, symmetry_planes).
 absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGridRequest& request);
 
 // The parameters actually used, as the request fields (every layer field set).

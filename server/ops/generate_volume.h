@@ -33,7 +33,9 @@ struct GenerateVolumeRequest {
   SurfaceOffsetOptions options;
   // The fit of revision 1; unset: interpolation with uniform parameters (a control point per
   // grid point, every block's face splines equal where blocks meet, so the fit is watertight at
-  // every level). Unless it names face kinds, k = 0 is the wall and k = max the outer boundary.
+  // every level). A given fit replaces that whole default, parameters included; its face kinds
+  // name the stored blocks' faces (i reversed where reversed_i says); unless it names some,
+  // k = 0 is the wall and k = max the outer boundary.
   std::optional<GridFitOptions> fit;
   bool allow_folds = false;
   int64_t max_points = 0;  // the server's cap on the generated points

@@ -501,6 +501,58 @@ TEST(SurfaceOffsetTest, RightAngleCreaseConvexFansOutConcaveIsRefused) {
   EXPECT_THAT(concave.status().message(), HasSubstr("folds at block 0 cell (0, "));
 }
 
+// A quarter of a band of the unit sphere: phi in [0, pi/2] (i), z from 0 up to a wavy top edge
+// (j). Its edges phi = 0, phi = pi/2 and z = 0 lie on the planes y = 0, x = 0 and z = 0; the
+// corners at z = 0 lie on two planes each and must stay on both.
+TEST(SurfaceOffsetTest, CornersOnTwoSymmetryPlanesStayOnBoth) {
+  StructuredBlock band({17, 9, 1}, 3);
+  for (int j = 0; j < 9; ++j) {
+    for (int i = 0; i < 17; ++i) {
+      const double phi = (kPi / 2.0) * i / 16.0;
+      const double z = (0.5 + 0.1 * std::sin(2.0 * phi)) * j / 8.0;
+      const double r = std::sqrt(1.0 - z * z);
+      double* x = band.Point(i, j, 0);
+      x[0] = r * std::cos(phi);
+      x[1] = r * std::sin(phi);
+      x[2] = z;
+    }
+  }
+  SurfaceOffsetOptions options;
+  options.layers = 12;
+  options.first_height = 0.01;
+  options.distance = 0.5;
+  options.outward = true;
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(band, options);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  ASSERT_EQ(grid->symmetry_planes.size(), 3u);
+  const StructuredBlock& b = grid->blocks[0];
+  EXPECT_GT(CheckCells(b, grid->sides[0]).min_scaled_jacobian, 0.0);
+  for (int k = 0; k < b.extent(2); ++k) {
+    for (int j = 0; j < b.extent(1); ++j) {
+      EXPECT_EQ(At(b, 0, j, k)[1], 0.0) << "phi = 0, layer " << k;
+      EXPECT_NEAR(At(b, 16, j, k)[0], 0.0, 1e-16) << "phi = pi/2 (cos = 6e-17), layer " << k;
+    }
+    for (int i = 0; i < b.extent(0); ++i) EXPECT_EQ(At(b, i, 0, k)[2], 0.0) << "z = 0, layer " << k;
+  }
+}
+
+// A Moebius strip: its seam matches itself back to front, so no side is outward or along.
+TEST(SurfaceOffsetTest, AMoebiusStripCannotBeOriented) {
+  StructuredBlock strip({41, 5, 1}, 3);
+  for (int j = 0; j < 5; ++j) {
+    for (int i = 0; i < 41; ++i) {
+      const double u = 2.0 * kPi * i / 40.0, v = -0.3 + 0.6 * j / 4.0;
+      double* x = strip.Point(i, j, 0);
+      x[0] = (1.0 + 0.5 * v * std::cos(u / 2.0)) * std::cos(u);
+      x[1] = (1.0 + 0.5 * v * std::cos(u / 2.0)) * std::sin(u);
+      x[2] = 0.5 * v * std::sin(u / 2.0);
+    }
+  }
+  const absl::StatusOr<SurfaceOffsetGrid> grid = OffsetSurface(strip, SurfaceOffsetOptions{});
+  EXPECT_EQ(grid.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(grid.status().message(), HasSubstr("cannot be oriented alike"));
+}
+
 TEST(SurfaceOffsetTest, OutwardNeedsAnEnclosedVolume) {
   MultiBlockGrid plane;
   plane.blocks.push_back(TiltedPlane({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}));
@@ -539,6 +591,9 @@ TEST(SurfaceOffsetTest, BadOptionsNameTheField) {
       {"max_curvature_step = 1", [](SurfaceOffsetOptions& o) { o.max_curvature_step = 1.0; }},
       {"max_shortfall = 2", [](SurfaceOffsetOptions& o) { o.max_shortfall = 2.0; }},
       {"max_retries = -1", [](SurfaceOffsetOptions& o) { o.max_retries = -1; }},
+      {"normal_smoothing = 1001 is outside [0, 1000]",
+       [](SurfaceOffsetOptions& o) { o.normal_smoothing = 1001; }},
+      {"max_retries = 101", [](SurfaceOffsetOptions& o) { o.max_retries = 101; }},
   };
   for (const BadOptionsCase& c : cases) {
     SurfaceOffsetOptions options;

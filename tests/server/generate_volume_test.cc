@@ -27,7 +27,8 @@ v1::GenerateGridRequest M6Request(const std::string& id) {
   return r;
 }
 
-// The smallest det[x_i, x_j, x_k] / (|x_i| |x_j| |x_k|) at the lower corner of every hexahedron.
+// The smallest det[x_i, x_j, x_k] / (|x_i| |x_j| |x_k|) at the lower corner of every hexahedron
+// (x_i, x_j, x_k its three edges from that corner).
 double MinCornerJacobian(const StructuredBlock& b) {
   double worst = HUGE_VAL;
   for (int k = 0; k + 1 < b.extent(2); ++k) {
@@ -109,6 +110,7 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
     SCOPED_TRACE(::testing::Message() << "level " << level);
     const MultiBlockGrid grid = Evaluate("m6-volume", level);
     ASSERT_EQ(grid.blocks.size(), 9u);
+    int64_t root_points = 0;
     for (size_t b = 0; b < grid.blocks.size(); ++b) {
       const StructuredBlock& block = grid.blocks[b];
       EXPECT_EQ(block.extent(2), 32 * (1 << level) + 1);
@@ -117,12 +119,15 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
       for (int j = 0; j < block.extent(1); ++j) {
         for (int i = 0; i < block.extent(0); ++i) {
           if (block.Point(i, j, 0)[2] != 0.0) continue;
+          ++root_points;
           for (int k = 0; k < block.extent(2); ++k) {
             ASSERT_NEAR(block.Point(i, j, k)[2], 0.0, 1e-12) << "block " << b;
           }
         }
       }
     }
+    // The root edges of blocks 0-3 (17 + 73 + 17 + 73 points at level 0).
+    EXPECT_EQ(root_points, 180 * (1 << level) - 4 * ((1 << level) - 1));
     // Watertight at the level: the faces match again, point for point.
     const absl::StatusOr<Connectivity> found = FindConnectivity(grid);
     ASSERT_TRUE(found.ok()) << found.status();
@@ -167,6 +172,13 @@ TEST_F(GenerateVolumeTest, BadRequestsAreRefusedByNameAndNothingIsStored) {
   r = M6Request("bad");
   r.set_distance(1e9);
   ExpectRefused(r, absl::StatusCode::kFailedPrecondition, "layer");
+  // The march's fields on a profile request.
+  v1::GenerateGridRequest profile;
+  profile.set_grid_id("bad");
+  profile.set_airfoil_file(ReadFileToString(SharedDataPath("airfoils/naca0012.dat")).value());
+  profile.set_normal_smoothing(40);
+  ExpectRefused(profile, absl::StatusCode::kInvalidArgument,
+                "normal_smoothing is set: it applies to a stored_surface");
   // The name is taken.
   r = M6Request("m6");
   ExpectRefused(r, absl::StatusCode::kAlreadyExists, "grids/m6 already exists");
