@@ -66,6 +66,18 @@ def _layers(request: service_pb2.GenerateGridRequest, method: Optional[str],
         request.orthogonalize = bool(orthogonalize)
 
 
+def _set_fit(request: service_pb2.GenerateGridRequest, control_counts: Optional[Triple],
+             tolerance: Optional[float], order: int, max_controls: int,
+             boundary_tolerances: Optional[dict[str, float]],
+             fairing: Union[None, str, float]) -> None:
+    """The fit of revision 1 from :meth:`fit`'s arguments; none given: the server's default."""
+    if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
+        request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
+                                        boundary_tolerances, fairing))
+        if not request.spec.HasField("resolution"):
+            request.spec.boundary_tolerances.SetInParent()
+
+
 def _volume_request(name: str, surface: str, revision: int, display_name: str,
                     layers: Optional[int], first_height: Optional[float],
                     distance: Optional[float], side: str, normal_smoothing: Optional[int],
@@ -141,11 +153,8 @@ class _GenerateCalls(_Calls):
         _profile(request, airfoil, points, stored_wall)
         _layers(request, method, wall_points, layers, first_height, distance, orthogonalize,
                 fit_tolerance)
-        if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
-            request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
-                                            boundary_tolerances, fairing))
-            if not request.spec.HasField("resolution"):
-                request.spec.boundary_tolerances.SetInParent()
+        _set_fit(request, control_counts, tolerance, order, max_controls, boundary_tolerances,
+                 fairing)
         return self._unary(self.stub.GenerateGrid, request,
                            service_pb2.GenerateGridResponse)
 
@@ -180,10 +189,7 @@ class _GenerateCalls(_Calls):
         """
         request = _volume_request(name, surface, revision, display_name, layers, first_height,
                                   distance, side, normal_smoothing, symmetry_planes, allow_folds)
-        if any(v is not None for v in (control_counts, tolerance, boundary_tolerances, fairing)):
-            request.spec.CopyFrom(_fit_spec(control_counts, tolerance, order, max_controls,
-                                            boundary_tolerances, fairing))
-            if not request.spec.HasField("resolution"):
-                request.spec.boundary_tolerances.SetInParent()
+        _set_fit(request, control_counts, tolerance, order, max_controls, boundary_tolerances,
+                 fairing)
         return self._unary(self.stub.GenerateGrid, request,
                            service_pb2.GenerateGridResponse)

@@ -47,14 +47,6 @@ double CellArea(const StructuredBlock& g, int i, int j) {
 
 class GenerateTest : public ServiceTest {
  protected:
-  // Every grid's name, in order.
-  std::vector<std::string> GridNames() {
-    std::vector<std::string> names;
-    const std::vector<v1::Grid> grids = client_->List().value();
-    for (const v1::Grid& g : grids) names.push_back(g.name());
-    return names;
-  }
-
   // Checks the stored grid `id`: one fitted 129 x (layers + 1) block whose level-0 cells all
   // have a positive signed area, and whose boundary kinds are wall at j = 0, outer at j = max
   // and interface on the seam i = 0 / i = max.
@@ -102,14 +94,6 @@ class GenerateTest : public ServiceTest {
   }
 
   // `request` fails with `code` naming `fragment`, and nothing new is stored.
-  void ExpectRefused(const v1::GenerateGridRequest& request, absl::StatusCode code,
-                     const std::string& fragment) {
-    const std::vector<std::string> before = GridNames();
-    const int64_t budget = SettledBudget();
-    EXPECT_THAT(client_->Generate(request).status(), StatusIs(code, fragment));
-    EXPECT_EQ(GridNames(), before);
-    EXPECT_TRUE(WaitForBudget(budget));
-  }
 };
 
 class GenerateAirfoilTest : public GenerateTest,
@@ -195,8 +179,8 @@ TEST_F(GenerateTest, EllipticFromAnAirfoilFile) {
   // Coarse to fine halves the points and layers: an even number of wall points is refused.
   request.set_grid_id("rae-elliptic-even");
   request.set_wall_points(kWallPoints + 1);
-  ExpectRefused(request, absl::StatusCode::kInvalidArgument,
-                absl::StrCat("wall_points = ", kWallPoints + 1, " must be odd"));
+  ExpectGenerateRefused(request, absl::StatusCode::kInvalidArgument,
+                        absl::StrCat("wall_points = ", kWallPoints + 1, " must be odd"));
 }
 
 // The seam of a generated O-grid is a C0 knot line (the spline is clamped at i = 0 and
@@ -268,12 +252,12 @@ TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
   // A wall that is not there, and a block that is not.
   request.set_grid_id("no-wall");
   request.mutable_stored_wall()->set_block(1);
-  ExpectRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.block = 1");
+  ExpectGenerateRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.block = 1");
   request.mutable_stored_wall()->set_block(0);
   request.mutable_stored_wall()->set_name("grids/nothing");
-  ExpectRefused(request, absl::StatusCode::kNotFound, "grids/nothing");
+  ExpectGenerateRefused(request, absl::StatusCode::kNotFound, "grids/nothing");
   request.mutable_stored_wall()->set_name("cgrid");
-  ExpectRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.name = 'cgrid'");
+  ExpectGenerateRefused(request, absl::StatusCode::kInvalidArgument, "stored_wall.name = 'cgrid'");
 }
 
 TEST_F(GenerateTest, BadInputIsRefusedByNameAndNothingIsStored) {
@@ -284,11 +268,12 @@ TEST_F(GenerateTest, BadInputIsRefusedByNameAndNothingIsStored) {
     return r;
   };
   const std::vector<double> diamond = {1, 0, 0.5, 0.1, 0, 0, 0.5, -0.1, 1, 0};
-  ExpectRefused(with_points({1, 0, 0.5, std::nan(""), 0, 0, 0.5, -0.1, 1, 0}),
-                absl::StatusCode::kInvalidArgument, "points.xy[3] = nan");
-  ExpectRefused(with_points({1, 0, 0, 0, 1, 0}), absl::StatusCode::kInvalidArgument,
-                "points.xy has 3 points");
-  ExpectRefused(with_points({1, 0, 0, 0, 1}), absl::StatusCode::kInvalidArgument, "odd count");
+  ExpectGenerateRefused(with_points({1, 0, 0.5, std::nan(""), 0, 0, 0.5, -0.1, 1, 0}),
+                        absl::StatusCode::kInvalidArgument, "points.xy[3] = nan");
+  ExpectGenerateRefused(with_points({1, 0, 0, 0, 1, 0}), absl::StatusCode::kInvalidArgument,
+                        "points.xy has 3 points");
+  ExpectGenerateRefused(with_points({1, 0, 0, 0, 1}), absl::StatusCode::kInvalidArgument,
+                        "odd count");
 
   // A figure eight: the outline crosses itself (the kernel's message, passed through).
   std::vector<double> eight;
@@ -297,39 +282,39 @@ TEST_F(GenerateTest, BadInputIsRefusedByNameAndNothingIsStored) {
     eight.push_back(0.5 + 0.5 * std::cos(t));
     eight.push_back(0.2 * std::sin(2 * t));
   }
-  ExpectRefused(with_points(eight), absl::StatusCode::kInvalidArgument, "crosses itself");
+  ExpectGenerateRefused(with_points(eight), absl::StatusCode::kInvalidArgument, "crosses itself");
 
   v1::GenerateGridRequest r = with_points(diamond);
   r.set_first_height(-1e-4);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = -0.0001");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "first_height = -0.0001");
   r.set_first_height(0.0);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = 0");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "first_height = 0");
   r.set_first_height(std::nan(""));
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = nan");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "first_height = nan");
   r.set_first_height(1.0);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "distance = 20 is below layers");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "distance = 20 is below layers");
   r.set_first_height(kFirstHeight);
   r.set_wall_points(4);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "wall_points = 4");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "wall_points = 4");
   r.set_wall_points(kWallPoints);
   r.set_layers(0);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "layers = 0");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "layers = 0");
   r.set_layers(kLayers);
   r.set_method(static_cast<v1::LayerMethod>(7));
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "method = 7");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "method = 7");
   r.set_method(v1::LAYER_METHOD_UNSPECIFIED);
   r.set_grid_id("Bad_Id");
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "grid_id = 'Bad_Id'");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "grid_id = 'Bad_Id'");
   r.set_grid_id("bad");
   r.mutable_spec()->set_tolerance(-1.0);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "tolerance");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "tolerance");
   r.clear_spec();
 
   v1::GenerateGridRequest unset = SmallRequest("bad");
-  ExpectRefused(unset, absl::StatusCode::kInvalidArgument, "profile is unset");
+  ExpectGenerateRefused(unset, absl::StatusCode::kInvalidArgument, "profile is unset");
   v1::GenerateGridRequest file = SmallRequest("bad");
   file.set_airfoil_file("NACA\n1.0 0.0\n0.5 x\n");
-  ExpectRefused(file, absl::StatusCode::kInvalidArgument, "airfoil_file");
+  ExpectGenerateRefused(file, absl::StatusCode::kInvalidArgument, "airfoil_file");
 
   // The name is taken: ALREADY_EXISTS, the existing grid untouched.
   v1::GenerateGridRequest first = SmallRequest("taken");
@@ -337,7 +322,7 @@ TEST_F(GenerateTest, BadInputIsRefusedByNameAndNothingIsStored) {
   ASSERT_TRUE(client_->Generate(first).ok());
   const v1::Grid before = client_->Get("taken").value();
   first.set_method(v1::LAYER_METHOD_TRANSFINITE);
-  ExpectRefused(first, absl::StatusCode::kAlreadyExists, "grids/taken already exists");
+  ExpectGenerateRefused(first, absl::StatusCode::kAlreadyExists, "grids/taken already exists");
   EXPECT_EQ(client_->Get("taken").value().DebugString(), before.DebugString());
   EXPECT_EQ(GridNames(), std::vector<std::string>{"grids/taken"});
 }
@@ -347,7 +332,7 @@ TEST_F(GenerateTest, SizeOverTheServersCapIsOutOfRange) {
   StartServer();
   v1::GenerateGridRequest r = SmallRequest("big");
   r.set_airfoil_file(AirfoilText("naca0012.dat"));
-  ExpectRefused(r, absl::StatusCode::kOutOfRange, "wall_points * (layers + 1) = 4386");
+  ExpectGenerateRefused(r, absl::StatusCode::kOutOfRange, "wall_points * (layers + 1) = 4386");
 }
 
 TEST_F(GenerateTest, AnExpiredDeadlineStoresNothing) {

@@ -58,22 +58,6 @@ double MinCornerJacobian(const StructuredBlock& b) {
 
 class GenerateVolumeTest : public ServiceTest {
  protected:
-  std::vector<std::string> GridNames() {
-    std::vector<std::string> names;
-    const std::vector<v1::Grid> grids = client_->List().value();
-    for (const v1::Grid& g : grids) names.push_back(g.name());
-    return names;
-  }
-
-  void ExpectRefused(const v1::GenerateGridRequest& request, absl::StatusCode code,
-                     const std::string& fragment) {
-    const std::vector<std::string> before = GridNames();
-    const int64_t budget = SettledBudget();
-    EXPECT_THAT(client_->Generate(request).status(), StatusIs(code, fragment));
-    EXPECT_EQ(GridNames(), before);
-    EXPECT_TRUE(WaitForBudget(budget));
-  }
-
   MultiBlockGrid Evaluate(const std::string& id, int level) {
     v1::EvaluateGridRequest request;
     request.set_name("grids/" + id);
@@ -145,43 +129,44 @@ TEST_F(GenerateVolumeTest, BadRequestsAreRefusedByNameAndNothingIsStored) {
 
   v1::GenerateGridRequest r = M6Request("bad");
   r.mutable_stored_surface()->set_name("grids/planar");
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument,
-                "stored_surface.name: block 0 of grids/planar revision 1 is 113x33x1 with 2 "
-                "coordinates");
+  ExpectGenerateRefused(
+      r, absl::StatusCode::kInvalidArgument,
+      "stored_surface.name: block 0 of grids/planar revision 1 is 113x33x1 with 2 "
+      "coordinates");
   r.mutable_stored_surface()->set_name("grids/none");
-  ExpectRefused(r, absl::StatusCode::kNotFound, "grids/none");
+  ExpectGenerateRefused(r, absl::StatusCode::kNotFound, "grids/none");
   r = M6Request("bad");
   r.mutable_stored_surface()->set_revision(7);
-  ExpectRefused(r, absl::StatusCode::kNotFound, "revision 7");
+  ExpectGenerateRefused(r, absl::StatusCode::kNotFound, "revision 7");
   r = M6Request("bad");
   r.set_method(v1::LAYER_METHOD_ELLIPTIC);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "method = LAYER_METHOD_ELLIPTIC");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "method = LAYER_METHOD_ELLIPTIC");
   r = M6Request("bad");
   r.set_wall_points(129);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "wall_points is set");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "wall_points is set");
   r = M6Request("bad");
   r.set_first_height(std::nan(""));
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "first_height = nan");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "first_height = nan");
   r = M6Request("bad");
   r.set_normal_smoothing(-1);
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "normal_smoothing = -1");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "normal_smoothing = -1");
   r = M6Request("bad");
   r.set_side(static_cast<v1::MarchSide>(9));
-  ExpectRefused(r, absl::StatusCode::kInvalidArgument, "side = 9");
+  ExpectGenerateRefused(r, absl::StatusCode::kInvalidArgument, "side = 9");
   // Far beyond what the wing's layers can reach: the march refuses, nothing is stored.
   r = M6Request("bad");
   r.set_distance(1e9);
-  ExpectRefused(r, absl::StatusCode::kFailedPrecondition, "layer");
+  ExpectGenerateRefused(r, absl::StatusCode::kFailedPrecondition, "layer");
   // The march's fields on a profile request.
   v1::GenerateGridRequest profile;
   profile.set_grid_id("bad");
   profile.set_airfoil_file(ReadFileToString(SharedDataPath("airfoils/naca0012.dat")).value());
   profile.set_normal_smoothing(40);
-  ExpectRefused(profile, absl::StatusCode::kInvalidArgument,
-                "normal_smoothing is set: it applies to a stored_surface");
+  ExpectGenerateRefused(profile, absl::StatusCode::kInvalidArgument,
+                        "normal_smoothing is set: it applies to a stored_surface");
   // The name is taken.
   r = M6Request("m6");
-  ExpectRefused(r, absl::StatusCode::kAlreadyExists, "grids/m6 already exists");
+  ExpectGenerateRefused(r, absl::StatusCode::kAlreadyExists, "grids/m6 already exists");
 }
 
 TEST_F(GenerateVolumeTest, SizeOverTheServersCapIsOutOfRange) {
@@ -189,8 +174,8 @@ TEST_F(GenerateVolumeTest, SizeOverTheServersCapIsOutOfRange) {
   StartServer();
   ImportShared("surfaces/m6_small.fmt", "m6");
   ASSERT_TRUE(client_->Fit("m6", v1::FitSpec()).ok());
-  ExpectRefused(M6Request("big"), absl::StatusCode::kOutOfRange,
-                "surface points * (layers + 1) = 528033 points");
+  ExpectGenerateRefused(M6Request("big"), absl::StatusCode::kOutOfRange,
+                        "surface points * (layers + 1) = 528033 points");
 }
 
 }  // namespace

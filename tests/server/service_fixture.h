@@ -88,6 +88,25 @@ class ServiceTest : public ::testing::Test {
     return false;
   }
 
+  // Every grid's name, in order.
+  std::vector<std::string> GridNames() {
+    std::vector<std::string> names;
+    const std::vector<v1::Grid> grids = client_->List().value();
+    for (const v1::Grid& g : grids) names.push_back(g.name());
+    return names;
+  }
+
+  // A GenerateGrid call refused with `code` and a message holding `fragment`: nothing stored,
+  // the memory budget back where it was.
+  void ExpectGenerateRefused(const v1::GenerateGridRequest& request, absl::StatusCode code,
+                             const std::string& fragment) {
+    const std::vector<std::string> before = GridNames();
+    const int64_t budget = SettledBudget();
+    EXPECT_THAT(client_->Generate(request).status(), StatusIs(code, fragment));
+    EXPECT_EQ(GridNames(), before);
+    EXPECT_TRUE(WaitForBudget(budget));
+  }
+
   std::unique_ptr<server::Server> server_;
   std::unique_ptr<client::Client> client_;
 };
