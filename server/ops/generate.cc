@@ -14,22 +14,6 @@
 namespace splinegrid::server::ops {
 namespace {
 
-// The fit of revision 1: the request's, or else interpolation (a control point per grid point,
-// like FitGrid without a spec). The default tolerances by kind are meant for chord-sized cells:
-// a wall tolerance of 1.5e-4 against a first layer of 1e-5 folds the wall cells, so a generated
-// grid is kept exact unless the request asks for compression. Unless the fit names face kinds,
-// the O-grid's j = 0 is the wall and j = max the outer boundary (the seam is an interface
-// through the connectivity), independent of the clustering heuristics.
-GridFitOptions GeneratedFitOptions(const GenerateRequest& request) {
-  GridFitOptions options = request.fit.value_or(GridFitOptions());
-  options.allow_folds = options.allow_folds || request.allow_folds;
-  if (options.face_kinds.empty()) {
-    options.face_kinds = {{Face{0, 1, false}, BoundaryKind::kWall},
-                          {Face{0, 1, true}, BoundaryKind::kOuter}};
-  }
-  return options;
-}
-
 // Reverses `points` when they run clockwise (Selig order runs counter-clockwise).
 void MakeCounterClockwise(StructuredBlock& points) {
   std::span<double> c = points.coords();
@@ -107,7 +91,15 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
   const int64_t points = GeneratedPoints(request.options);
   SG_RETURN_IF_ERROR(
       CheckNewGrid(context, header, points, "wall_points * (layers + 1)", request.max_points));
-  const GridFitOptions fit_options = GeneratedFitOptions(request);
+  // The fit of revision 1: the request's, or else interpolation (a control point per grid
+  // point, like FitGrid without a spec). The default tolerances by kind are meant for
+  // chord-sized cells: a wall tolerance of 1.5e-4 against a first layer of 1e-5 folds the wall
+  // cells, so a generated grid is kept exact unless the request asks for compression. Unless
+  // the fit names face kinds, the O-grid's j = 0 is the wall and j = max the outer boundary
+  // (the seam is an interface through the connectivity), independent of the clustering
+  // heuristics.
+  const GridFitOptions fit_options =
+      GeneratedGridFit(request.fit, GridFitOptions(), request.allow_folds, 1, /*outward=*/1);
   const bool bare_points = std::holds_alternative<ProfilePoints>(request.profile) &&
                            std::get<ProfilePoints>(request.profile).name.empty();
   ProfilePoints profile;

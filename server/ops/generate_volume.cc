@@ -14,25 +14,13 @@
 namespace splinegrid::server::ops {
 namespace {
 
-// The fit of revision 1: the request's, or else interpolation with uniform parameters. Chord
-// lengths averaged over each block's lines differ between two blocks along their shared face,
-// and so would their face splines between the grid points; uniform parameters and one control
-// point per point make both faces the interpolant of the same face points on the same knots.
-// Unless the fit names face kinds, k = 0 is the wall and k = max the outer boundary.
-GridFitOptions VolumeFitOptions(const GenerateVolumeRequest& request, int num_blocks) {
+// The default fit of revision 1: interpolation with uniform parameters. Chord lengths averaged
+// over each block's lines differ between two blocks along their shared face, and so would their
+// face splines between the grid points; uniform parameters and one control point per point make
+// both faces the interpolant of the same face points on the same knots.
+GridFitOptions UniformInterpolation() {
   GridFitOptions options;
-  if (request.fit.has_value()) {
-    options = *request.fit;
-  } else {
-    options.parametrization = Parametrization::kUniform;
-  }
-  options.allow_folds = options.allow_folds || request.allow_folds;
-  if (options.face_kinds.empty()) {
-    for (int b = 0; b < num_blocks; ++b) {
-      options.face_kinds.push_back({Face{b, 2, false}, BoundaryKind::kWall});
-      options.face_kinds.push_back({Face{b, 2, true}, BoundaryKind::kOuter});
-    }
-  }
+  options.parametrization = Parametrization::kUniform;
   return options;
 }
 
@@ -102,7 +90,9 @@ absl::StatusOr<GenerateVolumeResult> GenerateVolume(const OpsContext& context,
   SG_RETURN_IF_ERROR(
       CheckNewGrid(context, header, points, "surface points * (layers + 1)", request.max_points));
   const int num_blocks = static_cast<int>(surface.grid.blocks.size());
-  const GridFitOptions fit_options = VolumeFitOptions(request, num_blocks);
+  const GridFitOptions fit_options =
+      GeneratedGridFit(request.fit, UniformInterpolation(), request.allow_folds, num_blocks,
+                       /*outward=*/2);
 
   GenerateVolumeResult result;
   auto source = std::make_shared<SourcePoints>();

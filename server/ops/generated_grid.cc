@@ -27,6 +27,20 @@ absl::Status CheckNewGrid(const OpsContext& context, const NewGridHeader& header
   return absl::OkStatus();
 }
 
+GridFitOptions GeneratedGridFit(const std::optional<GridFitOptions>& requested,
+                                GridFitOptions default_fit, bool allow_folds, int num_blocks,
+                                int outward) {
+  GridFitOptions options = requested.value_or(std::move(default_fit));
+  options.allow_folds = options.allow_folds || allow_folds;
+  if (options.face_kinds.empty()) {
+    for (int b = 0; b < num_blocks; ++b) {
+      options.face_kinds.push_back({Face{b, outward, false}, BoundaryKind::kWall});
+      options.face_kinds.push_back({Face{b, outward, true}, BoundaryKind::kOuter});
+    }
+  }
+  return options;
+}
+
 absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreGenerated(
     const OpsContext& context, const NewGridHeader& header, const std::string& default_name,
     std::shared_ptr<SourcePoints> source, MultiBlockGrid blocks, const GridFitOptions& options,

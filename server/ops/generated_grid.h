@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
@@ -30,6 +31,14 @@ struct NewGridHeader {
 // "wall_points * (layers + 1)").
 absl::Status CheckNewGrid(const OpsContext& context, const NewGridHeader& header, int64_t points,
                           const std::string& points_what, int64_t max_points);
+
+// The fit of a generated grid's revision 1: `requested`, else `default_fit`; folds allowed when
+// either it or `allow_folds` says so; unless it names face kinds, every block's faces across
+// direction `outward` (the one leaving the wall) are the wall at index 0 and the outer boundary
+// at the last index (other faces: interfaces through the connectivity).
+GridFitOptions GeneratedGridFit(const std::optional<GridFitOptions>& requested,
+                                GridFitOptions default_fit, bool allow_folds, int num_blocks,
+                                int outward);
 
 // Stores `blocks` (whose bytes `source` already holds in the budget, described by `format`) as
 // the new grid's source points and fits them as revision 1; `default_name` names the grid when
