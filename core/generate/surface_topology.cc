@@ -101,6 +101,24 @@ int LoopDirection(const Face& face) {
   return face.upper ? +1 : -1;
 }
 
+// OK when both ranges of `match` lie inside their (surface) blocks of `surface`; else
+// INVALID_ARGUMENT: a connectivity of another grid.
+absl::Status CheckMatch(const MultiBlockGrid& surface, const BoundaryMatch& match) {
+  for (const FaceRange* range : {&match.a, &match.b}) {
+    const int b = range->face.block;
+    bool inside = b >= 0 && b < static_cast<int>(surface.blocks.size()) && range->face.normal < 2;
+    for (int d = 0; inside && d < 3; ++d) {
+      inside = range->begin[d] >= 0 && range->begin[d] <= range->end[d] &&
+               range->end[d] < surface.blocks[b].extent(d);
+    }
+    if (!inside) {
+      return absl::InvalidArgumentError(absl::StrCat("connectivity: the match ", match.Describe(),
+                                                     " does not fit the surface's blocks"));
+    }
+  }
+  return absl::OkStatus();
+}
+
 // Orients the blocks alike (file comment of the header): BFS over the matches. Two blocks are
 // oriented alike when their counter-clockwise boundary loops run along the shared edge in
 // opposite directions (as two faces of a polyhedron share an edge), a question of the match's
@@ -207,6 +225,7 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
     return numbering.base[b] + surface.blocks[b].Index(x[0], x[1], 0);
   };
   for (const BoundaryMatch& match : connectivity.matches) {
+    SG_RETURN_IF_ERROR(CheckMatch(surface, match));
     if (match.step != 1) {
       return absl::InvalidArgumentError(
           absl::StrCat("surface: the match ", match.Describe(),

@@ -67,8 +67,9 @@ struct SurfaceTopology {
 
 // The topology of `surface` (blocks ni x nj x 1, spatial_dim 3) with its `connectivity`
 // (FindConnectivity of the same blocks); symmetry planes only if `find_symmetry_planes`.
-// Errors: INVALID_ARGUMENT for a surface whose matches have hanging nodes (step 2) or whose
-// blocks cannot be oriented alike, naming the blocks.
+// Errors: INVALID_ARGUMENT for a match outside the blocks (a connectivity of another grid), a
+// surface whose matches have hanging nodes (step 2) or whose blocks cannot be oriented alike,
+// naming the match or the blocks.
 absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surface,
                                                      const Connectivity& connectivity,
                                                      bool find_symmetry_planes);

@@ -553,6 +553,17 @@ TEST(SurfaceOffsetTest, AMoebiusStripCannotBeOriented) {
   EXPECT_THAT(grid.status().message(), HasSubstr("cannot be oriented alike"));
 }
 
+TEST(SurfaceOffsetTest, AConnectivityOfAnotherGridIsRefused) {
+  const MultiBlockGrid l = RightAngle();
+  const MultiBlockGrid m6 = ReadShared("surfaces/m6_small.fmt");
+  const absl::StatusOr<Connectivity> other = FindConnectivity(m6);
+  ASSERT_TRUE(other.ok());
+  const absl::StatusOr<SurfaceOffsetGrid> grid =
+      OffsetSurfaceGrid(l, *other, SurfaceOffsetOptions{});
+  EXPECT_EQ(grid.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(grid.status().message(), HasSubstr("does not fit the surface's blocks"));
+}
+
 TEST(SurfaceOffsetTest, OutwardNeedsAnEnclosedVolume) {
   MultiBlockGrid plane;
   plane.blocks.push_back(TiltedPlane({0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}));
