@@ -58,7 +58,7 @@ ABSL_FLAG(std::string, face, "",
           "jmin, jmax, kmin or kmax and KIND wall, interface or outer (implies --kinds); e.g. "
           "--face 0:imin=wall,2:jmax=outer");
 ABSL_FLAG(bool, allow_folds, false,
-          "fit/fair/offset: store the revision even if cells fold at levels 0..2 (exit 1 after "
+          "fit/fair/offset: store the revision even if cells fold at levels 0..2 (exit 3 after "
           "storing it; without the flag such a fit is refused and nothing is stored)");
 
 ABSL_FLAG(int64_t, revision, 0, "get/eval/fair/curvature: revision (0: latest)");

@@ -13,6 +13,13 @@ absl::Status CheckGridOutput(const std::string& out) {
     return absl::InvalidArgumentError(
         absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x, .xyz or .cgns"));
   }
+  // Checked before a call that stores something (offset), so a typo does not leave a grid
+  // stored and its file unwritten.
+  const std::filesystem::path dir = std::filesystem::path(out).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
+    return absl::NotFoundError(
+        absl::StrCat("-o ", out, ": the directory ", dir.string(), " does not exist"));
+  }
   return absl::OkStatus();
 }
 

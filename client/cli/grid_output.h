@@ -15,9 +15,9 @@
 
 namespace splinegrid::cli {
 
-// OK when `out` ends in an extension WriteGridOutput writes (.vts, .vtm, .x, .xyz, .cgns);
-// INVALID_ARGUMENT naming it otherwise. Checked before any call, so a bad -o fails before the
-// work is done.
+// OK when `out` ends in an extension WriteGridOutput writes (.vts, .vtm, .x, .xyz, .cgns) and
+// its directory exists; INVALID_ARGUMENT (extension) or NOT_FOUND (directory) naming it
+// otherwise. Checked before any call, so a bad -o fails before the work is done.
 absl::Status CheckGridOutput(const std::string& out);
 
 // Writes `result` to `out` by its extension: .cgns with WriteCgnsOutput (boundary conditions and

@@ -488,10 +488,11 @@ absl::Status FoldedLayerError(const March& m, const CellCheck& check, int k, dou
         " while the curvature limit (max_curvature_step = ", options.max_curvature_step,
         ") holds its steps up to ", held_back, " short; lower the distance"));
   }
-  return absl::FailedPreconditionError(
-      absl::StrCat("layer ", k + 1, " folds at ", cell, " even with smoothed normals (step ", h,
-                   ", max_retries = ", options.max_retries,
-                   "); use more layers, a smaller growth or a smoother surface"));
+  return absl::FailedPreconditionError(absl::StrCat(
+      "layer ", k + 1, " folds at ", cell, " even with smoothed normals (step ", h,
+      ", max_retries = ", options.max_retries,
+      "); use more normal_smoothing (sweeps at the last layer: ", options.normal_smoothing,
+      "), more layers or a smaller growth"));
 }
 
 // Fairs the displacement p -> q of every block with weight `lambda` and adds its spline to the
@@ -616,6 +617,18 @@ absl::Status FitSurfaceBlocks(const MultiBlockGrid& surface, const SurfaceTopolo
 
 absl::Status SurfaceOffsetOptions::Validate() const {
   SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
+  if (layers == 1 && distance > first_height * (1.0 + 1e-12)) {
+    return absl::InvalidArgumentError(absl::StrCat("layers = 1 with first_height = ", first_height,
+                                                   " cannot reach distance = ", distance,
+                                                   ": one layer is first_height high"));
+  }
+  if (const double ratio = GeometricRatio(first_height, distance, layers);
+      !(ratio <= kMaxGrowthRatio)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("distance = ", distance, " needs a growth ratio of ", ratio,
+                     " between layers (", layers, " layers from first_height = ", first_height,
+                     "), above ", kMaxGrowthRatio, "; use more layers or a larger first_height"));
+  }
   if (side != 1 && side != -1) {
     return absl::InvalidArgumentError(absl::StrCat("side = ", side, " is neither +1 nor -1"));
   }

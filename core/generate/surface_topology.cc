@@ -133,7 +133,7 @@ absl::Status OrientBlocks(const MultiBlockGrid& surface, const Connectivity& con
   };
   std::vector<std::vector<Link>> links(num_blocks);
   for (const BoundaryMatch& match : connectivity.matches) {
-    // The edge's tangential direction in a (the one with more than one point, or i).
+    // The direction of a along the shared edge (not its face normal).
     const int t = match.a.face.normal == 0 ? 1 : 0;
     const int along = match.reversed[t] ? -1 : +1;
     const int sign = -LoopDirection(match.a.face) * LoopDirection(match.b.face) * along;

@@ -93,9 +93,14 @@ def _volume_request(name: str, surface: str, revision: int, display_name: str,
     request.stored_surface.name = grid_name(surface)
     request.stored_surface.revision = _non_negative_int(revision, "revision")
     _layers(request, None, None, layers, first_height, distance, None, None)
-    if normal_smoothing is not None:
-        request.normal_smoothing = _integer(normal_smoothing, "normal_smoothing")
+    if normal_smoothing is not None:  # the server names values outside [0, 1000]
+        smoothing = _integer(normal_smoothing, "normal_smoothing")
+        if not -2**31 <= smoothing < 2**31:
+            raise ValueError(f"normal_smoothing = {smoothing}; must be in [0, 1000]")
+        request.normal_smoothing = smoothing
     if symmetry_planes is not None:
+        if not isinstance(symmetry_planes, (bool, np.bool_)):
+            raise ValueError(f"symmetry_planes = {symmetry_planes!r}; must be True or False")
         request.symmetry_planes = bool(symmetry_planes)
     return request
 

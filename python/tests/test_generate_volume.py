@@ -24,6 +24,10 @@ def test_the_request_carries_the_march():
     assert not request.HasField("wall_points")
     with pytest.raises(ValueError, match="side = 'sideways'"):
         _volume_request("vol", "sphere", 0, "", None, None, None, "sideways", None, None, False)
+    with pytest.raises(ValueError, match="symmetry_planes = 'no'"):
+        _volume_request("vol", "sphere", 0, "", None, None, None, "outward", None, "no", False)
+    with pytest.raises(ValueError, match="normal_smoothing = 1000000000000"):
+        _volume_request("vol", "sphere", 0, "", None, None, None, "outward", 10**12, None, False)
 
 
 def corner_jacobians(x):

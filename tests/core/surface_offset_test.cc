@@ -605,6 +605,10 @@ TEST(SurfaceOffsetTest, BadOptionsNameTheField) {
       {"normal_smoothing = 1001 is outside [0, 1000]",
        [](SurfaceOffsetOptions& o) { o.normal_smoothing = 1001; }},
       {"max_retries = 101", [](SurfaceOffsetOptions& o) { o.max_retries = 101; }},
+      {"distance = 1e+300 needs a growth ratio of",
+       [](SurfaceOffsetOptions& o) { o.distance = 1e300; }},
+      {"layers = 1 with first_height = 0.001 cannot reach distance = 0.5",
+       [](SurfaceOffsetOptions& o) { o.layers = 1; }},
   };
   for (const BadOptionsCase& c : cases) {
     SurfaceOffsetOptions options;
