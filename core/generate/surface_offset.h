@@ -51,7 +51,10 @@
 // (surface_topology.h): it gets the normalised mean of its blocks' normals and one step, and
 // it is smoothed with all its blocks' stencils together, so the volume
 // blocks share their faces point for point (watertight) and a convex edge between blocks (a
-// blunt trailing edge's corner) fans out along the mean normal. On block edges the spline's
+// blunt trailing edge's corner) fans out along the mean normal. A concave crease (a wing-body
+// junction) is not treated: its mean normal rises only cos(angle / 2) of a step above either
+// face, it lags, and within a few cells' height the layers fold back over it (refused by the
+// fold check). On block edges the spline's
 // derivatives are one-sided (clamped knots), so no normal needs a neighbour outside its block.
 // Where an edge collapses to one point (a pole: X_v = 0 along u = 0, say) the normal X_u x X_v
 // vanishes; by l'Hopital X_v ~ u X_uv there, so the normal is that of X_u x X_uv (X_uv x X_v for
