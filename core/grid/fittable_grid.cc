@@ -1,6 +1,7 @@
 #include "core/grid/fittable_grid.h"
 
 #include "absl/strings/str_cat.h"
+#include "core/grid/connectivity_edit.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -11,6 +12,18 @@ absl::StatusOr<FittableGrid> FittableGrid::Check(MultiBlockGrid grid,
   SG_RETURN_IF_ERROR(ValidateFittableBlocks(grid));
   FittableGrid checked;
   SG_ASSIGN_OR_RETURN(checked.connectivity_, FindConnectivity(grid, options));
+  checked.grid_ = std::move(grid);
+  return checked;
+}
+
+absl::StatusOr<FittableGrid> FittableGrid::CheckWithConnectivity(MultiBlockGrid grid,
+                                                                 Connectivity connectivity,
+                                                                 double tolerance) {
+  if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
+  SG_RETURN_IF_ERROR(ValidateFittableBlocks(grid));
+  SG_RETURN_IF_ERROR(CheckConnectivity(grid, connectivity, tolerance));
+  FittableGrid checked;
+  checked.connectivity_ = std::move(connectivity);
   checked.grid_ = std::move(grid);
   return checked;
 }

@@ -24,6 +24,14 @@ class FittableGrid {
   static absl::StatusOr<FittableGrid> Check(MultiBlockGrid grid,
                                             const ConnectivityOptions& options = {});
 
+  // Checks every block of `grid` and takes `connectivity` as its connectivity, each match checked
+  // to fit the blocks and its points to coincide within `tolerance` (CheckConnectivity): for a
+  // grid made from another whose connectivity is derived (connectivity_edit.h), where finding
+  // it again would cost far more. INVALID_ARGUMENT as Check and for a match that does not hold.
+  static absl::StatusOr<FittableGrid> CheckWithConnectivity(MultiBlockGrid grid,
+                                                            Connectivity connectivity,
+                                                            double tolerance);
+
   const MultiBlockGrid& grid() const { return grid_; }
   const Connectivity& connectivity() const { return connectivity_; }
 

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/bspline/evaluation.h"
+#include "core/grid/connectivity_edit.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
 #include "server/ops/generated_grid.h"
@@ -104,19 +105,26 @@ absl::StatusOr<GenerateVolumeResult> GenerateVolume(const OpsContext& context,
                       OffsetSurfaceGrid(surface.grid, surface.connectivity, request.options));
   result.layer_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The volume's connectivity is the surface's, extruded along k (and renumbered where i is
+  // reversed): finding it again costs far more than the march on a deep stack.
+  Connectivity connectivity = Extruded(surface.connectivity, request.options.layers);
   MultiBlockGrid volume;
   for (int b = 0; b < num_blocks; ++b) {
     StructuredBlock& block = result.generated.blocks[b];
     const bool reverse = result.generated.sides[b] < 0;
     result.reversed_i.push_back(reverse);
-    if (reverse) ReverseI(block);
+    if (reverse) {
+      ReverseI(block);
+      ReverseBlockDirection(connectivity, b, 0, block.extents());
+    }
     volume.blocks.push_back(std::move(block));
   }
   result.generated.blocks.clear();
   source->format = absl::StrFormat("generated volume grid of %d blocks, %d layers off %s",
                                    num_blocks, request.options.layers, surface.name);
-  SG_ASSIGN_OR_RETURN(result.grid, StoreGenerated(context, header, surface.name, std::move(source),
-                                                  std::move(volume), fit_options, cancel));
+  SG_ASSIGN_OR_RETURN(
+      result.grid, StoreGenerated(context, header, surface.name, std::move(source),
+                                  std::move(volume), fit_options, cancel, std::move(connectivity)));
   result.options = request.options;
   result.options.cancel = {};
   return result;

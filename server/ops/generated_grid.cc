@@ -1,5 +1,7 @@
 #include "server/ops/generated_grid.h"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -8,6 +10,18 @@
 #include "server/ops/fit.h"
 
 namespace splinegrid::server::ops {
+namespace {
+
+// 1e-12 of the largest coordinate: what a derived connectivity's points may differ by.
+double RoundingTolerance(const MultiBlockGrid& grid) {
+  double largest = 0.0;
+  for (const StructuredBlock& block : grid.blocks) {
+    for (double x : block.coords()) largest = std::max(largest, std::abs(x));
+  }
+  return 1e-12 * largest;
+}
+
+}  // namespace
 
 absl::Status CheckNewGrid(const OpsContext& context, const NewGridHeader& header, int64_t points,
                           const std::string& points_what, int64_t max_points) {
@@ -44,8 +58,15 @@ GridFitOptions GeneratedGridFit(const std::optional<GridFitOptions>& requested,
 absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreGenerated(
     const OpsContext& context, const NewGridHeader& header, const std::string& default_name,
     std::shared_ptr<SourcePoints> source, MultiBlockGrid blocks, const GridFitOptions& options,
-    const CancelCheck& cancel) {
-  SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(blocks)));
+    const CancelCheck& cancel, std::optional<Connectivity> connectivity) {
+  if (connectivity.has_value()) {
+    const double tolerance = RoundingTolerance(blocks);
+    SG_ASSIGN_OR_RETURN(source->checked,
+                        FittableGrid::CheckWithConnectivity(std::move(blocks),
+                                                            *std::move(connectivity), tolerance));
+  } else {
+    SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(blocks)));
+  }
   SG_ASSIGN_OR_RETURN(GridRevision revision,
                       FitRevision(context, *source, options, RevisionOrigin::kFit, 0, cancel));
   revision.number = 1;

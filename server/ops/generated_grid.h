@@ -42,12 +42,14 @@ GridFitOptions GeneratedGridFit(const std::optional<GridFitOptions>& requested,
 
 // Stores `blocks` (whose bytes `source` already holds in the budget, described by `format`) as
 // the new grid's source points and fits them as revision 1; `default_name` names the grid when
-// the header does not. FAILED_PRECONDITION when the fit folds (and options.allow_folds is
-// false), ALREADY_EXISTS, CANCELLED; nothing is stored on an error.
+// the header does not. The grid's connectivity is `connectivity` when given (checked to hold to
+// rounding: derived from the generation's, connectivity_edit.h), else found (FindConnectivity).
+// FAILED_PRECONDITION when the fit folds (and options.allow_folds is false), ALREADY_EXISTS,
+// CANCELLED; nothing is stored on an error.
 absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreGenerated(
     const OpsContext& context, const NewGridHeader& header, const std::string& default_name,
     std::shared_ptr<SourcePoints> source, MultiBlockGrid blocks, const GridFitOptions& options,
-    const CancelCheck& cancel);
+    const CancelCheck& cancel, std::optional<Connectivity> connectivity = std::nullopt);
 
 }  // namespace splinegrid::server::ops
 
