@@ -22,8 +22,6 @@ using Vec = Eigen::Vector3d;
 // Per block point (i fastest) or per vertex of the surface (surface_topology.h).
 using Layer = std::vector<Vec>;
 
-// A derivative shorter than this times the surface's size has vanished (a collapsed edge).
-constexpr double kCollapsed = 1e-9;
 // A cell edge shorter than this times the cell's longest edge is collapsed: the Jacobians at
 // its corners vanish and are not checked.
 constexpr double kCollapsedCellEdge = 1e-9;
@@ -60,14 +58,17 @@ void RegularNormals(const TensorSpline& spline, const std::array<std::vector<dou
     const Vec xv(dv[3 * q], dv[3 * q + 1], dv[3 * q + 2]);
     const double a = xu.norm(), b = xv.norm();
     const Vec c = xu.cross(xv);
-    if (a <= kCollapsed * scale || b <= kCollapsed * scale || c.norm() <= 1e-12 * a * b) {
+    if (a <= kCollapsedFraction * scale || b <= kCollapsedFraction * scale ||
+        c.norm() <= 1e-12 * a * b) {
       // Singular: on a pole X_u ~ t X_uv (or X_v ~ t X_uv), t the parameter distance.
       known[q] = 0;
       const PartialDerivatives d =
           EvaluateDerivatives(spline, {params[0][q % s.ni], params[1][q / s.ni], 0.0}, 2);
       const Vec xuv = ToVec(d(1, 1, 0));
-      if (a <= kCollapsed * scale && b > kCollapsed * scale) lhopital[q] = xuv.cross(xv);
-      if (b <= kCollapsed * scale && a > kCollapsed * scale) lhopital[q] = xu.cross(xuv);
+      if (a <= kCollapsedFraction * scale && b > kCollapsedFraction * scale)
+        lhopital[q] = xuv.cross(xv);
+      if (b <= kCollapsedFraction * scale && a > kCollapsedFraction * scale)
+        lhopital[q] = xu.cross(xuv);
       continue;
     }
     normal[q] = side * c.normalized();
@@ -397,26 +398,19 @@ absl::Status CheckSurface(const StructuredBlock& surface, const std::string& nam
 }
 
 // The k = 0 vertex layer: the mean of each vertex's block points (matched points may differ by
-// the matches' gap), on its symmetry plane; into `*scale` the surface's size (the bounding-box
-// diagonal).
-absl::StatusOr<Layer> SurfaceVertices(const MultiBlockGrid& surface, const SurfaceTopology& t,
-                                      double* scale) {
+// the matches' gap); INVALID_ARGUMENT for a surface of one point.
+absl::StatusOr<Layer> SurfaceVertices(const MultiBlockGrid& surface, const SurfaceTopology& t) {
   Layer sum(t.num_vertices, Vec::Zero());
   std::vector<int> count(t.num_vertices, 0);
-  Vec lo = Vec::Constant(HUGE_VAL), hi = Vec::Constant(-HUGE_VAL);
   for (size_t b = 0; b < surface.blocks.size(); ++b) {
     const StructuredBlock& block = surface.blocks[b];
     for (int64_t q = 0; q < block.num_points(); ++q) {
       const double* x = block.coords().data() + 3 * q;
-      const Vec point(x[0], x[1], x[2]);
-      sum[t.vertex[b][q]] += point;
+      sum[t.vertex[b][q]] += Vec(x[0], x[1], x[2]);
       ++count[t.vertex[b][q]];
-      lo = lo.cwiseMin(point);
-      hi = hi.cwiseMax(point);
     }
   }
-  *scale = (hi - lo).norm();
-  if (!(*scale > 0.0)) {
+  if (!(t.scale > 0.0)) {
     return absl::InvalidArgumentError("surface: all points coincide; there is no surface");
   }
   for (int64_t v = 0; v < t.num_vertices; ++v) sum[v] /= static_cast<double>(count[v]);
@@ -501,18 +495,21 @@ absl::Status FoldedLayerError(const March& m, const CellCheck& check, int k, dou
 // displacement instead (counted in `*refits_dropped`).
 absl::Status FairLayer(March& m, const Layer& p, double lambda, Layer& q, CellCheck& check,
                        int* refits_dropped) {
-  std::vector<Displacement> faired;
-  Layer sum(m.num_vertices(), Vec::Zero());
-  std::vector<int> count(m.num_vertices(), 0);
-  for (const BlockMarch& block : m.blocks) {
+  // The displacement p -> q of one block's points, fitted with weight `weight`.
+  auto fit_block = [&](const BlockMarch& block, double weight) {
     Layer d(block.s.size());
     for (int64_t i = 0; i < block.s.size(); ++i) {
       const int64_t v = (*block.vertex)[i];
       d[i] = q[v] - p[v];
     }
-    SG_ASSIGN_OR_RETURN(
-        Displacement fit,
-        FitDisplacement(d, block.s, block.params, block.fit.all_knots(), lambda, m.options.cancel));
+    return FitDisplacement(d, block.s, block.params, block.fit.all_knots(), weight,
+                           m.options.cancel);
+  };
+  std::vector<Displacement> faired;
+  Layer sum(m.num_vertices(), Vec::Zero());
+  std::vector<int> count(m.num_vertices(), 0);
+  for (const BlockMarch& block : m.blocks) {
+    SG_ASSIGN_OR_RETURN(Displacement fit, fit_block(block, lambda));
     for (int64_t i = 0; i < block.s.size(); ++i) {
       const int64_t v = (*block.vertex)[i];
       sum[v] += p[v] + fit.moved[i];
@@ -528,14 +525,7 @@ absl::Status FairLayer(March& m, const Layer& p, double lambda, Layer& q, CellCh
   } else {
     ++*refits_dropped;
     for (size_t b = 0; b < m.blocks.size(); ++b) {
-      const BlockMarch& block = m.blocks[b];
-      Layer d(block.s.size());
-      for (int64_t i = 0; i < block.s.size(); ++i) {
-        const int64_t v = (*block.vertex)[i];
-        d[i] = q[v] - p[v];
-      }
-      SG_ASSIGN_OR_RETURN(faired[b], FitDisplacement(d, block.s, block.params,
-                                                     block.fit.all_knots(), 0.0, m.options.cancel));
+      SG_ASSIGN_OR_RETURN(faired[b], fit_block(m.blocks[b], 0.0));
     }
   }
   for (size_t b = 0; b < m.blocks.size(); ++b) {
@@ -672,8 +662,8 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
   SG_ASSIGN_OR_RETURN(SurfaceTopology topology,
                       BuildSurfaceTopology(surface, connectivity, options.symmetry_planes));
   SG_ASSIGN_OR_RETURN(const std::vector<int> sides, BlockSides(surface, topology, options));
-  March m{options, topology, {}, 0.0, {}};
-  SG_ASSIGN_OR_RETURN(Layer p, SurfaceVertices(surface, topology, &m.scale));
+  March m{options, topology, {}, topology.scale, {}};
+  SG_ASSIGN_OR_RETURN(Layer p, SurfaceVertices(surface, topology));
   ProjectPoints(m, p);
   SG_RETURN_IF_ERROR(FitSurfaceBlocks(surface, topology, sides, m));
   m.stencil = BuildSmoothingStencil(m);

@@ -9,6 +9,7 @@
 #include "Eigen/Core"
 #include "Eigen/Geometry"
 #include "absl/strings/str_cat.h"
+#include "core/grid/connectivity_edit.h"
 #include "core/util/status_macros.h"
 #include "core/util/union_find.h"
 
@@ -17,9 +18,6 @@ namespace {
 
 using Vec = Eigen::Vector3d;
 
-// An edge whose points all lie this close (times the surface's size) to its first point is
-// collapsed (a pole), as in the marcher.
-constexpr double kCollapsed = 1e-9;
 // Points of a symmetry-plane edge lie this close (times the surface's size) to the plane.
 constexpr double kPlaneTolerance = 1e-6;
 
@@ -81,18 +79,6 @@ struct PointNumbering {
   }
 };
 
-// Every point of the match's range a with the point of b it coincides with.
-template <typename F>
-void ForEachMatchedPoint(const BoundaryMatch& match, F f) {
-  const Extents& lo = match.a.begin;
-  const Extents& hi = match.a.end;
-  for (int k = lo[2]; k <= hi[2]; ++k) {
-    for (int j = lo[1]; j <= hi[1]; ++j) {
-      for (int i = lo[0]; i <= hi[0]; ++i) f(Extents{i, j, k}, match.MapToB({i, j, k}));
-    }
-  }
-}
-
 // The direction in which the counter-clockwise boundary loop of a block's (i, j) parameter
 // square runs along `face`'s tangential direction: +i along j = 0, +j along i = max, -i along
 // j = max, -j along i = 0.
@@ -101,20 +87,12 @@ int LoopDirection(const Face& face) {
   return face.upper ? +1 : -1;
 }
 
-// OK when both ranges of `match` lie inside their (surface) blocks of `surface`; else
-// INVALID_ARGUMENT: a connectivity of another grid.
-absl::Status CheckMatch(const MultiBlockGrid& surface, const BoundaryMatch& match) {
-  for (const FaceRange* range : {&match.a, &match.b}) {
-    const int b = range->face.block;
-    bool inside = b >= 0 && b < static_cast<int>(surface.blocks.size()) && range->face.normal < 2;
-    for (int d = 0; inside && d < 3; ++d) {
-      inside = range->begin[d] >= 0 && range->begin[d] <= range->end[d] &&
-               range->end[d] < surface.blocks[b].extent(d);
-    }
-    if (!inside) {
-      return absl::InvalidArgumentError(absl::StrCat("connectivity: the match ", match.Describe(),
-                                                     " does not fit the surface's blocks"));
-    }
+// OK when `match` fits `surface`'s blocks (CheckMatchFits) as a match of two of their edges.
+absl::Status CheckSurfaceMatch(const MultiBlockGrid& surface, const BoundaryMatch& match) {
+  SG_RETURN_IF_ERROR(CheckMatchFits(surface, match, "the surface's blocks"));
+  if (match.a.face.normal == 2 || match.b.face.normal == 2) {
+    return absl::InvalidArgumentError(absl::StrCat("connectivity: the match ", match.Describe(),
+                                                   " does not fit the surface's blocks"));
   }
   return absl::OkStatus();
 }
@@ -225,7 +203,7 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
     return numbering.base[b] + surface.blocks[b].Index(x[0], x[1], 0);
   };
   for (const BoundaryMatch& match : connectivity.matches) {
-    SG_RETURN_IF_ERROR(CheckMatch(surface, match));
+    SG_RETURN_IF_ERROR(CheckSurfaceMatch(surface, match));
     if (match.step != 1) {
       return absl::InvalidArgumentError(
           absl::StrCat("surface: the match ", match.Describe(),
@@ -243,6 +221,7 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
   // Poles: every point of a collapsed edge is one vertex, and none is smoothed.
   const Box box = BoundingBox(surface);
   const double scale = box.diagonal();
+  out.scale = scale;
   std::vector<char> on_pole(numbering.total, 0);
   for (int b = 0; b < num_blocks; ++b) {
     const StructuredBlock& block = surface.blocks[b];
@@ -250,7 +229,7 @@ absl::StatusOr<SurfaceTopology> BuildSurfaceTopology(const MultiBlockGrid& surfa
       const std::vector<int64_t> points = EdgePoints(block.extent(0), block.extent(1), e);
       const Vec first = PointOf(block, points.front());
       const bool collapsed = std::all_of(points.begin(), points.end(), [&](int64_t q) {
-        return (PointOf(block, q) - first).norm() <= kCollapsed * scale;
+        return (PointOf(block, q) - first).norm() <= kCollapsedFraction * scale;
       });
       if (!collapsed) continue;
       for (int64_t q : points) {

@@ -32,6 +32,10 @@
 
 namespace splinegrid {
 
+// An edge whose points all lie this close (times the surface's size) to its first point is
+// collapsed (a pole); a derivative this short (times the size) has vanished.
+inline constexpr double kCollapsedFraction = 1e-9;
+
 // At most this many symmetry planes (two per axis, the surface between them, is six).
 inline constexpr size_t kMaxSymmetryPlanes = 8;
 
@@ -63,6 +67,7 @@ struct SurfaceTopology {
   int components = 0;
   // Largest distance between block points joined into one vertex (the matches' gap).
   double max_gap = 0.0;
+  double scale = 0.0;  // the diagonal of the surface's bounding box
 };
 
 // The topology of `surface` (blocks ni x nj x 1, spatial_dim 3) with its `connectivity`

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/util/status_macros.h"
 
 namespace splinegrid {
 namespace {
@@ -48,42 +49,46 @@ void ReverseBlockDirection(Connectivity& connectivity, int block, int direction,
   }
 }
 
+absl::Status CheckMatchFits(const MultiBlockGrid& grid, const BoundaryMatch& match,
+                            const std::string& what) {
+  const int num_blocks = static_cast<int>(grid.blocks.size());
+  for (const FaceRange* range : {&match.a, &match.b}) {
+    const int b = range->face.block;
+    bool inside = b >= 0 && b < num_blocks && range->face.normal >= 0 && range->face.normal < 3;
+    for (int d = 0; inside && d < 3; ++d) {
+      inside = range->begin[d] >= 0 && range->begin[d] <= range->end[d] &&
+               range->end[d] < grid.blocks[b].extent(d);
+    }
+    if (!inside) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("connectivity: the match ", match.Describe(), " does not fit ", what));
+    }
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckConnectivity(const MultiBlockGrid& grid, const Connectivity& connectivity,
                                double tolerance) {
-  const int num_blocks = static_cast<int>(grid.blocks.size());
   for (const BoundaryMatch& match : connectivity.matches) {
-    for (const FaceRange* range : {&match.a, &match.b}) {
-      const int b = range->face.block;
-      bool inside = b >= 0 && b < num_blocks && range->face.normal >= 0 && range->face.normal < 3;
-      for (int d = 0; inside && d < 3; ++d) {
-        inside = range->begin[d] >= 0 && range->begin[d] <= range->end[d] &&
-                 range->end[d] < grid.blocks[b].extent(d);
-      }
-      if (!inside) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("connectivity: the match ", match.Describe(), " does not fit the grid"));
-      }
-    }
+    SG_RETURN_IF_ERROR(CheckMatchFits(grid, match, "the grid"));
     const StructuredBlock& a = grid.blocks[match.a.face.block];
     const StructuredBlock& b = grid.blocks[match.b.face.block];
     const int dim = a.spatial_dim();
-    for (int k = match.a.begin[2]; k <= match.a.end[2]; ++k) {
-      for (int j = match.a.begin[1]; j <= match.a.end[1]; ++j) {
-        for (int i = match.a.begin[0]; i <= match.a.end[0]; ++i) {
-          const Extents y = match.MapToB({i, j, k});
-          double gap2 = 0.0;
-          for (int c = 0; c < dim; ++c) {
-            const double d = a.Point(i, j, k)[c] - b.Point(y[0], y[1], y[2])[c];
-            gap2 += d * d;
-          }
-          if (!(std::sqrt(gap2) <= tolerance)) {
-            return absl::InvalidArgumentError(absl::StrCat(
-                "connectivity: the match ", match.Describe(), " has points ", std::sqrt(gap2),
-                " apart at (", i, ", ", j, ", ", k, ") of block ", match.a.face.block));
-          }
-        }
+    absl::Status status;
+    ForEachMatchedPoint(match, [&](const Extents& x, const Extents& y) {
+      if (!status.ok()) return;
+      double gap2 = 0.0;
+      for (int c = 0; c < dim; ++c) {
+        const double d = a.Point(x[0], x[1], x[2])[c] - b.Point(y[0], y[1], y[2])[c];
+        gap2 += d * d;
       }
-    }
+      if (!(std::sqrt(gap2) <= tolerance)) {
+        status = absl::InvalidArgumentError(absl::StrCat(
+            "connectivity: the match ", match.Describe(), " has points ", std::sqrt(gap2),
+            " apart at (", x[0], ", ", x[1], ", ", x[2], ") of block ", match.a.face.block));
+      }
+    });
+    SG_RETURN_IF_ERROR(status);
   }
   return absl::OkStatus();
 }

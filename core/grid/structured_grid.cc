@@ -44,6 +44,23 @@ absl::Status ValidateExtents(const Extents& extents, const std::string& what, in
   return absl::OkStatus();
 }
 
+void ReverseDirection(StructuredBlock& block, int direction) {
+  const Extents& n = block.extents();
+  const int dim = block.spatial_dim();
+  Extents x = {0, 0, 0};
+  for (x[2] = 0; x[2] < n[2]; ++x[2]) {
+    for (x[1] = 0; x[1] < n[1]; ++x[1]) {
+      for (x[0] = 0; x[0] < n[0]; ++x[0]) {
+        if (2 * x[direction] >= n[direction] - 1) continue;  // each pair once
+        Extents y = x;
+        y[direction] = n[direction] - 1 - x[direction];
+        std::swap_ranges(block.Point(x[0], x[1], x[2]), block.Point(x[0], x[1], x[2]) + dim,
+                         block.Point(y[0], y[1], y[2]));
+      }
+    }
+  }
+}
+
 absl::Status ValidateFinite(const StructuredBlock& block, const std::string& what) {
   const auto coords = block.coords();
   const int s = block.spatial_dim();

@@ -75,6 +75,10 @@ struct MultiBlockGrid {
 absl::Status ValidateExtents(const Extents& extents, const std::string& what,
                              int64_t max_points = int64_t{1} << 31, int max_extent = 1 << 24);
 
+// Reverses `block`'s index direction `direction` (0, 1 or 2) in place: point x moves to
+// n - 1 - x along it.
+void ReverseDirection(StructuredBlock& block, int direction);
+
 // OK when every coordinate of `block` is finite; otherwise INVALID_ARGUMENT naming
 // `what`, the point index (i, j, k) and the value.
 absl::Status ValidateFinite(const StructuredBlock& block, const std::string& what);

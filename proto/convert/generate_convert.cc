@@ -1,6 +1,7 @@
 #include "proto/convert/generate_convert.h"
 
 #include <cmath>
+#include <initializer_list>
 #include <string>
 #include <utility>
 
@@ -9,6 +10,19 @@
 #include "proto/convert/convert.h"
 
 namespace splinegrid {
+namespace {
+
+// INVALID_ARGUMENT "<field> is set: <why>" for the first field of `fields` (set, name) that is
+// set: a field of the other kind of generation.
+absl::Status RefuseSetFields(std::initializer_list<std::pair<bool, const char*>> fields,
+                             const char* why) {
+  for (const auto& [set, field] : fields) {
+    if (set) return absl::InvalidArgumentError(absl::StrCat(field, " is set: ", why));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
 
 absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGridRequest& request) {
   ProfileGridOptions options;
@@ -27,14 +41,10 @@ absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGri
       return absl::InvalidArgumentError(
           absl::StrCat("method = ", static_cast<int>(request.method()), " is not a known value"));
   }
-  for (const auto& [set, field] : {std::pair{request.side() != v1::MARCH_SIDE_OUTWARD, "side"},
-                                   std::pair{request.has_normal_smoothing(), "normal_smoothing"},
-                                   std::pair{request.has_symmetry_planes(), "symmetry_planes"}}) {
-    if (set) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, " is set: it applies to a stored_surface, not to a profile"));
-    }
-  }
+  SG_RETURN_IF_ERROR(RefuseSetFields({{request.side() != v1::MARCH_SIDE_OUTWARD, "side"},
+                                      {request.has_normal_smoothing(), "normal_smoothing"},
+                                      {request.has_symmetry_planes(), "symmetry_planes"}},
+                                     "it applies to a stored_surface, not to a profile"));
   if (request.has_wall_points()) options.wall_points = request.wall_points();
   if (request.has_layers()) options.layers = request.layers();
   if (request.has_first_height()) options.first_height = request.first_height();
@@ -127,14 +137,11 @@ absl::StatusOr<SurfaceOffsetOptions> ParseSurfaceOffsetOptions(
         ": layers off a surface are marched (OFFSETS); transfinite and elliptic grids are made "
         "around profiles only"));
   }
-  for (const auto& [set, field] : {std::pair{request.has_wall_points(), "wall_points"},
-                                   std::pair{request.has_orthogonalize(), "orthogonalize"},
-                                   std::pair{request.has_fit_tolerance(), "fit_tolerance"}}) {
-    if (set) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, " is set: it applies to profiles; a stored_surface keeps its own points"));
-    }
-  }
+  SG_RETURN_IF_ERROR(RefuseSetFields({{request.has_wall_points(), "wall_points"},
+                                      {request.has_orthogonalize(), "orthogonalize"},
+                                      {request.has_fit_tolerance(), "fit_tolerance"}},
+                                     "it applies to profiles; a stored_surface keeps its own "
+                                     "points"));
   SurfaceOffsetOptions options;
   if (request.has_layers()) options.layers = request.layers();
   if (request.has_first_height()) options.first_height = request.first_height();

@@ -1,6 +1,5 @@
 #include "server/ops/generate_volume.h"
 
-#include <algorithm>
 #include <chrono>
 #include <utility>
 
@@ -64,19 +63,6 @@ int64_t GeneratedPoints(const MultiBlockGrid& surface, int layers) {
   return points * (int64_t{layers} + 1);
 }
 
-// Reverses `block`'s i direction in place (no second copy of a large volume).
-void ReverseI(StructuredBlock& block) {
-  const int ni = block.extent(0), dim = block.spatial_dim();
-  for (int k = 0; k < block.extent(2); ++k) {
-    for (int j = 0; j < block.extent(1); ++j) {
-      for (int i = 0; i < ni / 2; ++i) {
-        std::swap_ranges(block.Point(i, j, k), block.Point(i, j, k) + dim,
-                         block.Point(ni - 1 - i, j, k));
-      }
-    }
-  }
-}
-
 }  // namespace
 
 absl::StatusOr<GenerateVolumeResult> GenerateVolume(const OpsContext& context,
@@ -114,7 +100,7 @@ absl::StatusOr<GenerateVolumeResult> GenerateVolume(const OpsContext& context,
     const bool reverse = result.generated.sides[b] < 0;
     result.reversed_i.push_back(reverse);
     if (reverse) {
-      ReverseI(block);
+      ReverseDirection(block, 0);
       ReverseBlockDirection(connectivity, b, 0, block.extents());
     }
     volume.blocks.push_back(std::move(block));
