@@ -142,7 +142,7 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     // The assembled records are released before the call ends, stored or not.
     absl::Cleanup release = [this] { assembler_.reset(); };
     SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
-                        assembler_->Finish(/*check_counts=*/true));
+                        assembler_->Finish(/*check_counts=*/true, Cancel()));
     log_.set_grid(absl::StrCat("grids/", grid->id));
     SG_RETURN_IF_ERROR(ops::StoreArchived(state_->Ops(), grid, assembler_->stated_connectivity(),
                                           caller_.owner()));

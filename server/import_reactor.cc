@@ -237,7 +237,8 @@ class ImportReactor : public UploadReactor<v1::ImportGridRequest> {
     bytes_ = std::string();
     upload_ = MemoryReservation();
     if (!source.ok()) return source.status();
-    const ops::ImportRequest request = {header_.grid_id(), header_.display_name(), caller_.owner()};
+    const ops::ImportRequest request = {header_.grid_id(), header_.display_name(), caller_.owner(),
+                                        Cancel()};
     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
                         ops::StoreImported(state_->Ops(), request, *std::move(source)));
     log_.set_grid(absl::StrCat("grids/", grid->id));

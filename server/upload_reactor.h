@@ -87,6 +87,9 @@ class UploadReactor : public grpc::ServerReadReactor<Decoded<Request>> {
   // Everything arrived, on the pool: its status ends the call.
   virtual absl::Status Complete() = 0;
 
+  // The call's cancellation and deadline, for the kernel work of Complete().
+  CancelCheck Cancel() const { return CallCancelCheck(context_); }
+
   // Frees the read buffer's capacity (e.g. after a large header); only at the end of Accept, as
   // the message Accept was given lives there.
   void ReleaseMessage() { message_.message = Request(); }

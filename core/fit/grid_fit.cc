@@ -236,7 +236,7 @@ absl::StatusOr<GridFit> FitGrid(const MultiBlockGrid& grid, const GridFitOptions
                                 const CancelCheck& cancel) {
   SG_RETURN_IF_ERROR(ValidateGridFit(grid, options));
   SG_ASSIGN_OR_RETURN(const Connectivity connectivity,
-                      FindConnectivity(grid, options.connectivity));
+                      FindConnectivity(grid, options.connectivity, cancel));
   return FitValidated(grid, connectivity, options, cancel);
 }
 

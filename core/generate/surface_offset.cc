@@ -720,7 +720,7 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurface(const StructuredBlock& surface,
   SG_RETURN_IF_ERROR(CheckSurface(surface, "surface"));
   MultiBlockGrid grid;
   grid.blocks.push_back(surface);
-  SG_ASSIGN_OR_RETURN(const Connectivity connectivity, FindConnectivity(grid));
+  SG_ASSIGN_OR_RETURN(const Connectivity connectivity, FindConnectivity(grid, {}, options.cancel));
   return OffsetSurfaceGrid(grid, connectivity, options);
 }
 

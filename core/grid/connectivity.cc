@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <unordered_map>
 
+#include "absl/container/flat_hash_map.h"
+#include "absl/container/flat_hash_set.h"
 #include "absl/strings/str_cat.h"
 #include "core/grid/poles.h"
 #include "core/util/status_macros.h"
@@ -26,10 +27,14 @@ std::vector<int> Tangents(const StructuredBlock& block, const Face& face) {
 // Boundary points of all faces, hashed by position.
 class BoundaryIndex {
  public:
-  BoundaryIndex(const MultiBlockGrid& grid, const ConnectivityOptions& options, double abs_tol)
+  // Hashes every boundary point; stops early (incomplete) once `poller` fires.
+  BoundaryIndex(const MultiBlockGrid& grid, const ConnectivityOptions& options, double abs_tol,
+                CancelPoller& poller)
       : grid_(grid), rel_tol_(options.relative_tolerance), abs_tol_(abs_tol) {
     for (int b = 0; b < static_cast<int>(grid.blocks.size()); ++b) {
-      for (const Face& face : BlockFaces(grid.blocks[b], b)) AddFace(face);
+      for (const Face& face : BlockFaces(grid.blocks[b], b)) {
+        if (!AddFace(face, poller)) return;
+      }
     }
   }
 
@@ -95,7 +100,8 @@ class BoundaryIndex {
   }
 
  private:
-  void AddFace(const Face& face) {
+  // False once `poller` fires (polled once per row of the face).
+  bool AddFace(const Face& face, CancelPoller& poller) {
     const int f = static_cast<int>(faces_.size());
     faces_.push_back(face);
     const StructuredBlock& block = grid_.blocks[face.block];
@@ -109,8 +115,10 @@ class BoundaryIndex {
           cells_[CellHash(Key(Point(entries_.back())))].push_back(e);
           face_entries_[FaceIndexKey(f, {i, j, k})] = e;
         }
+        if (poller.Tick(hi[0] - lo[0] + 1)) return false;
       }
     }
+    return true;
   }
 
   const double* Point(const Entry& e) const {
@@ -159,8 +167,8 @@ class BoundaryIndex {
   double rel_tol_, abs_tol_;
   std::vector<Face> faces_;
   std::vector<Entry> entries_;
-  std::unordered_map<uint64_t, std::vector<int>> cells_;  // position cell -> entries
-  std::unordered_map<uint64_t, int> face_entries_;        // (face, index) -> entry
+  absl::flat_hash_map<uint64_t, std::vector<int>> cells_;  // position cell -> entries
+  absl::flat_hash_map<uint64_t, int> face_entries_;        // (face, index) -> entry
 };
 
 // Grows a match from a seed pair of coinciding points of faces fa and fb.
@@ -169,8 +177,10 @@ class MatchGrower {
   MatchGrower(const MultiBlockGrid& grid, const BoundaryIndex& index)
       : grid_(grid), index_(index) {}
 
-  // A match through the seed with the given orientation, or none.
-  std::optional<BoundaryMatch> Grow(int fa, const Extents& xa, int fb, const Extents& xb) const {
+  // A match through the seed with the given orientation, or none (also once `poller` fires,
+  // polled once per row tried).
+  std::optional<BoundaryMatch> Grow(int fa, const Extents& xa, int fb, const Extents& xb,
+                                    CancelPoller& poller) const {
     const Face& a = index_.face(fa);
     const Face& b = index_.face(fb);
     const StructuredBlock& ba = grid_.blocks[a.block];
@@ -225,6 +235,10 @@ class MatchGrower {
               nlo[o] = lo[o];
               nhi[o] = hi[o];
             }
+          }
+          if (poller.Tick(
+                  NumPoints({nhi[0] - nlo[0] + 1, nhi[1] - nlo[1] + 1, nhi[2] - nlo[2] + 1}))) {
+            return std::nullopt;
           }
           Extents glo = lo, ghi = hi;  // the grown range
           (side < 0 ? glo[d] : ghi[d]) += side;
@@ -439,7 +453,8 @@ absl::Status ConnectivityOptions::Validate() const {
 }
 
 absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
-                                              const ConnectivityOptions& options) {
+                                              const ConnectivityOptions& options,
+                                              const CancelCheck& cancel) {
   SG_RETURN_IF_ERROR(options.Validate());
   Connectivity connectivity;
   if (grid.blocks.empty()) return connectivity;
@@ -467,24 +482,33 @@ absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
   // Collapsed boundary lines (poles.h) are found at this distance.
   const double pole_tol = kPoleRelativeTolerance * std::sqrt(diag2);
 
-  const BoundaryIndex index(grid, options, abs_tol);
+  // Hashing, visiting and growing are polled once per 2^16 points' work: six stacked blocks of
+  // 5 x 5 x 100,001 points (15 million) take 28 s here (77 s with std::unordered_map), and a
+  // cancelled search returns within 0.5-0.6 s, most of it freeing the index.
+  CancelPoller poller(cancel);
+  const BoundaryIndex index(grid, options, abs_tol, poller);
+  SG_RETURN_IF_ERROR(poller.status());
   const MatchGrower grower(grid, index);
   // Pairs of entries already explained by a recorded match (both orders).
-  std::unordered_map<uint64_t, bool> covered;
+  absl::flat_hash_set<uint64_t> covered;
   auto pair_key = [](int x, int y) {
     return (static_cast<uint64_t>(x) << 32) | static_cast<uint32_t>(y);
   };
   const auto& entries = index.entries();
   for (int e = 0; e < static_cast<int>(entries.size()); ++e) {
+    // A visit looks up to 27 hash cells: counted as 27 points' work.
+    if (poller.Tick(27)) return poller.status();
     for (int p : index.Partners(e)) {
-      if (p < e || covered.count(pair_key(e, p))) continue;
+      if (p < e || covered.contains(pair_key(e, p))) continue;
       // e as the first range; with hanging nodes the coarse side comes first, so if e is the
       // fine side only the swapped attempt succeeds.
       std::optional<BoundaryMatch> match =
-          grower.Grow(entries[e].face, entries[e].index, entries[p].face, entries[p].index);
+          grower.Grow(entries[e].face, entries[e].index, entries[p].face, entries[p].index, poller);
       if (!match) {
-        match = grower.Grow(entries[p].face, entries[p].index, entries[e].face, entries[e].index);
+        match = grower.Grow(entries[p].face, entries[p].index, entries[e].face, entries[e].index,
+                            poller);
       }
+      if (poller.cancelled()) return poller.status();
       if (!match) continue;
       // Mark every point pair of the match.
       int count = 0;
@@ -496,10 +520,12 @@ absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
             const int ea = index.EntryAt(fa, {i, j, k});
             const int eb = index.EntryAt(fb, m.MapToB({i, j, k}));
             if (ea >= 0 && eb >= 0) {
-              covered[pair_key(ea, eb)] = covered[pair_key(eb, ea)] = true;
+              covered.insert(pair_key(ea, eb));
+              covered.insert(pair_key(eb, ea));
             }
             ++count;
           }
+          if (poller.Tick(m.a.end[0] - m.a.begin[0] + 1)) return poller.status();
         }
       }
       // A self-match of a face onto itself must not map points onto themselves. A range

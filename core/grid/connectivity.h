@@ -19,6 +19,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/grid/structured_grid.h"
+#include "core/util/cancellation.h"
 
 namespace splinegrid {
 
@@ -82,10 +83,12 @@ struct Connectivity {
 };
 
 // Finds all matches between the boundaries of `grid`'s blocks. Cost about O(boundary points)
-// (hashed), plus O(matched points) to grow the matches. Errors: INVALID_ARGUMENT for bad options,
-// blocks of different spatial dimensions or non-finite coordinates (naming the block and point).
+// (hashed), plus O(matched points) to grow the matches; `cancel` is polled once per 2^16 points.
+// Errors: INVALID_ARGUMENT for bad options, blocks of different spatial dimensions or non-finite
+// coordinates (naming the block and point), CANCELLED.
 absl::StatusOr<Connectivity> FindConnectivity(const MultiBlockGrid& grid,
-                                              const ConnectivityOptions& options = {});
+                                              const ConnectivityOptions& options = {},
+                                              const CancelCheck& cancel = {});
 
 // The faces of `block` (index b): two per direction with more than one point.
 std::vector<Face> BlockFaces(const StructuredBlock& block, int b);

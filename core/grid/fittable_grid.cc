@@ -7,11 +7,12 @@
 namespace splinegrid {
 
 absl::StatusOr<FittableGrid> FittableGrid::Check(MultiBlockGrid grid,
-                                                 const ConnectivityOptions& options) {
+                                                 const ConnectivityOptions& options,
+                                                 const CancelCheck& cancel) {
   if (grid.blocks.empty()) return absl::InvalidArgumentError("the grid has no blocks");
   SG_RETURN_IF_ERROR(ValidateFittableBlocks(grid));
   FittableGrid checked;
-  SG_ASSIGN_OR_RETURN(checked.connectivity_, FindConnectivity(grid, options));
+  SG_ASSIGN_OR_RETURN(checked.connectivity_, FindConnectivity(grid, options, cancel));
   checked.grid_ = std::move(grid);
   return checked;
 }

@@ -18,11 +18,12 @@ class FittableGrid {
   // No blocks; FitGrid refuses it.
   FittableGrid() = default;
 
-  // Checks every block of `grid` and finds its connectivity. INVALID_ARGUMENT naming the block
-  // ("block 2: ...") for one that cannot be fitted or for a grid without blocks; the
-  // connectivity's errors.
+  // Checks every block of `grid` and finds its connectivity (polling `cancel`). INVALID_ARGUMENT
+  // naming the block ("block 2: ...") for one that cannot be fitted or for a grid without
+  // blocks; the connectivity's errors; CANCELLED.
   static absl::StatusOr<FittableGrid> Check(MultiBlockGrid grid,
-                                            const ConnectivityOptions& options = {});
+                                            const ConnectivityOptions& options = {},
+                                            const CancelCheck& cancel = {});
 
   // Checks every block of `grid` and takes `connectivity` as its connectivity, each match checked
   // to fit the blocks and its points to coincide within `tolerance` (CheckConnectivity): for a

@@ -65,7 +65,7 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreGenerated(
                         FittableGrid::CheckWithConnectivity(std::move(blocks),
                                                             *std::move(connectivity), tolerance));
   } else {
-    SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(blocks)));
+    SG_ASSIGN_OR_RETURN(source->checked, FittableGrid::Check(std::move(blocks), {}, cancel));
   }
   SG_ASSIGN_OR_RETURN(GridRevision revision,
                       FitRevision(context, *source, options, RevisionOrigin::kFit, 0, cancel));

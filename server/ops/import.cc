@@ -36,7 +36,8 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> StoreImported(const OpsContext
   ImportedGrid& imported = source.imported;
   auto points = std::make_shared<SourcePoints>();
   const int64_t bytes = SourceBytes(imported.grid);
-  SG_ASSIGN_OR_RETURN(points->checked, FittableGrid::Check(std::move(imported.grid)));
+  SG_ASSIGN_OR_RETURN(points->checked,
+                      FittableGrid::Check(std::move(imported.grid), {}, request.cancel));
   SG_RETURN_IF_ERROR(context.budget.Resize(&source.memory, bytes, "the imported grid"));
   points->memory = std::move(source.memory);
   for (std::string& note : CompareConnections(imported.connections, points->connectivity(),

@@ -11,6 +11,7 @@
 #include "core/grid/source_boundaries.h"
 #include "core/io/plot3d.h"
 #include "core/io/plot3d_source_format.h"
+#include "core/util/cancellation.h"
 #include "server/ops/ops_context.h"
 
 namespace splinegrid::server::ops {
@@ -36,7 +37,8 @@ absl::StatusOr<ImportedSource> ReadPlot3dUpload(const OpsContext& context, const
 struct ImportRequest {
   std::string grid_id;  // empty: the server picks one
   std::string display_name;
-  std::string owner;  // the importing principal
+  std::string owner;   // the importing principal
+  CancelCheck cancel;  // polled while the connectivity is found
 };
 
 // Stores `source` as a new grid. A grid that cannot be fitted (all points equal, a direction of

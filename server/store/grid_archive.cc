@@ -174,13 +174,14 @@ absl::Status GridAssembler::AddRevision(const v1::StoredRevision& stored) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<std::shared_ptr<StoredGrid>> GridAssembler::Finish(bool check_counts) {
+absl::StatusOr<std::shared_ptr<StoredGrid>> GridAssembler::Finish(bool check_counts,
+                                                                  const CancelCheck& cancel) {
   if (!header_) return absl::InvalidArgumentError("the archive is empty: no header");
   SG_RETURN_IF_ERROR(source_error_);
   if (source_) SG_RETURN_IF_ERROR(FinishSource("the archive ends"));
   // The points are checked for fitting and matched once, here (on the caller's worker, not
   // as records arrive): a block that cannot be fitted refuses the whole grid.
-  SG_ASSIGN_OR_RETURN(points_->checked, FittableGrid::Check(std::move(unchecked_)),
+  SG_ASSIGN_OR_RETURN(points_->checked, FittableGrid::Check(std::move(unchecked_), {}, cancel),
                       "the archive's source points: ");
   grid_->source = std::move(points_);
   if (check_counts && static_cast<int64_t>(grid_->revisions.size()) != header_->num_revisions()) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "core/util/cancellation.h"
 #include "proto/convert/archive_convert.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
@@ -44,8 +45,9 @@ class GridAssembler {
   bool has_source() const;
   // The grid. With `check_counts` the header's num_revisions must match what arrived. Its
   // source points are checked for fitting and matched here (FittableGrid::Check): a block that
-  // cannot be fitted is INVALID_ARGUMENT naming it.
-  absl::StatusOr<std::shared_ptr<StoredGrid>> Finish(bool check_counts);
+  // cannot be fitted is INVALID_ARGUMENT naming it; CANCELLED when `cancel` fires meanwhile.
+  absl::StatusOr<std::shared_ptr<StoredGrid>> Finish(bool check_counts,
+                                                     const CancelCheck& cancel = {});
 
   // The connectivity the header states (once the source is finished). The grid keeps the one
   // this server finds in the points; an importer compares the two.

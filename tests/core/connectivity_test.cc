@@ -71,6 +71,45 @@ TEST(ConnectivityTest, FullEdgeBetweenTwoBlocks) {
   EXPECT_EQ(m.Describe(), "block 0 i=max j[0..4] ~ block 1 i=0 j[0..4] j->j");
 }
 
+// Two blocks of 3 x `n` points sharing their long edge: 4n boundary points, enough for several
+// polls of the cancel check (once per 2^16 points).
+MultiBlockGrid LongSideBySide(int n) {
+  MultiBlockGrid grid;
+  for (int b = 0; b < 2; ++b) {
+    StructuredBlock block({3, n, 1}, 2);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < 3; ++i) {
+        block.Point(i, j, 0)[0] = 0.5 * (2 * b + i);
+        block.Point(i, j, 0)[1] = 1e-3 * j;
+      }
+    }
+    grid.blocks.push_back(std::move(block));
+  }
+  return grid;
+}
+
+TEST(ConnectivityTest, PollsTheCancelCheckWhileHashingAndWhileMatching) {
+  const MultiBlockGrid grid = LongSideBySide(60000);
+  int polls = 0;
+  const absl::StatusOr<Connectivity> never =
+      FindConnectivity(grid, {}, [&polls] { return ++polls < 0; });
+  ASSERT_TRUE(never.ok()) << never.status();
+  EXPECT_EQ(*never, Find(grid));  // the same matches as without a check
+  ASSERT_EQ(never->matches.size(), 1u);
+  // 240,000 boundary points are hashed (3 polls), then visited (27 units each: about 100 polls)
+  // and the 60,000 matched pairs grown and marked (about 2).
+  EXPECT_GE(polls, 6);
+  // Cancelled at the first poll (hashing) and at the last (matching): CANCELLED either way.
+  for (const int fire_at : {1, polls}) {
+    SCOPED_TRACE(fire_at);
+    int count = 0;
+    const absl::StatusOr<Connectivity> stopped =
+        FindConnectivity(grid, {}, [&] { return ++count >= fire_at; });
+    EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
+    EXPECT_EQ(count, fire_at);  // stopped at once
+  }
+}
+
 TEST(ConnectivityTest, PartialEdgeCoversOnlyTheOverlap) {
   // B starts half way up A's edge: A's j 4..8 are B's j 0..4.
   const MultiBlockGrid grid = SideBySide(9, 0.5);

@@ -320,6 +320,27 @@ TEST_F(OpsStreamsTest, StoreImportedRefusesUnfittableGridsAndKeepsTheConnectivit
             absl::StatusCode::kInvalidArgument);  // no blocks, checked before the id
 }
 
+TEST_F(OpsStreamsTest, StoreImportedStopsWhenTheCallIsCancelledAndStoresNothing) {
+  // 3 x 70,000 points: 140,000 boundary points, more than one poll's worth (2^16).
+  StructuredBlock strip({3, 70000, 1}, 2);
+  for (int j = 0; j < 70000; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      strip.Point(i, j, 0)[0] = i;
+      strip.Point(i, j, 0)[1] = 1e-3 * j;
+    }
+  }
+  ops::ImportedSource source;
+  source.imported.grid.blocks.push_back(std::move(strip));
+  const int64_t before = budget_.used();
+  int polls = 0;
+  const auto stopped = ops::StoreImported(ops_, {"naca", "", "", [&polls] { return ++polls > 0; }},
+                                          std::move(source));
+  EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_EQ(polls, 1);  // stopped at the first poll
+  EXPECT_EQ(store_.Get("naca").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(budget_.used(), before);
+}
+
 TEST_F(OpsStreamsTest, ArchivedGridsMustBringTheConnectivityOfTheirPoints) {
   AddNaca("naca", 1);
   const std::shared_ptr<const StoredGrid> original = store_.Get("naca").value();
