@@ -31,6 +31,7 @@
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/hexahedron_checks.h"
 #include "tests/core/test_data.h"
 #include "tests/store/server_process.h"
 
@@ -392,28 +393,10 @@ TEST_F(EndToEndTest, CliMarchesAVolumeGridOffAStoredSurface) {
   EXPECT_THAT(offset.out, HasSubstr("levels 0-2: 0 folded sub-cells"));
   const MultiBlockGrid grid = ReadPlot3dFile(x).value();
   ASSERT_EQ(grid.blocks.size(), 9u);
-  int64_t non_positive = 0;
-  for (const StructuredBlock& g : grid.blocks) {
-    ASSERT_EQ(g.extent(2), 33);
-    for (int k = 0; k + 1 < g.extent(2); ++k) {
-      for (int j = 0; j + 1 < g.extent(1); ++j) {
-        for (int i = 0; i + 1 < g.extent(0); ++i) {
-          const double* o = g.Point(i, j, k);
-          const double* a = g.Point(i + 1, j, k);
-          const double* b = g.Point(i, j + 1, k);
-          const double* c = g.Point(i, j, k + 1);
-          const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
-          const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
-          const double w[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
-          const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) -
-                             u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                             u[2] * (v[0] * w[1] - v[1] * w[0]);
-          non_positive += !(det > 0.0);
-        }
-      }
-    }
+  for (size_t b = 0; b < grid.blocks.size(); ++b) {
+    ASSERT_EQ(grid.blocks[b].extent(2), 33);
+    EXPECT_GT(MinCornerJacobian(grid.blocks[b]), 0.0) << "block " << b;  // right-handed
   }
-  EXPECT_EQ(non_positive, 0);  // right-handed everywhere
   const Result planar = Cli("offset grids/nothing --layers 8");
   EXPECT_EQ(planar.exit_code, 1);
   EXPECT_THAT(planar.out, HasSubstr("NOT_FOUND"));

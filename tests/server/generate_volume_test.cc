@@ -9,6 +9,7 @@
 
 #include "core/grid/connectivity.h"
 #include "gmock/gmock.h"
+#include "tests/core/hexahedron_checks.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
@@ -25,35 +26,6 @@ v1::GenerateGridRequest M6Request(const std::string& id) {
   r.set_first_height(1e-4);
   r.set_distance(5.0);
   return r;
-}
-
-// The smallest det[x_i, x_j, x_k] / (|x_i| |x_j| |x_k|) at the lower corner of every hexahedron
-// (x_i, x_j, x_k its three edges from that corner).
-double MinCornerJacobian(const StructuredBlock& b) {
-  double worst = HUGE_VAL;
-  for (int k = 0; k + 1 < b.extent(2); ++k) {
-    for (int j = 0; j + 1 < b.extent(1); ++j) {
-      for (int i = 0; i + 1 < b.extent(0); ++i) {
-        const double* o = b.Point(i, j, k);
-        const double* pi = b.Point(i + 1, j, k);
-        const double* pj = b.Point(i, j + 1, k);
-        const double* pk = b.Point(i, j, k + 1);
-        double e[3][3];
-        for (int c = 0; c < 3; ++c) {
-          e[0][c] = pi[c] - o[c];
-          e[1][c] = pj[c] - o[c];
-          e[2][c] = pk[c] - o[c];
-        }
-        const double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                           e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                           e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-        double lengths = 1.0;
-        for (const auto& v : e) lengths *= std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        worst = std::min(worst, det / lengths);
-      }
-    }
-  }
-  return worst;
 }
 
 class GenerateVolumeTest : public ServiceTest {
