@@ -132,7 +132,8 @@ ABSL_FLAG(std::string, method, "",
 ABSL_FLAG(std::optional<bool>, orthogonalize, std::nullopt,
           "offset --method transfinite: grid lines leave the wall normally (default true)");
 ABSL_FLAG(std::optional<double>, profile_tol, std::nullopt,
-          "offset: largest distance of the profile spline from the file's points (default 1e-4)");
+          "offset: largest distance of the profile spline from the file's points, in its unit "
+          "(default 1e-4 of the profile's chord)");
 ABSL_FLAG(std::string, side, "",
           "offset SURFACE: outward (default: away from the volume the surface bounds), along or "
           "against (the first block's i x j normal)");

@@ -119,13 +119,21 @@ absl::Status ProfileGridOptions::Validate() const {
         "wall_points * (layers + 1) = ", static_cast<int64_t>(wall_points) * (layers + 1),
         " points exceed the limit of ", kMaxProfileGridPoints));
   }
-  SG_RETURN_IF_ERROR(CheckFinitePositive(fit_tolerance, "fit_tolerance"));
+  if (fit_tolerance) SG_RETURN_IF_ERROR(CheckFinitePositive(*fit_tolerance, "fit_tolerance"));
   if (method == LayerMethod::kElliptic && (wall_points % 2 == 0 || layers % 2 != 0)) {
     return absl::InvalidArgumentError(absl::StrCat(
         "the elliptic method solves on every second point and layer first: wall_points = ",
         wall_points, " must be odd and layers = ", layers, " even"));
   }
   return absl::OkStatus();
+}
+
+double ProfileChord(const StructuredBlock& coordinates) {
+  double chord = 0.0;
+  for (int i = 1; i < coordinates.extent(0); ++i) {
+    chord = std::max(chord, Norm(Minus(At(coordinates, i, 0), At(coordinates, 0, 0))));
+  }
+  return chord;
 }
 
 OGridQuality MeasureOGrid(const StructuredBlock& g, const std::vector<int>& corners) {
@@ -182,14 +190,29 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
   SG_RETURN_IF_ERROR(options.Validate());
   ProfileGrid out;
   auto start = std::chrono::steady_clock::now();
+  if (options.fit_tolerance) {
+    out.fit_tolerance = *options.fit_tolerance;
+  } else {
+    const double chord = ProfileChord(coordinates);
+    if (!(chord > 0.0) || !std::isfinite(chord)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("the profile's chord (largest distance from its first point) is ", chord,
+                       "; the default fit_tolerance is ", kDefaultProfileFitTolerance,
+                       " of it: check the coordinates"));
+    }
+    out.fit_tolerance = kDefaultProfileFitTolerance * chord;
+  }
   AirfoilFitOptions fit_options;
-  fit_options.tolerance = options.fit_tolerance;
+  fit_options.tolerance = out.fit_tolerance;
   fit_options.cancel = options.cancel;
   SG_ASSIGN_OR_RETURN(out.profile, FitAirfoil(coordinates, fit_options));
   if (!out.profile.met) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("the profile cannot be fitted within fit_tolerance = ", options.fit_tolerance,
-                     ": ", out.profile.unmet_reason));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the profile cannot be fitted within fit_tolerance = ", out.fit_tolerance,
+        options.fit_tolerance
+            ? ""
+            : absl::StrCat(" (the default, ", kDefaultProfileFitTolerance, " of its chord)"),
+        ": ", out.profile.unmet_reason));
   }
   out.fit_seconds = SecondsSince(start);
 

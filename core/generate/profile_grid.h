@@ -17,6 +17,7 @@
 #define SPLINEGRID_CORE_GENERATE_PROFILE_GRID_H_
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -41,6 +42,13 @@ std::string_view LayerMethodName(LayerMethod method);
 // The most points a generated grid may have (2^24: 256 MiB of coordinates).
 inline constexpr int64_t kMaxProfileGridPoints = int64_t{1} << 24;
 
+// The default fit tolerance of a profile, as a fraction of its chord.
+inline constexpr double kDefaultProfileFitTolerance = 1e-4;
+
+// The chord of an outline in Selig order (n x 1 x 1, spatial_dim 2): the largest distance of a
+// point from the first, the trailing edge. O(n).
+double ProfileChord(const StructuredBlock& coordinates);
+
 struct ProfileGridOptions {
   LayerMethod method = LayerMethod::kOffsets;
   int wall_points = 257;        // points around the loop, the first repeated as the last, >= 9
@@ -48,7 +56,10 @@ struct ProfileGridOptions {
   double first_height = 1e-5;   // of the first layer, in the profile's unit (chords)
   double distance = 50.0;       // of the outermost layer from the wall
   bool orthogonalize = true;    // kTransfinite, kElliptic: lines leave the wall along its normals
-  double fit_tolerance = 1e-4;  // of the profile spline to the coordinates (AirfoilFitOptions)
+  // Of the profile spline to the coordinates (AirfoilFitOptions), in their unit; unset:
+  // kDefaultProfileFitTolerance of the profile's chord (ProfileChord), so that a file in
+  // millimetres is fitted as one in chords.
+  std::optional<double> fit_tolerance;
   CancelCheck cancel;
 
   // INVALID_ARGUMENT naming the field and its value (kElliptic: wall_points odd, layers even).
@@ -77,6 +88,7 @@ OGridQuality MeasureOGrid(const StructuredBlock& grid, const std::vector<int>& c
 struct ProfileGrid {
   StructuredBlock block;     // wall_points x (layers + 1), spatial_dim 2
   AirfoilFit profile;        // the fitted outline
+  double fit_tolerance = 0;  // the tolerance it was fitted to (options' or the default)
   WallLoop wall;             // its distributed loop (block's j = 0, maybe reversed: offset_march.h)
   std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;

@@ -72,7 +72,7 @@ void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGri
   out->set_first_height(options.first_height);
   out->set_distance(options.distance);
   out->set_orthogonalize(options.orthogonalize);
-  out->set_fit_tolerance(options.fit_tolerance);
+  if (options.fit_tolerance) out->set_fit_tolerance(*options.fit_tolerance);
 }
 
 absl::StatusOr<StructuredBlock> ParseProfilePoints(const v1::ProfilePoints& points,

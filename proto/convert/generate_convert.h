@@ -19,7 +19,8 @@ namespace splinegrid {
 // a field of surfaces only: side, normal_smoothing, symmetry_planes).
 absl::StatusOr<ProfileGridOptions> ParseProfileGridOptions(const v1::GenerateGridRequest& request);
 
-// The parameters actually used, as the request fields (every layer field set).
+// The parameters actually used, as the request fields (every layer field set; fit_tolerance
+// only when `options` has one: GenerateProfileGrid resolves the default).
 void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGridRequest* out);
 
 // ProfilePoints as an n x 1 x 1 curve with spatial_dim 2; INVALID_ARGUMENT naming

@@ -139,7 +139,8 @@ class _GenerateCalls(_Calls):
         ``wall_points`` (257; the first repeated as the last), ``layers`` (128 cells outward),
         ``first_height`` (1e-5, the profile's unit), ``distance`` (50, of the outer boundary
         from the wall), ``orthogonalize`` (transfinite: lines leave the wall normally; True),
-        ``fit_tolerance`` (1e-4, of the profile spline to the points).
+        ``fit_tolerance`` (of the profile spline to the points, in their unit; default 1e-4 of
+        the profile's chord).
 
         The fit of revision 1 takes :meth:`fit`'s arguments; with none of ``control_counts``,
         ``tolerance``, ``boundary_tolerances`` and ``fairing`` the server interpolates the grid
