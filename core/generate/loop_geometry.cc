@@ -51,14 +51,17 @@ Point2 CornerBisector(const std::vector<Point2>& p, int i, double orientation) {
   return len > 0.0 ? Point2{m[0] / len, m[1] / len} : Point2{0.0, 0.0};
 }
 
-double TurningDegrees(const std::vector<Point2>& p, int i) {
+double SignedTurning(const std::vector<Point2>& p, int i, double orientation) {
   const int n = static_cast<int>(p.size());
   const int prev = i == 0 ? n - 2 : i - 1;
   const int next = i == n - 1 ? 1 : i + 1;
   const Point2 a = {p[i][0] - p[prev][0], p[i][1] - p[prev][1]};
   const Point2 b = {p[next][0] - p[i][0], p[next][1] - p[i][1]};
-  return std::abs(std::atan2(Cross(a, b), a[0] * b[0] + a[1] * b[1])) * 180.0 /
-         3.14159265358979323846;
+  return orientation * std::atan2(Cross(a, b), a[0] * b[0] + a[1] * b[1]);
+}
+
+double TurningDegrees(const std::vector<Point2>& p, int i) {
+  return std::abs(SignedTurning(p, i, 1.0)) * 180.0 / 3.14159265358979323846;
 }
 
 StructuredBlock ReversedI(const StructuredBlock& block) {

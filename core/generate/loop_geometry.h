@@ -43,6 +43,10 @@ inline constexpr double kWedgeDegrees = 120.0;
 // How far the loop turns at point i, in degrees (0 where it runs straight on).
 double TurningDegrees(const std::vector<Point2>& p, int i);
 
+// The loop's turning at point i in radians, signed: positive where it turns with `orientation`
+// (the sign of the loop's area), that is where the loop is convex.
+double SignedTurning(const std::vector<Point2>& p, int i, double orientation);
+
 // `block` with its i direction reversed.
 StructuredBlock ReversedI(const StructuredBlock& block);
 

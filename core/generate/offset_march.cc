@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
 #include "core/fit/solve/tensor_fit.h"
+#include "core/generate/concave_fill.h"
 #include "core/generate/loop_geometry.h"
 #include "core/grid/polyline.h"
 #include "core/grid/sampling.h"
@@ -222,6 +223,26 @@ absl::Status RefitLayer(const std::vector<Point2>& p, const std::vector<int>& pi
   return absl::OkStatus();
 }
 
+// Curvature reduction of layer q (above p) before the next step h_next (concave_fill.h): its
+// convex corners and the seam stay, the rest is smoothed where concave beyond
+// max_concave_turning, no point moving by more than h_next. Kept only if the layer stays valid
+// above p; whether it was smoothed.
+bool ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool>& is_corner,
+                            double h_next, double orientation, const OffsetOptions& options,
+                            std::vector<Point2>& q) {
+  const int n = static_cast<int>(q.size());
+  std::vector<bool> fixed(n);
+  for (int i = 0; i < n; ++i) fixed[i] = is_corner[i] && SignedTurning(q, i, orientation) > 0.0;
+  std::vector<Point2> filled = q;
+  const ConcaveFill fill =
+      FillConcavities(filled, fixed, orientation, h_next, options.max_concave_turning, h_next);
+  int where = 0;
+  if (fill.rounds == 0 || !LayerValid(p, filled, orientation, options.min_segment_ratio, &where))
+    return false;
+  q = std::move(filled);
+  return true;
+}
+
 }  // namespace
 
 absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
@@ -249,13 +270,14 @@ absl::Status OffsetOptions::Validate() const {
   if (normal_smoothing < 0 || !(fairing >= 0.0) || !std::isfinite(fairing) ||
       !(uniformity >= 0.0 && uniformity <= 1.0) ||
       !(min_segment_ratio > 0.0 && min_segment_ratio < 1.0) || max_retries < 0 ||
+      !(max_concave_turning > 0.0 && max_concave_turning < 1.0) ||
       !(wall_tilt_degrees >= 0.0 && wall_tilt_degrees < 90.0) ||
       !(far_tilt_degrees >= 0.0 && far_tilt_degrees < 90.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("smoothing options out of range: normal_smoothing = ", normal_smoothing,
-                     ", fairing = ", fairing, ", uniformity = ", uniformity,
-                     ", min_segment_ratio = ", min_segment_ratio, ", max_retries = ", max_retries,
-                     ", tilts = ", wall_tilt_degrees, " and ", far_tilt_degrees, " degrees"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "smoothing options out of range: normal_smoothing = ", normal_smoothing, ", fairing = ",
+        fairing, ", uniformity = ", uniformity, ", min_segment_ratio = ", min_segment_ratio,
+        ", max_concave_turning = ", max_concave_turning, ", max_retries = ", max_retries,
+        ", tilts = ", wall_tilt_degrees, " and ", far_tilt_degrees, " degrees"));
   }
   return absl::OkStatus();
 }
@@ -295,6 +317,8 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
         std::vector<Point2> q,
         OffsetWithRetries(p, normals, sharp.is_corner, h, orientation, k, options, &out.retries));
     SG_RETURN_IF_ERROR(RefitLayer(p, sharp.pieces, h, k, orientation, options, q));
+    out.concave_fills +=
+        ReduceConcaveCurvature(p, sharp.is_corner, h * out.growth_ratio, orientation, options, q);
     p = std::move(q);
     store(k + 1);
   }

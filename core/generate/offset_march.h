@@ -12,6 +12,9 @@
 //    shrink below min_segment_ratio of their length, reverse, or cross another is retried with
 //    the normals smoothed over their neighbours (which lowers the layer's effective curvature)
 //    until it does not, so no layer intersects itself;
+//  - curvature reduction: before the next step h' a layer's concave parts are smoothed until no
+//    point turns by more than max_concave_turning over h' (h' kappa <= 0.1, concave_fill.h), so a
+//    cove fills faster than the rest instead of focusing its normals on one point;
 //  - normals are smoothed more the farther the layer (normal_smoothing sweeps times the
 //    fraction of the layers done), and the fairing weight grows the same way, so the far field
 //    rounds out; a corner stays a corner (its normal the bisector, CornerBisector, the refit split
@@ -51,6 +54,9 @@ struct OffsetOptions {
   double wall_tilt_degrees = 2.5;
   double far_tilt_degrees = 30.0;
   double min_segment_ratio = 0.25;  // of a layer's segments against the previous layer's
+  // The largest h' kappa left on a layer's concave parts before the next step h' (concave_fill.h),
+  // in (0, 1): a concave part shrinks by 1 - h' kappa in that step.
+  double max_concave_turning = 0.1;
   int max_retries = 60;             // normal smoothing rounds for one layer before giving up
   CancelCheck cancel;
 
@@ -62,6 +68,7 @@ struct OffsetGrid {
   double growth_ratio = 1.0;  // r
   std::vector<double> steps;  // h_k
   int retries = 0;            // extra normal smoothing rounds over all layers
+  int concave_fills = 0;      // layers whose concave parts were smoothed (concave_fill.h)
 };
 
 // Marches the layers (file comment). Errors: INVALID_ARGUMENT for bad options, a wall loop of

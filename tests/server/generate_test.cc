@@ -226,6 +226,37 @@ TEST_F(GenerateTest, TheSeamOfADefaultOGridFoldsNoSubCell) {
   EXPECT_EQ(gap, 0.0);
 }
 
+// The 30P30N main element in the file's units (chord about 832, a flap cove with a concave
+// corner): offsets at 1e-5 chord and 50 chords, the profile fitted to the default tolerance (1e-4
+// of its chord, reported), stored interpolated with no folded sub-cell; every level-2 cell of the
+// evaluated grid has a positive area.
+TEST_F(GenerateTest, TheCoveOfTheHighLiftMainElementInItsOwnUnits) {
+  constexpr double kChord = 831.56;
+  v1::GenerateGridRequest request;
+  request.set_grid_id("main-element");
+  request.set_airfoil_file(AirfoilText("30p30n/30p30n_main.dat"));
+  request.set_layers(64);
+  request.set_first_height(1e-5 * kChord);
+  request.set_distance(50 * kChord);
+  const absl::StatusOr<v1::GenerateGridResponse> generated = client_->Generate(request);
+  ASSERT_TRUE(generated.ok()) << generated.status();  // refused if anything folds
+  const v1::GenerateGridResponse& r = *generated;
+  EXPECT_EQ(r.report().quality().negative_cells(), 0);
+  EXPECT_NEAR(r.report().parameters().fit_tolerance(), 1e-4 * kChord, 1e-6 * kChord);
+  EXPECT_LE(r.report().profile().max_deviation(), r.report().parameters().fit_tolerance());
+  EXPECT_EQ(r.fit().blocks(0).quality().folded(), 0);
+
+  v1::EvaluateGridRequest evaluate;
+  evaluate.set_name("grids/main-element");
+  evaluate.set_refinement_level(2);
+  const StructuredBlock fine = client_->Evaluate(evaluate).value().blocks.at(0).points;
+  int non_positive = 0;
+  for (int j = 0; j + 1 < fine.extent(1); ++j) {
+    for (int i = 0; i + 1 < fine.extent(0); ++i) non_positive += !(CellArea(fine, i, j) > 0);
+  }
+  EXPECT_EQ(non_positive, 0);
+}
+
 TEST_F(GenerateTest, FromTheWallOfAStoredCGrid) {
   ImportShared("grids/n0012_225-65.p2dfmt", "cgrid");
   v1::FitSpec spec;
