@@ -39,6 +39,8 @@
 
 namespace splinegrid {
 
+// tau of one implicit step (worth 16 explicit sweeps), and the neighbours smoothed with an
+// offending point on each side (file comment).
 inline constexpr double kConcaveFillTau = 4.0;
 inline constexpr int kConcaveFillReach = 2;
 
