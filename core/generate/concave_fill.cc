@@ -73,7 +73,6 @@ ConcaveFill FillConcavities(std::vector<Point2>& layer, const std::vector<bool>&
       int b = a;
       while (b + 1 < n - 1 && run[b + 1]) ++b;
       ImplicitStep(layer, a, b, kConcaveFillTau);
-      out.max_run = std::max(out.max_run, b - a + 1);
       a = b + 1;
     }
   }

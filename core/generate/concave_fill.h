@@ -46,7 +46,6 @@ inline constexpr int kConcaveFillReach = 2;
 
 struct ConcaveFill {
   int rounds = 0;     // implicit steps taken (0: the layer was within the bound)
-  int max_run = 0;    // most points of one smoothed run
   bool met = true;    // no point left beyond the bound (else the rounds ran out: 4 per point)
   int held_back = 0;  // points whose move was cut to max_move
 };

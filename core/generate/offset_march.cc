@@ -226,8 +226,8 @@ absl::Status RefitLayer(const std::vector<Point2>& p, const std::vector<int>& pi
 // Curvature reduction of layer q (above p) before the next step h_next (concave_fill.h): its
 // convex corners and the seam stay, the rest is smoothed where concave beyond
 // max_concave_turning, no point moving by more than h_next. Kept only if the layer stays valid
-// above p; whether it was smoothed.
-bool ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool>& is_corner,
+// above p.
+void ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool>& is_corner,
                             double h_next, double orientation, const OffsetOptions& options,
                             std::vector<Point2>& q) {
   const int n = static_cast<int>(q.size());
@@ -237,10 +237,9 @@ bool ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool
   const ConcaveFill fill =
       FillConcavities(filled, fixed, orientation, h_next, options.max_concave_turning, h_next);
   int where = 0;
-  if (fill.rounds == 0 || !LayerValid(p, filled, orientation, options.min_segment_ratio, &where))
-    return false;
-  q = std::move(filled);
-  return true;
+  if (fill.rounds > 0 && LayerValid(p, filled, orientation, options.min_segment_ratio, &where)) {
+    q = std::move(filled);
+  }
 }
 
 }  // namespace
@@ -317,8 +316,7 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
         std::vector<Point2> q,
         OffsetWithRetries(p, normals, sharp.is_corner, h, orientation, k, options, &out.retries));
     SG_RETURN_IF_ERROR(RefitLayer(p, sharp.pieces, h, k, orientation, options, q));
-    out.concave_fills +=
-        ReduceConcaveCurvature(p, sharp.is_corner, h * out.growth_ratio, orientation, options, q);
+    ReduceConcaveCurvature(p, sharp.is_corner, h * out.growth_ratio, orientation, options, q);
     p = std::move(q);
     store(k + 1);
   }

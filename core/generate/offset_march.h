@@ -68,7 +68,6 @@ struct OffsetGrid {
   double growth_ratio = 1.0;  // r
   std::vector<double> steps;  // h_k
   int retries = 0;            // extra normal smoothing rounds over all layers
-  int concave_fills = 0;      // layers whose concave parts were smoothed (concave_fill.h)
 };
 
 // Marches the layers (file comment). Errors: INVALID_ARGUMENT for bad options, a wall loop of
