@@ -28,9 +28,11 @@
 
 #include "benchmark/benchmark.h"
 #include "core/fit/solve/tensor_fit.h"
+#include "core/generate/cove_completion.h"
 #include "core/generate/elliptic.h"
 #include "core/generate/profile_grid.h"
 #include "core/generate/surface_offset.h"
+#include "core/generate/transfinite.h"
 #include "core/io/airfoil.h"
 #include "core/io/plot3d.h"
 #include "tests/core/test_data.h"
@@ -87,10 +89,16 @@ void BM_EllipticCoarseToFine(benchmark::State& state) {
   if (!outline.ok()) return state.SkipWithError(outline.status().ToString().c_str());
   EllipticOptions elliptic;
   elliptic.tolerance = std::pow(10.0, -static_cast<double>(state.range(1)));
+  const CompletionOptions completion;  // 128 layers, 1e-5, 50 chords
+  absl::StatusOr<AlgebraicGrid> algebraic =
+      AlgebraicOGrid(outline->wall, OuterSpacing::kEven, completion, nullptr);
+  if (!algebraic.ok()) return state.SkipWithError(algebraic.status().ToString().c_str());
+  const int held = std::max(LayersWithin(LayerHeights(completion), kHeldBoundaryLayer),
+                            algebraic->marched_layers + 1);
   CoarseToFine run;
   for (auto _ : state) {
     absl::StatusOr<CoarseToFine> smoothed =
-        SmoothCoarseToFine(outline->wall, CompletionOptions(), elliptic, /*compare=*/true);
+        SmoothCoarseToFine(algebraic->block, held, elliptic, /*compare=*/true);
     if (!smoothed.ok()) return state.SkipWithError(smoothed.status().ToString().c_str());
     run = *std::move(smoothed);
   }

@@ -128,7 +128,7 @@ ABSL_FLAG(std::optional<double>, far, std::nullopt,
 ABSL_FLAG(std::optional<int>, points, std::nullopt,
           "offset: wall points around the profile, the first repeated as the last (default 257)");
 ABSL_FLAG(std::string, method, "",
-          "offset: how layers are built: offsets (default) or transfinite");
+          "offset: how layers are built: offsets (default), transfinite or elliptic");
 ABSL_FLAG(std::optional<bool>, orthogonalize, std::nullopt,
           "offset --method transfinite: grid lines leave the wall normally (default true)");
 ABSL_FLAG(std::optional<double>, profile_tol, std::nullopt,

@@ -242,6 +242,11 @@ std::string FormatGenerate(const v1::GenerateGridResponse& response) {
                                         "ratio %.5f, %d retries, %d wall corners\n",
                                         p.layers(), p.first_height(), p.distance(),
                                         r.growth_ratio(), r.retries(), r.wall_corners()));
+  if (r.marched_layers() > 0) {
+    absl::StrAppend(&out, absl::StrFormat("  from offset layer %d on (the lines from the wall "
+                                          "would cross in a cove)\n",
+                                          r.marched_layers()));
+  }
   absl::StrAppend(
       &out,
       absl::StrFormat("  quality: %d negative cells (min area %.3g), first layer %.4g .. %.4g, "

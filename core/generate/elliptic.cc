@@ -153,14 +153,6 @@ struct LineSystem {
   }
 };
 
-// Every second wall and outer point.
-WallLoop EverySecond(const WallLoop& wall) {
-  WallLoop out;
-  for (size_t i = 0; i < wall.points.size(); i += 2) out.points.push_back(wall.points[i]);
-  for (int c : wall.corners) out.corners.push_back(c / 2);
-  return out;
-}
-
 // The fitted differences' weights B(-phi), B(phi), B(-psi), B(psi) at every point.
 std::vector<double> FittedWeights(const ControlFunctions& control, int64_t num_points) {
   std::vector<double> weights(4 * num_points);
@@ -409,10 +401,6 @@ absl::Status EllipticOptions::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("tolerance = ", tolerance, " is not a positive finite number"));
   }
-  if (!(hold_distance >= 0.0) || !std::isfinite(hold_distance)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("hold_distance = ", hold_distance, " is not a finite number >= 0"));
-  }
   if (!(relaxation > 0.0 && relaxation < 2.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("relaxation = ", relaxation, " is outside (0, 2)"));
@@ -626,41 +614,31 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
   return result;
 }
 
-absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
-                                                const CompletionOptions& completion,
+int LayersWithin(const std::vector<double>& heights, double distance) {
+  int within = 1;
+  while (within < static_cast<int>(heights.size()) && heights[within] <= distance) ++within;
+  return within;
+}
+
+absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic, int held_layers,
                                                 const EllipticOptions& options, bool compare) {
   SG_RETURN_IF_ERROR(options.Validate());
-  const int n = static_cast<int>(wall.points.size());
-  if (n % 2 == 0 || completion.layers % 2 != 0) {
+  SG_RETURN_IF_ERROR(CheckOGrid(algebraic));
+  const int ni = algebraic.extent(0), nj = algebraic.extent(1);
+  if (ni % 2 == 0 || nj % 2 == 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "coarse to fine needs an odd number of wall points (the first repeated) and an even "
         "number of layers, not wall_points = ",
-        n, " and layers = ", completion.layers));
+        ni, " and layers = ", nj - 1));
   }
   CoarseToFine out;
-  const std::vector<std::array<double, 2>> outer =
-      OuterCircle(wall, completion.distance, OuterSpacing::kEven);
-  SG_ASSIGN_OR_RETURN(const StructuredBlock fine_tfi, TransfiniteGrid(wall, outer, completion));
-  // Coarse level: every second point and layer (the layer heights d_{2j}: first height
-  // h0 (1 + r) and growth r^2 add up to the same distance), so the coarse transfinite grid is
-  // the fine one at every second point and layer.
-  const double r = GeometricRatio(completion.first_height, completion.distance, completion.layers);
-  CompletionOptions coarse_completion = completion;
-  coarse_completion.layers = completion.layers / 2;
-  coarse_completion.first_height = completion.first_height * (1.0 + r);
-  std::vector<std::array<double, 2>> coarse_outer;
-  for (size_t i = 0; i < outer.size(); i += 2) coarse_outer.push_back(outer[i]);
-  SG_ASSIGN_OR_RETURN(const StructuredBlock coarse_tfi,
-                      TransfiniteGrid(EverySecond(wall), coarse_outer, coarse_completion));
-  // Held: the layers within hold_distance, rounded so that the last held fine layer is a coarse
-  // one (fine held = 2 coarse held - 1).
-  int within = 1;  // layers 0 .. within - 1 are within hold_distance
-  double height = completion.first_height;
-  while (within < completion.layers && height <= options.hold_distance) {
-    height += completion.first_height * std::pow(r, within);
-    ++within;
-  }
-  const int coarse_held = std::clamp((within + 1) / 2, 1, coarse_completion.layers - 1);
+  const StructuredBlock& fine_tfi = algebraic;
+  // Coarse level: every second point and layer of the algebraic grid (of a transfinite grid,
+  // that is the transfinite grid with the heights d_{2j}).
+  const StructuredBlock coarse_tfi = Inject(algebraic);
+  // Held: at least held_layers, rounded up so that the last held fine layer is a coarse one
+  // (fine held = 2 coarse held - 1).
+  const int coarse_held = std::clamp((held_layers + 2) / 2, 1, coarse_tfi.extent(1) - 2);
   out.held_layers = 2 * coarse_held - 1;
   const ControlFunctions coarse_control = TrackingControls(coarse_tfi, coarse_held - 1);
   const ControlFunctions fine_control = TrackingControls(fine_tfi, out.held_layers - 1);
@@ -675,8 +653,7 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
     params[d] =
         spline.distribution.Refined(d, 0, spline.distribution.num_points(d) - 1, d < 2 ? 1 : 0);
   }
-  StructuredBlock guess = EvaluateGrid(spline.spline, params);
-  const int ni = guess.extent(0), nj = guess.extent(1);
+  StructuredBlock guess = EvaluateGrid(spline.spline, params);  // ni x nj again
   for (int j = 0; j < nj; ++j) {
     const bool held = j < out.held_layers || j == nj - 1;
     for (int i = 0; i < ni; ++i) {

@@ -7,7 +7,7 @@
 //   alpha = |x_eta|^2,  beta = x_xi . x_eta,  gamma = |x_xi|^2
 // (J. F. Thompson, F. C. Thames, C. W. Mastin, J. Comput. Phys. 15, 1974), with control
 // functions in the form of P. D. Thomas and J. F. Middlecoff (AIAA J. 18(6), 1980), computed from
-// an algebraic grid (the transfinite grid of transfinite.h):
+// an algebraic grid (cove_completion.h: the transfinite grid, from an offset layer past coves):
 //  - phi from the point distributions of the two loops that bound the smoothed region (the
 //    innermost free layer and the outer loop), blended linearly in eta, so the points slide
 //    along the layers from the one distribution towards the other;
@@ -16,8 +16,8 @@
 //    the boundary layer's growth. (With psi = 0, Winslow, the layers would spread evenly; with
 //    psi from the layer distribution alone, -(x_eta . x_etaeta) / |x_eta|^2, the layers'
 //    curvature pulls them in and a 1e-5 first layer shrinks a hundredfold.)
-// The layers within hold_distance of the wall are held as the algebraic grid has them
-// (orthogonalised there, with the requested heights), and so are the wall and the outer loop.
+// The layers near the wall are held as the algebraic grid has them (orthogonalised there, with
+// the requested heights; its offset layers, if any), and so are the wall and the outer loop.
 //
 // Discretisation: central differences on the unit index grid, except that x_xixi + phi x_xi
 // (and likewise in eta) is exponentially fitted (D. N. de G. Allen and R. V. Southwell 1955,
@@ -30,8 +30,8 @@
 // tridiagonal in i: the long far-field cells couple in i), each relaxed by omega, until no point
 // moves by more than `tolerance` times its smallest neighbouring spacing in a sweep.
 //
-// Coarse to fine: the coarse grid takes every second wall and outer point and layer; it is
-// smoothed from its own transfinite grid, interpolated by a B-spline surface (tensor_fit.h) and
+// Coarse to fine: the coarse grid takes every second point and layer of the algebraic grid; it
+// is smoothed from there, interpolated by a B-spline surface (tensor_fit.h) and
 // evaluated at refinement level 1 of its point distribution, which gives as many points as the
 // fine grid; with the fine held layers and outer loop put back, that is the fine level's initial
 // guess. The fine level is then solved by multigrid cycles (below): the relaxation alone loses
@@ -56,7 +56,6 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "core/generate/transfinite.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
 
@@ -73,8 +72,6 @@ struct ControlFunctions {
 ControlFunctions TrackingControls(const StructuredBlock& grid, int inner);
 
 struct EllipticOptions {
-  // Layers within this distance of the wall (in the wall's unit) are held; at least the wall.
-  double hold_distance = 0.01;
   int max_sweeps = 20000;
   // Converged when no point moves by more than this fraction of its smallest neighbouring
   // spacing in a sweep.
@@ -118,20 +115,25 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
                                                const EllipticOptions& options);
 
 struct CoarseToFine {
-  EllipticResult coarse;  // the coarse level from its transfinite grid
+  EllipticResult coarse;  // the coarse level from the algebraic grid's every second point
   EllipticResult fine;    // the fine level from the coarse grid's spline, two-level cycles
-  // The fine level from its own transfinite grid by relaxation alone (with `compare`): the
-  // baseline of the work saved.
+  // The fine level from the algebraic grid by relaxation alone (with `compare`): the baseline
+  // of the work saved.
   EllipticResult fine_from_transfinite;
   int held_layers = 1;  // of the fine level
 };
 
-// The transfinite O-grid between `wall` and an evenly spaced outer circle (completion options
-// as in transfinite.h) smoothed coarse to fine; with `compare`, also smoothed from its own
-// transfinite grid. Errors: INVALID_ARGUMENT unless the wall has an odd number of points (with
-// the first repeated) and completion.layers is even, and as TransfiniteGrid and SmoothElliptic.
-absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const WallLoop& wall,
-                                                const CompletionOptions& completion,
+// The layers 0 .. LayersWithin - 1 of the stack `heights` (transfinite.h LayerHeights) lie
+// within `distance` of the wall: d_j <= distance. At least 1, the wall.
+int LayersWithin(const std::vector<double>& heights, double distance);
+
+// The algebraic grid `algebraic` (cove_completion.h: an O-grid between the wall and an evenly
+// spaced outer circle) smoothed coarse to fine, holding at least layers 0 .. held_layers - 1
+// (one more if that makes the last held fine layer a coarse one); with `compare`, also smoothed
+// from the algebraic grid by relaxation alone. Errors: INVALID_ARGUMENT unless `algebraic` is a
+// periodic planar O-grid with an odd number of points around (the first repeated) and an even
+// number of layers, and as SmoothElliptic.
+absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic, int held_layers,
                                                 const EllipticOptions& options, bool compare);
 
 }  // namespace splinegrid

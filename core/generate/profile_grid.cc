@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
+#include "core/generate/cove_completion.h"
 #include "core/generate/elliptic.h"
 #include "core/generate/loop_geometry.h"
 #include "core/generate/offset_march.h"
@@ -190,18 +191,14 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
   SG_RETURN_IF_ERROR(options.Validate());
   ProfileGrid out;
   auto start = std::chrono::steady_clock::now();
-  if (options.fit_tolerance) {
-    out.fit_tolerance = *options.fit_tolerance;
-  } else {
-    const double chord = ProfileChord(coordinates);
-    if (!(chord > 0.0) || !std::isfinite(chord)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("the profile's chord (largest distance from its first point) is ", chord,
-                       "; the default fit_tolerance is ", kDefaultProfileFitTolerance,
-                       " of it: check the coordinates"));
-    }
-    out.fit_tolerance = kDefaultProfileFitTolerance * chord;
+  const double chord = ProfileChord(coordinates);
+  if (!(chord > 0.0) || !std::isfinite(chord)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the profile's chord (largest distance from its first point) is ", chord,
+                     ": check the coordinates"));
   }
+  out.fit_tolerance =
+      options.fit_tolerance ? *options.fit_tolerance : kDefaultProfileFitTolerance * chord;
   AirfoilFitOptions fit_options;
   fit_options.tolerance = out.fit_tolerance;
   fit_options.cancel = options.cancel;
@@ -243,15 +240,23 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
     completion.first_height = options.first_height;
     completion.distance = options.distance;
     completion.orthogonalize = options.orthogonalize;
-    if (options.method == LayerMethod::kTransfinite) {
-      SG_ASSIGN_OR_RETURN(
-          out.block,
-          TransfiniteGrid(out.wall, OuterCircle(out.wall, options.distance), completion));
+    completion.orthogonal_reach = kOrthogonalReach * chord;
+    const bool elliptic = options.method == LayerMethod::kElliptic;
+    SG_ASSIGN_OR_RETURN(
+        AlgebraicGrid algebraic,
+        AlgebraicOGrid(out.wall, elliptic ? OuterSpacing::kEven : OuterSpacing::kFollowWall,
+                       completion, options.cancel));
+    out.marched_layers = algebraic.marched_layers;
+    if (!elliptic) {
+      out.block = std::move(algebraic.block);
     } else {
-      EllipticOptions elliptic;
-      elliptic.cancel = options.cancel;
+      EllipticOptions smoothing;
+      smoothing.cancel = options.cancel;
+      // The boundary layer and the offset layers stay as they are.
+      const int held = std::max(LayersWithin(LayerHeights(completion), kHeldBoundaryLayer * chord),
+                                algebraic.marched_layers + 1);
       SG_ASSIGN_OR_RETURN(CoarseToFine smoothed,
-                          SmoothCoarseToFine(out.wall, completion, elliptic, /*compare=*/false));
+                          SmoothCoarseToFine(algebraic.block, held, smoothing, /*compare=*/false));
       out.block = std::move(smoothed.fine.grid);
       out.coarse_sweeps = smoothed.coarse.sweeps;
       out.fine_sweeps = smoothed.fine.sweeps;

@@ -7,9 +7,10 @@
 //      - kOffsets: marched by curvature-controlled offsets, each refitted and faired
 //        (offset_march.h), or
 //      - kTransfinite: interpolated between the wall and a circle `distance` out, the lines
-//        optionally bent to leave the wall orthogonally (transfinite.h);
-//      - kElliptic: the transfinite grid to an evenly spaced circle, smoothed by the elliptic
-//        equations coarse to fine above the boundary layer (elliptic.h);
+//        optionally bent to leave the wall orthogonally (transfinite.h); past a cove the lines
+//        would cross, and they start from an offset layer instead (cove_completion.h);
+//      - kElliptic: that grid to an evenly spaced circle, smoothed by the elliptic equations
+//        coarse to fine above the boundary layer and the offset layers (elliptic.h);
 //   4. the result is measured (MeasureOGrid).
 // The grid is an O-grid, i along the loop (clockwise, the first line repeated as the last: the
 // seam leaves the trailing edge), j outward from the wall, every cell's signed area positive.
@@ -45,17 +46,24 @@ inline constexpr int64_t kMaxProfileGridPoints = int64_t{1} << 24;
 // The default fit tolerance of a profile, as a fraction of its chord.
 inline constexpr double kDefaultProfileFitTolerance = 1e-4;
 
+// The lengths of the completion and of elliptic smoothing, as fractions of the profile's chord
+// (so that a profile in millimetres gets the grid it gets in chords, scaled): how far the
+// orthogonalised lines bend (CompletionOptions::orthogonal_reach) and how thick the boundary
+// layer held as the algebraic grid has it is (EllipticOptions::hold_distance).
+inline constexpr double kOrthogonalReach = 0.2;
+inline constexpr double kHeldBoundaryLayer = 0.01;
+
 // The chord of an outline in Selig order (n x 1 x 1, spatial_dim 2): the largest distance of a
 // point from the first, the trailing edge. O(n).
 double ProfileChord(const StructuredBlock& coordinates);
 
 struct ProfileGridOptions {
   LayerMethod method = LayerMethod::kOffsets;
-  int wall_points = 257;        // points around the loop, the first repeated as the last, >= 9
-  int layers = 128;             // cells across, >= 1 (the grid has layers + 1 lines)
-  double first_height = 1e-5;   // of the first layer, in the profile's unit (chords)
-  double distance = 50.0;       // of the outermost layer from the wall
-  bool orthogonalize = true;    // kTransfinite, kElliptic: lines leave the wall along its normals
+  int wall_points = 257;       // points around the loop, the first repeated as the last, >= 9
+  int layers = 128;            // cells across, >= 1 (the grid has layers + 1 lines)
+  double first_height = 1e-5;  // of the first layer, in the profile's unit (chords)
+  double distance = 50.0;      // of the outermost layer from the wall
+  bool orthogonalize = true;   // kTransfinite, kElliptic: lines leave the wall along its normals
   // Of the profile spline to the coordinates (AirfoilFitOptions), in their unit; unset:
   // kDefaultProfileFitTolerance of the profile's chord (ProfileChord), so that a file in
   // millimetres is fitted as one in chords.
@@ -93,6 +101,9 @@ struct ProfileGrid {
   std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;
   int retries = 0;  // kOffsets: extra normal smoothing rounds over all layers
+  // kTransfinite, kElliptic: the offset layers the interpolation starts from (cove_completion.h;
+  // 0: from the wall).
+  int marched_layers = 0;
   // kElliptic: sweeps and seconds of the coarse level (from its transfinite grid) and of the
   // fine level (its multigrid cycles: fine sweeps, and the seconds of all levels); whether the
   // fine level converged.

@@ -39,17 +39,26 @@ absl::Status CompletionOptions::Validate() const {
   return absl::OkStatus();
 }
 
-std::vector<Point2> OuterCircle(const WallLoop& wall, double distance, OuterSpacing spacing) {
-  const std::vector<Point2>& w = wall.points;
-  const int n = static_cast<int>(w.size());
-  Point2 c = {0.0, 0.0};
+Circle EnclosingCircle(const std::vector<Point2>& wall, double distance) {
+  const int n = static_cast<int>(wall.size());
+  Circle circle;
   for (int i = 0; i + 1 < n; ++i) {
-    c[0] += w[i][0] / (n - 1);
-    c[1] += w[i][1] / (n - 1);
+    circle.center[0] += wall[i][0] / (n - 1);
+    circle.center[1] += wall[i][1] / (n - 1);
   }
   double reach = 0.0;
-  for (const Point2& p : w) reach = std::max(reach, std::hypot(p[0] - c[0], p[1] - c[1]));
-  const double radius = distance + reach;
+  for (const Point2& p : wall) {
+    reach = std::max(reach, std::hypot(p[0] - circle.center[0], p[1] - circle.center[1]));
+  }
+  circle.radius = distance + reach;
+  return circle;
+}
+
+std::vector<Point2> PointsOnCircle(const Circle& circle, const std::vector<Point2>& loop,
+                                   OuterSpacing spacing) {
+  const std::vector<Point2>& w = loop;
+  const Point2& c = circle.center;
+  const int n = static_cast<int>(w.size());
   const double orientation = SignedArea2(w) > 0.0 ? 1.0 : -1.0;
   const double start = std::atan2(w[0][1] - c[1], w[0][0] - c[0]);
   std::vector<double> arc(n, 0.0);
@@ -61,10 +70,45 @@ std::vector<Point2> OuterCircle(const WallLoop& wall, double distance, OuterSpac
     const double fraction =
         spacing == OuterSpacing::kEven ? static_cast<double>(i) / (n - 1) : arc[i] / arc.back();
     const double angle = start + orientation * 2.0 * kPi * fraction;
-    out[i] = {c[0] + radius * std::cos(angle), c[1] + radius * std::sin(angle)};
+    out[i] = {c[0] + circle.radius * std::cos(angle), c[1] + circle.radius * std::sin(angle)};
   }
   out.back() = out.front();
   return out;
+}
+
+std::vector<Point2> OuterCircle(const WallLoop& wall, double distance, OuterSpacing spacing) {
+  return PointsOnCircle(EnclosingCircle(wall.points, distance), wall.points, spacing);
+}
+
+std::vector<double> LayerHeights(const CompletionOptions& options) {
+  const double r = GeometricRatio(options.first_height, options.distance, options.layers);
+  std::vector<double> d(options.layers + 1, 0.0);
+  for (int j = 1; j <= options.layers; ++j) {
+    d[j] = d[j - 1] + options.first_height * std::pow(r, j - 1);
+  }
+  return d;
+}
+
+void InterpolateLines(const std::vector<Point2>& inner, const std::vector<Point2>& directions,
+                      const std::vector<Point2>& outer, const std::vector<double>& heights,
+                      const CompletionOptions& options, int from, StructuredBlock& grid) {
+  const int n = static_cast<int>(inner.size());
+  const double length = heights.back() - heights[from];
+  // The exponent of the orthogonalising bump t (1 - t)^m, whose largest value, about
+  // 1 / (e (m + 1)) at t = 1 / (m + 1), bounds how far (times the length) the lines bend off
+  // straight.
+  const double m = std::max(1.0, length / (std::exp(1.0) * options.orthogonal_reach) - 1.0);
+  for (int j = from; j < static_cast<int>(heights.size()); ++j) {
+    const double t = (heights[j] - heights[from]) / length;
+    const double bump = options.orthogonalize ? t * std::pow(1.0 - t, m) : 0.0;
+    for (int i = 0; i < n; ++i) {
+      double* x = grid.Point(i, j, 0);
+      for (int c = 0; c < 2; ++c) {
+        const double chord = outer[i][c] - inner[i][c];
+        x[c] = inner[i][c] + t * chord + bump * (length * directions[i][c] - chord);
+      }
+    }
+  }
 }
 
 absl::StatusOr<StructuredBlock> TransfiniteGrid(const WallLoop& wall,
@@ -112,26 +156,8 @@ absl::StatusOr<StructuredBlock> TransfiniteGrid(const WallLoop& wall,
     }
   }
   normals.back() = normals.front();
-  const double r = GeometricRatio(options.first_height, options.distance, options.layers);
-  std::vector<double> d(options.layers + 1, 0.0);
-  for (int j = 1; j <= options.layers; ++j) {
-    d[j] = d[j - 1] + options.first_height * std::pow(r, j - 1);
-  }
-  // The exponent of the orthogonalising bump t (1 - t)^m, whose largest value, about
-  // 1 / (e (m + 1)) at t = 1 / (m + 1), bounds how far (times D) the lines bend off straight.
-  const double m = std::max(1.0, d.back() / (std::exp(1.0) * options.orthogonal_reach) - 1.0);
   StructuredBlock grid({n, options.layers + 1, 1}, 2);
-  for (int j = 0; j <= options.layers; ++j) {
-    const double t = d[j] / d.back();
-    const double bump = options.orthogonalize ? t * std::pow(1.0 - t, m) : 0.0;
-    for (int i = 0; i < n; ++i) {
-      double* x = grid.Point(i, j, 0);
-      for (int c = 0; c < 2; ++c) {
-        const double chord = outer[i][c] - w[i][c];
-        x[c] = w[i][c] + t * chord + bump * (d.back() * normals[i][c] - chord);
-      }
-    }
-  }
+  InterpolateLines(w, normals, outer, LayerHeights(options), options, 0, grid);
   if (orientation > 0.0) return ReversedI(grid);
   return grid;
 }

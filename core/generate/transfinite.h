@@ -45,10 +45,38 @@ struct CompletionOptions {
 // at a trailing edge would leave far-field cells a thousandth as wide as they are long).
 enum class OuterSpacing { kFollowWall, kEven };
 
-// The circle of the file comment with as many points as `wall` (first repeated as last),
-// running the same way round.
+// The circle of the file comment: about the wall's centroid, `distance` beyond its farthest
+// point.
+struct Circle {
+  std::array<double, 2> center = {0.0, 0.0};
+  double radius = 0.0;
+};
+Circle EnclosingCircle(const std::vector<std::array<double, 2>>& wall, double distance);
+
+// As many points on `circle` as `loop` has (closed, first repeated as last), running the same
+// way round from the direction of its first point, spaced as `spacing` says (kFollowWall: at
+// the angles of the loop's arc length).
+std::vector<std::array<double, 2>> PointsOnCircle(const Circle& circle,
+                                                  const std::vector<std::array<double, 2>>& loop,
+                                                  OuterSpacing spacing);
+
+// PointsOnCircle(EnclosingCircle(wall, distance), wall, spacing).
 std::vector<std::array<double, 2>> OuterCircle(const WallLoop& wall, double distance,
                                                OuterSpacing spacing = OuterSpacing::kFollowWall);
+
+// The heights d_0 = 0 < d_1 < ... < d_layers = distance of the layers: first_height, growing by
+// the ratio r (sampling.h GeometricRatio).
+std::vector<double> LayerHeights(const CompletionOptions& options);
+
+// Rows from .. heights.size() - 1 of `grid` (at least that many rows, inner.size() points per
+// row): the lines of the file comment from inner[i] to outer[i] (closed loops of the same
+// points), leaving inner[i] along directions[i] (unit) with orthogonalize, at
+// t_j = (d_j - d_from) / (d_last - d_from) of `heights`; row `from` is `inner`.
+void InterpolateLines(const std::vector<std::array<double, 2>>& inner,
+                      const std::vector<std::array<double, 2>>& directions,
+                      const std::vector<std::array<double, 2>>& outer,
+                      const std::vector<double>& heights, const CompletionOptions& options,
+                      int from, StructuredBlock& grid);
 
 // The O-grid between `wall` and `outer` (same point count, both closed, outer enclosing wall):
 // points x (layers + 1), spatial_dim 2, with i running as in offset_march.h (clockwise, cell

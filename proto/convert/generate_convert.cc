@@ -110,6 +110,7 @@ void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int
   profile->set_fairing_weight(grid.profile.fairing_weight);
   out->set_growth_ratio(grid.growth_ratio);
   out->set_retries(grid.retries);
+  out->set_marched_layers(grid.marched_layers);
   const OGridQuality& q = grid.quality;
   v1::OGridQuality* quality = out->mutable_quality();
   quality->set_negative_cells(q.negative_cells);

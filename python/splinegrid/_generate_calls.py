@@ -149,7 +149,8 @@ class _GenerateCalls(_Calls):
 
         Returns the GenerateGridResponse proto: ``grid`` (BASIC view, revision 1), ``report``
         (GenerationReport: ``parameters`` used, ``extents``, ``profile`` fit, ``growth_ratio``,
-        ``retries``, ``quality`` with ``negative_cells``, ``first_height_min``/``max``,
+        ``retries``, ``marched_layers`` (transfinite, elliptic: the offset layers the lines start
+        from past a cove; 0 from the wall), ``quality`` with ``negative_cells``, ``first_height_min``/``max``,
         ``wall_orthogonality_degrees``, ...; stage seconds) and ``fit`` (as :meth:`fit`
         returns it).
         """
