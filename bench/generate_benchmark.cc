@@ -93,8 +93,7 @@ void BM_EllipticCoarseToFine(benchmark::State& state) {
   absl::StatusOr<AlgebraicGrid> algebraic =
       AlgebraicOGrid(outline->wall, OuterSpacing::kEven, completion, nullptr);
   if (!algebraic.ok()) return state.SkipWithError(algebraic.status().ToString().c_str());
-  const int held = std::max(LayersWithin(LayerHeights(completion), kHeldBoundaryLayer),
-                            algebraic->marched_layers + 1);
+  const int held = HeldLayers(completion, *algebraic, /*chord=*/1.0);
   CoarseToFine run;
   for (auto _ : state) {
     absl::StatusOr<CoarseToFine> smoothed =

@@ -12,21 +12,12 @@
 namespace splinegrid {
 namespace {
 
-Point2 At(const StructuredBlock& g, int i, int j) {
-  const double* p = g.Point(i, j, 0);
-  return {p[0], p[1]};
-}
-
-Point2 Minus(const Point2& a, const Point2& b) { return {a[0] - b[0], a[1] - b[1]}; }
-
 // Whether every cell of rows from .. nj - 2 of the clockwise O-grid `g` has a positive signed
-// area (half the cross product of its diagonals, as MeasureOGrid counts it).
+// area (as MeasureOGrid counts it).
 bool PositiveFrom(const StructuredBlock& g, int from) {
   for (int j = from; j + 1 < g.extent(1); ++j) {
     for (int i = 0; i + 1 < g.extent(0); ++i) {
-      const double area =
-          Cross(Minus(At(g, i + 1, j + 1), At(g, i, j)), Minus(At(g, i, j + 1), At(g, i + 1, j)));
-      if (!(area > 0.0)) return false;
+      if (!(SignedCellArea(g, i, j) > 0.0)) return false;
     }
   }
   return true;
@@ -57,10 +48,11 @@ absl::StatusOr<AlgebraicGrid> AlgebraicOGrid(const WallLoop& wall, OuterSpacing 
   for (int k = 1; k < completion.layers; ++k) {
     SG_RETURN_IF_ERROR(PollCancel(cancel));
     for (int i = 0; i < n; ++i) {
-      inner[i] = At(marched.block, i, k);
-      const Point2 step = Minus(inner[i], At(marched.block, i, k - 1));
-      const double length = std::hypot(step[0], step[1]);
-      directions[i] = {step[0] / length, step[1] / length};
+      const double* p = marched.block.Point(i, k, 0);
+      const double* below = marched.block.Point(i, k - 1, 0);
+      const double length = std::hypot(p[0] - below[0], p[1] - below[1]);
+      inner[i] = {p[0], p[1]};
+      directions[i] = {(p[0] - below[0]) / length, (p[1] - below[1]) / length};
     }
     InterpolateLines(inner, directions, PointsOnCircle(circle, inner, OuterSpacing::kFollowWall),
                      heights, completion, k, grid);

@@ -632,17 +632,16 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
         ni, " and layers = ", nj - 1));
   }
   CoarseToFine out;
-  const StructuredBlock& fine_tfi = algebraic;
   // Coarse level: every second point and layer of the algebraic grid (of a transfinite grid,
   // that is the transfinite grid with the heights d_{2j}).
-  const StructuredBlock coarse_tfi = Inject(algebraic);
+  const StructuredBlock coarse_algebraic = Inject(algebraic);
   // Held: at least held_layers, rounded up so that the last held fine layer is a coarse one
   // (fine held = 2 coarse held - 1).
-  const int coarse_held = std::clamp((held_layers + 2) / 2, 1, coarse_tfi.extent(1) - 2);
+  const int coarse_held = std::clamp((held_layers + 2) / 2, 1, coarse_algebraic.extent(1) - 2);
   out.held_layers = 2 * coarse_held - 1;
-  const ControlFunctions coarse_control = TrackingControls(coarse_tfi, coarse_held - 1);
-  const ControlFunctions fine_control = TrackingControls(fine_tfi, out.held_layers - 1);
-  SG_ASSIGN_OR_RETURN(out.coarse, SmoothElliptic(coarse_tfi, coarse_control, coarse_held, options));
+  const ControlFunctions coarse_control = TrackingControls(coarse_algebraic, coarse_held - 1);
+  SG_ASSIGN_OR_RETURN(out.coarse,
+                      SmoothElliptic(coarse_algebraic, coarse_control, coarse_held, options));
   // The coarse solution's spline at level 1 of its point distribution, with the fine level's
   // held layers and outer loop put back.
   FitOptions interpolation;
@@ -657,14 +656,15 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
   for (int j = 0; j < nj; ++j) {
     const bool held = j < out.held_layers || j == nj - 1;
     for (int i = 0; i < ni; ++i) {
-      const double* from = held ? fine_tfi.Point(i, j, 0) : guess.Point(i == ni - 1 ? 0 : i, j, 0);
+      const double* from = held ? algebraic.Point(i, j, 0) : guess.Point(i == ni - 1 ? 0 : i, j, 0);
       std::copy(from, from + 2, guess.Point(i, j, 0));  // periodic: the last line is the first
     }
   }
-  SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, fine_tfi, out.held_layers, options));
+  SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, algebraic, out.held_layers, options));
   if (compare) {
     SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,
-                        SmoothElliptic(fine_tfi, fine_control, out.held_layers, options));
+                        SmoothElliptic(algebraic, TrackingControls(algebraic, out.held_layers - 1),
+                                       out.held_layers, options));
   }
   return out;
 }

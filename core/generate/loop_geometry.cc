@@ -60,6 +60,14 @@ double SignedTurning(const std::vector<Point2>& p, int i, double orientation) {
   return orientation * std::atan2(Cross(a, b), a[0] * b[0] + a[1] * b[1]);
 }
 
+double SignedCellArea(const StructuredBlock& grid, int i, int j) {
+  const double* a = grid.Point(i, j, 0);
+  const double* b = grid.Point(i + 1, j, 0);
+  const double* c = grid.Point(i + 1, j + 1, 0);
+  const double* d = grid.Point(i, j + 1, 0);
+  return 0.5 * Cross({c[0] - a[0], c[1] - a[1]}, {d[0] - b[0], d[1] - b[1]});
+}
+
 double TurningDegrees(const std::vector<Point2>& p, int i) {
   return std::abs(SignedTurning(p, i, 1.0)) * 180.0 / 3.14159265358979323846;
 }

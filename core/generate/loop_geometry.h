@@ -47,6 +47,11 @@ double TurningDegrees(const std::vector<Point2>& p, int i);
 // (the sign of the loop's area), that is where the loop is convex.
 double SignedTurning(const std::vector<Point2>& p, int i, double orientation);
 
+// The signed area of cell (i, j) of a planar grid (spatial_dim 2): half the cross product of its
+// diagonals (equal to the shoelace area of the quadrilateral), positive where (i, j) is
+// right-handed.
+double SignedCellArea(const StructuredBlock& grid, int i, int j);
+
 // `block` with its i direction reversed.
 StructuredBlock ReversedI(const StructuredBlock& block);
 

@@ -129,6 +129,11 @@ absl::Status ProfileGridOptions::Validate() const {
   return absl::OkStatus();
 }
 
+int HeldLayers(const CompletionOptions& completion, const AlgebraicGrid& algebraic, double chord) {
+  return std::max(LayersWithin(LayerHeights(completion), kHeldBoundaryLayer * chord),
+                  algebraic.marched_layers + 1);
+}
+
 double ProfileChord(const StructuredBlock& coordinates) {
   double chord = 0.0;
   for (int i = 1; i < coordinates.extent(0); ++i) {
@@ -143,9 +148,7 @@ OGridQuality MeasureOGrid(const StructuredBlock& g, const std::vector<int>& corn
   q.min_cell_area = std::numeric_limits<double>::infinity();
   for (int j = 0; j + 1 < nj; ++j) {
     for (int i = 0; i + 1 < ni; ++i) {
-      // Half the cross product of the diagonals.
-      const double area = 0.5 * Cross(Minus(At(g, i + 1, j + 1), At(g, i, j)),
-                                      Minus(At(g, i, j + 1), At(g, i + 1, j)));
+      const double area = SignedCellArea(g, i, j);
       q.min_cell_area = std::min(q.min_cell_area, area);
       q.negative_cells += !(area > 0.0);
     }
@@ -252,11 +255,10 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
     } else {
       EllipticOptions smoothing;
       smoothing.cancel = options.cancel;
-      // The boundary layer and the offset layers stay as they are.
-      const int held = std::max(LayersWithin(LayerHeights(completion), kHeldBoundaryLayer * chord),
-                                algebraic.marched_layers + 1);
-      SG_ASSIGN_OR_RETURN(CoarseToFine smoothed,
-                          SmoothCoarseToFine(algebraic.block, held, smoothing, /*compare=*/false));
+      SG_ASSIGN_OR_RETURN(
+          CoarseToFine smoothed,
+          SmoothCoarseToFine(algebraic.block, HeldLayers(completion, algebraic, chord), smoothing,
+                             /*compare=*/false));
       out.block = std::move(smoothed.fine.grid);
       out.coarse_sweeps = smoothed.coarse.sweeps;
       out.fine_sweeps = smoothed.fine.sweeps;

@@ -25,6 +25,8 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/fit/airfoil/airfoil_fit.h"
+#include "core/generate/cove_completion.h"
+#include "core/generate/transfinite.h"
 #include "core/generate/wall_loop.h"
 #include "core/grid/structured_grid.h"
 #include "core/util/cancellation.h"
@@ -49,9 +51,14 @@ inline constexpr double kDefaultProfileFitTolerance = 1e-4;
 // The lengths of the completion and of elliptic smoothing, as fractions of the profile's chord
 // (so that a profile in millimetres gets the grid it gets in chords, scaled): how far the
 // orthogonalised lines bend (CompletionOptions::orthogonal_reach) and how thick the boundary
-// layer held as the algebraic grid has it is (EllipticOptions::hold_distance).
+// layer is that elliptic smoothing holds as the algebraic grid has it (elliptic.h LayersWithin).
 inline constexpr double kOrthogonalReach = 0.2;
 inline constexpr double kHeldBoundaryLayer = 0.01;
+
+// The layers of `algebraic` (the layer stack `completion`, around a profile of chord `chord`)
+// that elliptic smoothing holds: the boundary layer within kHeldBoundaryLayer chords of the
+// wall, and the offset layers the grid starts from.
+int HeldLayers(const CompletionOptions& completion, const AlgebraicGrid& algebraic, double chord);
 
 // The chord of an outline in Selig order (n x 1 x 1, spatial_dim 2): the largest distance of a
 // point from the first, the trailing edge. O(n).
@@ -104,7 +111,7 @@ struct ProfileGrid {
   // kTransfinite, kElliptic: the offset layers the interpolation starts from (cove_completion.h;
   // 0: from the wall).
   int marched_layers = 0;
-  // kElliptic: sweeps and seconds of the coarse level (from its transfinite grid) and of the
+  // kElliptic: sweeps and seconds of the coarse level (from the algebraic grid) and of the
   // fine level (its multigrid cycles: fine sweeps, and the seconds of all levels); whether the
   // fine level converged.
   int coarse_sweeps = 0, fine_sweeps = 0;
