@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
 #include "core/fit/solve/tensor_fit.h"
+#include "core/generate/concave_crease.h"
 #include "core/generate/offset_march.h"
 #include "core/grid/sampling.h"
 #include "core/util/status_macros.h"
@@ -120,7 +121,8 @@ struct BlockMarch {
 // The weights of the normal smoothing (surface_topology.h's kinds), per vertex the
 // neighbouring vertices and their weights (rows in CSR form, built once): a shared vertex takes
 // the sum of the (1 2 1) x (1 2 1) stencils of all its block points (each cut off at its
-// block's edges); a free-edge vertex the (1 2 1) stencil along its edge; a fixed one none.
+// block's edges); a free-edge vertex the (1 2 1) stencil along its edge; a fixed one none. A
+// concave crease (concave_crease.h) is smoothed along itself, and its faces without it.
 struct SmoothingStencil {
   std::vector<int64_t> start;  // row v is [start[v], start[v + 1])
   std::vector<int64_t> neighbour;
@@ -135,6 +137,12 @@ struct March {
   std::vector<BlockMarch> blocks;
   double scale = 0.0;
   SmoothingStencil stencil;
+  VertexGraph graph;  // the grid edges of every block, between vertices
+  // The concave creases of the surface (concave_crease.h) and their points on it: the crease of
+  // the layer at height H is at origin + H offset.
+  ConcaveCreases creases;
+  std::vector<Vec> crease_origin;
+  std::vector<char> is_crease;  // per vertex
   int64_t num_vertices() const { return topology.num_vertices; }
 };
 
@@ -179,10 +187,19 @@ void LeanTowardsPlanes(const March& m, const Layer& p, double height, Layer& nor
   }
 }
 
-// Per vertex: the normalised mean of its block points' normals (from each block's layer
-// spline); INVALID_ARGUMENT when a block's fitted layer has no regular point.
-absl::StatusOr<Layer> VertexNormals(const March& m) {
+// A layer's normals per vertex: the normalised mean of its block points' normals (from each
+// block's layer spline), and where those differ by more than kCreaseDegrees from the mean, each
+// block point's normal (concave_crease.h; empty elsewhere).
+struct VertexNormalField {
+  Layer mean;
+  std::vector<std::vector<Vec>> faces;
+};
+
+// The normal field of the current layer; INVALID_ARGUMENT when a block's fitted layer has no
+// regular point.
+absl::StatusOr<VertexNormalField> VertexNormals(const March& m) {
   Layer normal(m.num_vertices(), Vec::Zero());
+  std::vector<Layer> block_normals;
   for (size_t b = 0; b < m.blocks.size(); ++b) {
     const BlockMarch& block = m.blocks[b];
     const Shape& s = block.s;
@@ -201,12 +218,43 @@ absl::StatusOr<Layer> VertexNormals(const March& m) {
       const int64_t v = (*block.vertex)[q];
       normal[v] += local[q];
     }
+    block_normals.push_back(std::move(local));
   }
   for (Vec& n : normal) {
     if (n.norm() > 0.0) n.normalize();
   }
-  ProjectNormals(m, normal);
-  return normal;
+  // The block normals of every vertex where one of them leaves the mean by kCreaseDegrees.
+  const double min_cos = std::cos(kCreaseDegrees * M_PI / 180.0);
+  std::vector<char> creased(m.num_vertices(), 0);
+  for (size_t b = 0; b < m.blocks.size(); ++b) {
+    for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
+      const int64_t v = (*m.blocks[b].vertex)[q];
+      if (block_normals[b][q].dot(normal[v]) < min_cos) creased[v] = 1;
+    }
+  }
+  VertexNormalField field{std::move(normal), std::vector<std::vector<Vec>>(m.num_vertices())};
+  for (size_t b = 0; b < m.blocks.size(); ++b) {
+    for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
+      const int64_t v = (*m.blocks[b].vertex)[q];
+      if (creased[v]) field.faces[v].push_back(block_normals[b][q]);
+    }
+  }
+  ProjectNormals(m, field.mean);
+  return field;
+}
+
+// The grid edges of every block as a graph of vertices.
+VertexGraph BuildGridGraph(const March& m) {
+  std::vector<std::pair<int64_t, int64_t>> edges;
+  for (const BlockMarch& block : m.blocks) {
+    for (int j = 0; j < block.s.nj; ++j) {
+      for (int i = 0; i < block.s.ni; ++i) {
+        if (i + 1 < block.s.ni) edges.emplace_back(block.V(i, j), block.V(i + 1, j));
+        if (j + 1 < block.s.nj) edges.emplace_back(block.V(i, j), block.V(i, j + 1));
+      }
+    }
+  }
+  return BuildVertexGraph(m.num_vertices(), edges);
 }
 
 // The stencil of the march's blocks and vertex kinds.
@@ -243,8 +291,10 @@ SmoothingStencil BuildSmoothingStencil(const March& m) {
   }
   SmoothingStencil stencil;
   stencil.start.push_back(0);
-  for (const auto& row : rows) {
-    for (const auto& [neighbour, weight] : row) {
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    for (const auto& [neighbour, weight] : rows[v]) {
+      // A concave crease is a feature line: smoothed along itself only, and not into its faces.
+      if (m.is_crease[v] != m.is_crease[neighbour]) continue;
       stencil.neighbour.push_back(neighbour);
       stencil.weight.push_back(weight);
     }
@@ -280,10 +330,13 @@ absl::Status Smooth(const March& m, int sweeps, Layer& normals) {
 // The curvature each vertex's step is limited by (file comment): the fastest convergence of the
 // normals in use along a grid edge at the vertex, over the grid edges of every block,
 //   kappa_e = -(n_b - n_a).(x_b - x_a) / |x_b - x_a|^2;
-// zero where they diverge everywhere (convex).
-std::vector<double> LimitingCurvature(const March& m, const Layer& p, const Layer& normals) {
+// zero where they diverge everywhere (convex). Edges at a concave crease (`is_crease`) are left
+// out: the crease's normals converge at once, but its offset does not focus (concave_crease.h).
+std::vector<double> LimitingCurvature(const March& m, const Layer& p, const Layer& normals,
+                                      const std::vector<char>& is_crease) {
   std::vector<double> out(m.num_vertices(), 0.0);
   auto edge = [&](int64_t a, int64_t b) {
+    if (is_crease[a] || is_crease[b]) return;
     const Vec dx = p[b] - p[a];
     const double length2 = dx.squaredNorm();
     if (!(length2 > 0.0)) return;  // a collapsed edge
@@ -425,8 +478,9 @@ struct LayerSteps {
 
 // The steps of the layer above p along `normals` (LimitingCurvature).
 void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h,
-                  const std::vector<double>& deficit, LayerSteps& steps) {
-  steps.kappa = LimitingCurvature(m, p, normals);
+                  const std::vector<double>& deficit, const std::vector<char>& is_crease,
+                  LayerSteps& steps) {
+  steps.kappa = LimitingCurvature(m, p, normals, is_crease);
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
     steps.want[v] = h + deficit[v];
     steps.step[v] = steps.kappa[v] > 0.0
@@ -435,11 +489,80 @@ void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h
   }
 }
 
+// The vertices near the surface's concave creases (concave_crease.h) at a layer: per vertex
+// the nearest crease (an index into March::creases, -1 for none or a crease itself), the
+// crease's face it lies on (the face whose normal is nearest its own) and the weight w(d / R).
+struct CreaseBand {
+  std::vector<int> crease;
+  std::vector<int> face;
+  std::vector<double> weight;
+};
+
+// The band of the layer p at `height` (its normals `layer_normals`, unsmoothed): the reach is
+// R = kCreaseReach height times the largest move of a crease along one of its faces per unit
+// of height.
+CreaseBand BandOfCreases(const March& m, const Layer& p, const Layer& layer_normals,
+                         double height) {
+  const ConcaveCreases& creases = m.creases;
+  CreaseBand band{std::vector<int>(m.num_vertices(), -1), std::vector<int>(m.num_vertices(), -1),
+                  std::vector<double>(m.num_vertices(), 0.0)};
+  double along = 0.0;
+  for (size_t c = 0; c < creases.vertices.size(); ++c) {
+    const Vec& d = creases.offset[c];
+    for (const Vec& f : creases.faces[c]) along = std::max(along, (d - d.dot(f) * f).norm());
+  }
+  if (!(along > 0.0)) return band;
+  const double reach = kCreaseReach * height * along;
+  const CreaseDistances near = DistancesToCreases(m.graph, p, creases.vertices, reach);
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const int c = near.nearest[v];
+    if (c < 0 || m.is_crease[v]) continue;
+    const std::vector<Vec>& faces = creases.faces[c];
+    int best = 0;
+    for (size_t f = 1; f < faces.size(); ++f) {
+      if (faces[f].dot(layer_normals[v]) > faces[best].dot(layer_normals[v])) best = f;
+    }
+    band.crease[v] = c;
+    band.face[v] = best;
+    band.weight[v] = CreaseShiftWeight(near.distance[v] / reach);
+  }
+  return band;
+}
+
+// Next to a crease a vertex marches along the normal of the crease's face it lies on, farther
+// away along its own (smoothed) normal: n = w face + (1 - w) n, normalised.
+void BlendBandNormals(const March& m, const CreaseBand& band, Layer& normals) {
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const int c = band.crease[v];
+    if (c < 0) continue;
+    const double w = band.weight[v];
+    const Vec n = w * m.creases.faces[c][band.face[v]] + (1.0 - w) * normals[v];
+    if (n.norm() > 0.0) normals[v] = n.normalized();
+  }
+}
+
+// The creases' share of layer q above p: each crease point goes to its place at the layer's
+// `height`, and each vertex of the band moves w times its crease's move along their face.
+void StepCreases(const March& m, const CreaseBand& band, const Layer& p, double height, Layer& q) {
+  const ConcaveCreases& creases = m.creases;
+  for (size_t c = 0; c < creases.vertices.size(); ++c) {
+    q[creases.vertices[c]] = m.crease_origin[c] + height * creases.offset[c];
+  }
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const int c = band.crease[v];
+    if (c < 0) continue;
+    const int64_t crease = creases.vertices[c];
+    const Vec move = q[crease] - p[crease];
+    const Vec& face = creases.faces[c][band.face[v]];
+    q[v] += band.weight[v] * (move - move.dot(face) * face);
+  }
+}
+
 // The layer q above p (at `height` above the surface, step h), its normals smoothed two more
 // sweeps per retry (counted in `*retries`) until its cells do not fold or max_retries is spent;
 // the check of the last attempt.
-absl::StatusOr<CellCheck> OffsetWithRetries(const March& m, const Layer& p, Layer& normals,
-                                            double height, double h,
+absl::StatusOr<CellCheck> OffsetWithRetries(const March& m, const Layer& p, const CreaseBand& band,
+                                            Layer& normals, double height, double h,
                                             const std::vector<double>& deficit, LayerSteps& steps,
                                             Layer& q, int* retries) {
   CellCheck check;
@@ -450,8 +573,10 @@ absl::StatusOr<CellCheck> OffsetWithRetries(const March& m, const Layer& p, Laye
     }
     Layer leaning = normals;  // the lean is taken afresh from the smoothed normals each attempt
     LeanTowardsPlanes(m, p, height, leaning);
-    LimitedSteps(m, p, leaning, h, deficit, steps);
+    BlendBandNormals(m, band, leaning);
+    LimitedSteps(m, p, leaning, h, deficit, m.is_crease, steps);
     for (int64_t v = 0; v < m.num_vertices(); ++v) q[v] = p[v] + steps.step[v] * leaning[v];
+    StepCreases(m, band, p, height, q);
     ProjectPoints(m, q);
     check = CheckCells(m, p, q);
     if (!check.folded) break;
@@ -662,11 +787,13 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
   SG_ASSIGN_OR_RETURN(SurfaceTopology topology,
                       BuildSurfaceTopology(surface, connectivity, options.symmetry_planes));
   SG_ASSIGN_OR_RETURN(const std::vector<int> sides, BlockSides(surface, topology, options));
-  March m{options, topology, {}, topology.scale, {}};
+  March m{options, topology, {}, topology.scale, {}, {}, {}, {}, {}};
   SG_ASSIGN_OR_RETURN(Layer p, SurfaceVertices(surface, topology));
   ProjectPoints(m, p);
   SG_RETURN_IF_ERROR(FitSurfaceBlocks(surface, topology, sides, m));
+  m.is_crease.assign(m.num_vertices(), 0);  // until the first layer finds them
   m.stencil = BuildSmoothingStencil(m);
+  m.graph = BuildGridGraph(m);
 
   SurfaceOffsetGrid out;
   out.sides = sides;
@@ -697,11 +824,22 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
     const double h = options.first_height * std::pow(out.growth_ratio, k);
     out.steps.push_back(h);
     const double fraction = static_cast<double>(k + 1) / options.layers;
-    SG_ASSIGN_OR_RETURN(Layer normals, VertexNormals(m));
+    SG_ASSIGN_OR_RETURN(VertexNormalField field, VertexNormals(m));
+    if (k == 0) {  // the surface's creases
+      m.creases = FindConcaveCreases(m.graph, p, field.mean, field.faces);
+      for (const int64_t v : m.creases.vertices) {
+        m.is_crease[v] = 1;
+        m.crease_origin.push_back(p[v]);
+      }
+      out.crease_vertices = static_cast<int64_t>(m.creases.vertices.size());
+      if (out.crease_vertices > 0) m.stencil = BuildSmoothingStencil(m);
+    }
+    Layer normals = field.mean;
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
     SG_RETURN_IF_ERROR(Smooth(m, sweeps, normals));
-    SG_ASSIGN_OR_RETURN(CellCheck check, OffsetWithRetries(m, p, normals, height + h, h, deficit,
-                                                           steps, q, &out.retries));
+    const CreaseBand band = BandOfCreases(m, p, field.mean, height + h);
+    SG_ASSIGN_OR_RETURN(CellCheck check, OffsetWithRetries(m, p, band, normals, height + h, h,
+                                                           deficit, steps, q, &out.retries));
     if (check.folded) return FoldedLayerError(m, check, k, h, steps);
     // Fair the displacement and add its spline to the layer's (file comment); a faired
     // displacement that folds a cell is dropped for the interpolating one.

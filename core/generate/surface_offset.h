@@ -51,10 +51,13 @@
 // (surface_topology.h): it gets the normalised mean of its blocks' normals and one step, and
 // it is smoothed with all its blocks' stencils together, so the volume
 // blocks share their faces point for point (watertight) and a convex edge between blocks (a
-// blunt trailing edge's corner) fans out along the mean normal. A concave crease (a wing-body
-// junction) is not treated: its mean normal rises only cos(angle / 2) of a step above either
-// face, it lags, and within a few cells' height the layers fold back over it (refused by the
-// fold check). On block edges the spline's
+// blunt trailing edge's corner) fans out along the mean normal. A concave crease between blocks
+// (a wing-body junction, the inside of an L) is found on the surface and marched apart
+// (concave_crease.h): its points go straight to their layer's height above both faces (along
+// the bisector, by the miter), the faces' points near it move with it along their face and
+// march along the face's normal, the normal smoothing does not cross it, and its edges do not
+// limit the step. A corner where three concave creases meet (inside a box) is not treated and
+// folds (refused). On block edges the spline's
 // derivatives are one-sided (clamped knots), so no normal needs a neighbour outside its block.
 // Where an edge collapses to one point (a pole: X_v = 0 along u = 0, say) the normal X_u x X_v
 // vanishes; by l'Hopital X_v ~ u X_uv there, so the normal is that of X_u x X_uv (X_uv x X_v for
@@ -143,6 +146,8 @@ struct SurfaceOffsetGrid {
   int retries = 0;            // extra normal smoothing rounds over all layers
   int refits_dropped = 0;     // layers whose faired displacement would have folded a cell
   int64_t limited_steps = 0;  // point steps shortened by the curvature limit, over all layers
+  // Vertices of the surface on concave creases between blocks (concave_crease.h).
+  int64_t crease_vertices = 0;
   // Largest height the curvature limit left unreached at a point of the last layer, in the
   // surface's unit (at most max_shortfall * distance).
   double shortfall = 0.0;
