@@ -187,19 +187,15 @@ void LeanTowardsPlanes(const March& m, const Layer& p, double height, Layer& nor
   }
 }
 
-// A layer's normals per vertex: the normalised mean of its block points' normals (from each
-// block's layer spline), and where those differ by more than kCreaseDegrees from the mean, each
-// block point's normal (concave_crease.h; empty elsewhere).
-struct VertexNormalField {
-  Layer mean;
-  std::vector<std::vector<Vec>> faces;
-};
-
-// The normal field of the current layer; INVALID_ARGUMENT when a block's fitted layer has no
-// regular point.
-absl::StatusOr<VertexNormalField> VertexNormals(const March& m) {
+// Per vertex: the normalised mean of its block points' normals (from each block's layer
+// spline); with `faces`, also each block point's normal at every vertex joined from several
+// (what FindConcaveCreases needs; empty elsewhere). INVALID_ARGUMENT when a block's fitted
+// layer has no regular point.
+absl::StatusOr<Layer> VertexNormals(const March& m,
+                                    std::vector<std::vector<Vec>>* faces = nullptr) {
   Layer normal(m.num_vertices(), Vec::Zero());
   std::vector<Layer> block_normals;
+  std::vector<int> joined(m.num_vertices(), 0);  // block points per vertex
   for (size_t b = 0; b < m.blocks.size(); ++b) {
     const BlockMarch& block = m.blocks[b];
     const Shape& s = block.s;
@@ -217,30 +213,24 @@ absl::StatusOr<VertexNormalField> VertexNormals(const March& m) {
     for (int64_t q = 0; q < s.size(); ++q) {
       const int64_t v = (*block.vertex)[q];
       normal[v] += local[q];
+      ++joined[v];
     }
-    block_normals.push_back(std::move(local));
+    if (faces != nullptr) block_normals.push_back(std::move(local));
   }
   for (Vec& n : normal) {
     if (n.norm() > 0.0) n.normalize();
   }
-  // The block normals of every vertex where one of them leaves the mean by kCreaseDegrees.
-  const double min_cos = std::cos(kCreaseDegrees * M_PI / 180.0);
-  std::vector<char> creased(m.num_vertices(), 0);
-  for (size_t b = 0; b < m.blocks.size(); ++b) {
-    for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
-      const int64_t v = (*m.blocks[b].vertex)[q];
-      if (block_normals[b][q].dot(normal[v]) < min_cos) creased[v] = 1;
+  if (faces != nullptr) {
+    faces->assign(m.num_vertices(), {});
+    for (size_t b = 0; b < m.blocks.size(); ++b) {
+      for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
+        const int64_t v = (*m.blocks[b].vertex)[q];
+        if (joined[v] > 1) (*faces)[v].push_back(block_normals[b][q]);
+      }
     }
   }
-  VertexNormalField field{std::move(normal), std::vector<std::vector<Vec>>(m.num_vertices())};
-  for (size_t b = 0; b < m.blocks.size(); ++b) {
-    for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
-      const int64_t v = (*m.blocks[b].vertex)[q];
-      if (creased[v]) field.faces[v].push_back(block_normals[b][q]);
-    }
-  }
-  ProjectNormals(m, field.mean);
-  return field;
+  ProjectNormals(m, normal);
+  return normal;
 }
 
 // The grid edges of every block as a graph of vertices.
@@ -330,26 +320,19 @@ absl::Status Smooth(const March& m, int sweeps, Layer& normals) {
 // The curvature each vertex's step is limited by (file comment): the fastest convergence of the
 // normals in use along a grid edge at the vertex, over the grid edges of every block,
 //   kappa_e = -(n_b - n_a).(x_b - x_a) / |x_b - x_a|^2;
-// zero where they diverge everywhere (convex). Edges at a concave crease (`is_crease`) are left
-// out: the crease's normals converge at once, but its offset does not focus (concave_crease.h).
-std::vector<double> LimitingCurvature(const March& m, const Layer& p, const Layer& normals,
-                                      const std::vector<char>& is_crease) {
+// zero where they diverge everywhere (convex). Edges at a concave crease are left out: the
+// crease's normals converge at once, but its offset does not focus (concave_crease.h).
+std::vector<double> LimitingCurvature(const March& m, const Layer& p, const Layer& normals) {
   std::vector<double> out(m.num_vertices(), 0.0);
-  auto edge = [&](int64_t a, int64_t b) {
-    if (is_crease[a] || is_crease[b]) return;
-    const Vec dx = p[b] - p[a];
-    const double length2 = dx.squaredNorm();
-    if (!(length2 > 0.0)) return;  // a collapsed edge
-    const double converge = -(normals[b] - normals[a]).dot(dx) / length2;
-    out[a] = std::max(out[a], converge);
-    out[b] = std::max(out[b], converge);
-  };
-  for (const BlockMarch& block : m.blocks) {
-    for (int j = 0; j < block.s.nj; ++j) {
-      for (int i = 0; i < block.s.ni; ++i) {
-        if (i + 1 < block.s.ni) edge(block.V(i, j), block.V(i + 1, j));
-        if (j + 1 < block.s.nj) edge(block.V(i, j), block.V(i, j + 1));
-      }
+  for (int64_t a = 0; a < m.num_vertices(); ++a) {
+    if (m.is_crease[a]) continue;
+    for (int64_t e = m.graph.start[a]; e < m.graph.start[a + 1]; ++e) {
+      const int64_t b = m.graph.neighbour[e];
+      if (m.is_crease[b]) continue;
+      const Vec dx = p[b] - p[a];
+      const double length2 = dx.squaredNorm();
+      if (!(length2 > 0.0)) continue;  // coinciding points
+      out[a] = std::max(out[a], -(normals[b] - normals[a]).dot(dx) / length2);
     }
   }
   return out;
@@ -478,9 +461,8 @@ struct LayerSteps {
 
 // The steps of the layer above p along `normals` (LimitingCurvature).
 void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h,
-                  const std::vector<double>& deficit, const std::vector<char>& is_crease,
-                  LayerSteps& steps) {
-  steps.kappa = LimitingCurvature(m, p, normals, is_crease);
+                  const std::vector<double>& deficit, LayerSteps& steps) {
+  steps.kappa = LimitingCurvature(m, p, normals);
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
     steps.want[v] = h + deficit[v];
     steps.step[v] = steps.kappa[v] > 0.0
@@ -491,7 +473,8 @@ void LimitedSteps(const March& m, const Layer& p, const Layer& normals, double h
 
 // The vertices near the surface's concave creases (concave_crease.h) at a layer: per vertex
 // the nearest crease (an index into March::creases, -1 for none or a crease itself), the
-// crease's face it lies on (the face whose normal is nearest its own) and the weight w(d / R).
+// crease's face it lies on (the face whose normal is nearest its own) and the weight w(d / R);
+// empty for a surface without creases.
 struct CreaseBand {
   std::vector<int> crease;
   std::vector<int> face;
@@ -504,14 +487,14 @@ struct CreaseBand {
 CreaseBand BandOfCreases(const March& m, const Layer& p, const Layer& layer_normals,
                          double height) {
   const ConcaveCreases& creases = m.creases;
-  CreaseBand band{std::vector<int>(m.num_vertices(), -1), std::vector<int>(m.num_vertices(), -1),
-                  std::vector<double>(m.num_vertices(), 0.0)};
   double along = 0.0;
   for (size_t c = 0; c < creases.vertices.size(); ++c) {
     const Vec& d = creases.offset[c];
     for (const Vec& f : creases.faces[c]) along = std::max(along, (d - d.dot(f) * f).norm());
   }
-  if (!(along > 0.0)) return band;
+  if (!(along > 0.0)) return {};
+  CreaseBand band{std::vector<int>(m.num_vertices(), -1), std::vector<int>(m.num_vertices(), -1),
+                  std::vector<double>(m.num_vertices(), 0.0)};
   const double reach = kCreaseReach * height * along;
   const CreaseDistances near = DistancesToCreases(m.graph, p, creases.vertices, reach);
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
@@ -532,7 +515,7 @@ CreaseBand BandOfCreases(const March& m, const Layer& p, const Layer& layer_norm
 // Next to a crease a vertex marches along the normal of the crease's face it lies on, farther
 // away along its own (smoothed) normal: n = w face + (1 - w) n, normalised.
 void BlendBandNormals(const March& m, const CreaseBand& band, Layer& normals) {
-  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+  for (size_t v = 0; v < band.crease.size(); ++v) {
     const int c = band.crease[v];
     if (c < 0) continue;
     const double w = band.weight[v];
@@ -548,7 +531,7 @@ void StepCreases(const March& m, const CreaseBand& band, const Layer& p, double 
   for (size_t c = 0; c < creases.vertices.size(); ++c) {
     q[creases.vertices[c]] = m.crease_origin[c] + height * creases.offset[c];
   }
-  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+  for (size_t v = 0; v < band.crease.size(); ++v) {
     const int c = band.crease[v];
     if (c < 0) continue;
     const int64_t crease = creases.vertices[c];
@@ -574,7 +557,7 @@ absl::StatusOr<CellCheck> OffsetWithRetries(const March& m, const Layer& p, cons
     Layer leaning = normals;  // the lean is taken afresh from the smoothed normals each attempt
     LeanTowardsPlanes(m, p, height, leaning);
     BlendBandNormals(m, band, leaning);
-    LimitedSteps(m, p, leaning, h, deficit, m.is_crease, steps);
+    LimitedSteps(m, p, leaning, h, deficit, steps);
     for (int64_t v = 0; v < m.num_vertices(); ++v) q[v] = p[v] + steps.step[v] * leaning[v];
     StepCreases(m, band, p, height, q);
     ProjectPoints(m, q);
@@ -824,9 +807,10 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
     const double h = options.first_height * std::pow(out.growth_ratio, k);
     out.steps.push_back(h);
     const double fraction = static_cast<double>(k + 1) / options.layers;
-    SG_ASSIGN_OR_RETURN(VertexNormalField field, VertexNormals(m));
-    if (k == 0) {  // the surface's creases
-      m.creases = FindConcaveCreases(m.graph, p, field.mean, field.faces);
+    std::vector<std::vector<Vec>> faces;  // the surface's, to find its creases
+    SG_ASSIGN_OR_RETURN(const Layer layer_normals, VertexNormals(m, k == 0 ? &faces : nullptr));
+    if (k == 0) {
+      m.creases = FindConcaveCreases(m.graph, p, layer_normals, faces);
       for (const int64_t v : m.creases.vertices) {
         m.is_crease[v] = 1;
         m.crease_origin.push_back(p[v]);
@@ -834,10 +818,10 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
       out.crease_vertices = static_cast<int64_t>(m.creases.vertices.size());
       if (out.crease_vertices > 0) m.stencil = BuildSmoothingStencil(m);
     }
-    Layer normals = field.mean;
+    Layer normals = layer_normals;
     const int sweeps = static_cast<int>(std::lround(options.normal_smoothing * fraction));
     SG_RETURN_IF_ERROR(Smooth(m, sweeps, normals));
-    const CreaseBand band = BandOfCreases(m, p, field.mean, height + h);
+    const CreaseBand band = BandOfCreases(m, p, layer_normals, height + h);
     SG_ASSIGN_OR_RETURN(CellCheck check, OffsetWithRetries(m, p, band, normals, height + h, h,
                                                            deficit, steps, q, &out.retries));
     if (check.folded) return FoldedLayerError(m, check, k, h, steps);

@@ -1,8 +1,9 @@
 // OffsetSurface: a tilted plane offset exactly (both sides, and which handedness each gives), the
 // shared sphere blocks outward and inward at the stacked radii, an inward offset past the centre
 // refused or limited short of it, a polar cap whose collapsed edge stays one point on the axis,
-// the shared M6 wing blocks, and every error path. Cells are checked with an independent oracle:
-// the corner Jacobians and grid_quality's hexahedron volume.
+// the shared M6 wing blocks, wedges marched into their concave crease, and every error path. Cells
+// are checked with an independent oracle: the corner Jacobians and grid_quality's hexahedron
+// volume.
 #include "core/generate/surface_offset.h"
 
 #include <algorithm>
