@@ -293,9 +293,10 @@ std::string FormatGenerateVolume(const v1::GenerateGridResponse& response) {
                       "with i reversed (right-handed cells)\n",
                       v.components(), v.surface_gap(), planes.empty() ? "none" : planes, reversed));
   absl::StrAppend(&out, absl::StrFormat("  quality: min scaled Jacobian %.3g, %d limited steps, "
-                                        "shortfall %.3g, %d faired layers dropped\n",
+                                        "shortfall %.3g, %d faired layers dropped, %d concave "
+                                        "crease vertices\n",
                                         v.min_scaled_jacobian(), v.limited_steps(), v.shortfall(),
-                                        v.refits_dropped()));
+                                        v.refits_dropped(), v.crease_vertices()));
   absl::StrAppend(&out, FormatFit(response.grid().name(), response.fit()));
   return out;
 }

@@ -195,6 +195,7 @@ void EncodeVolumeReport(const SurfaceOffsetGrid& grid, const std::vector<Extents
   out->set_limited_steps(grid.limited_steps);
   out->set_shortfall(grid.shortfall);
   out->set_min_scaled_jacobian(grid.min_scaled_jacobian);
+  out->set_crease_vertices(grid.crease_vertices);
 }
 
 }  // namespace splinegrid

@@ -191,8 +191,8 @@ class _GenerateCalls(_Calls):
         The fit takes :meth:`fit`'s arguments; with none the server interpolates with uniform
         parameters (exact, and watertight at every level). Returns the GenerateGridResponse:
         ``report.volume`` (VolumeReport: ``block_extents``, ``reversed_i``,
-        ``symmetry_planes``, ``min_scaled_jacobian``, ...), ``report.parameters``, ``grid`` and
-        ``fit``.
+        ``symmetry_planes``, ``min_scaled_jacobian``, ``crease_vertices``, ...),
+        ``report.parameters``, ``grid`` and ``fit``.
         """
         request = _volume_request(name, surface, revision, display_name, layers, first_height,
                                   distance, side, normal_smoothing, symmetry_planes, allow_folds)

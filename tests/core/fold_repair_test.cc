@@ -55,7 +55,8 @@ TEST(FoldRepairTest, BreakingRunsBoundsThemAndOnlyRemovesKnotsOnRuns) {
 
 // Control counts that fold the NACA 0012 113 x 33 C-grid at levels 1-2: no repair is tried
 // (that would change the counts), the fit fails naming the block, the levels and the cells,
-// unless allow_folds, which returns it with quality_met = false.
+// unless allow_folds, which returns it with quality_met = false. Interpolation folds it too, and
+// is named as such, not as counts the caller never gave.
 TEST(FoldRepairTest, ACountFitThatFoldsIsRefusedUnlessAllowed) {
   const std::string path = SharedDataPath("grids/n0012_113-33.p2dfmt");
   const MultiBlockGrid grid = ParsePlot3d(ReadFileToString(path).value(), path).value();
@@ -69,6 +70,15 @@ TEST(FoldRepairTest, ACountFitThatFoldsIsRefusedUnlessAllowed) {
   EXPECT_THAT(message, HasSubstr("the worst at cell ("));
   EXPECT_THAT(message, HasSubstr("A fit to control counts is not repaired"));
   EXPECT_THAT(message, HasSubstr("allow_folds"));
+
+  // Without counts every block interpolates its points, and the message says so.
+  GridFitOptions interpolating;
+  interpolating.control_counts = {0, 0, 0};
+  const absl::StatusOr<GridFit> interpolated = FitGrid(grid, interpolating);
+  ASSERT_EQ(interpolated.status().code(), absl::StatusCode::kFailedPrecondition)
+      << interpolated.status();
+  EXPECT_THAT(std::string(interpolated.status().message()),
+              HasSubstr("An interpolating fit (a control point per grid point"));
 
   options.allow_folds = true;
   absl::StatusOr<GridFit> allowed = FitGrid(grid, options);

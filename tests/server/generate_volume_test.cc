@@ -55,6 +55,7 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
   ASSERT_EQ(v.symmetry_planes_size(), 1);
   EXPECT_EQ(v.symmetry_planes(0).axis(), "z");
   EXPECT_GT(v.min_scaled_jacobian(), 0.0);
+  EXPECT_EQ(v.crease_vertices(), 0);  // its edges are convex
   EXPECT_EQ(r.report().parameters().side(), v1::MARCH_SIDE_OUTWARD);
   EXPECT_EQ(r.report().parameters().normal_smoothing(), 80);
   EXPECT_EQ(r.fit().report().folded_cells(), 0);
@@ -88,6 +89,52 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
     const absl::StatusOr<Connectivity> found = FindConnectivity(grid);
     ASSERT_TRUE(found.ok()) << found.status();
     EXPECT_EQ(static_cast<int>(found->matches.size()), matches);
+  }
+}
+
+// The inside of an L (two 33 x 33 unit squares at a right angle, the crease along y): the
+// march reports the crease's 33 vertices, and the stored grid at level 1 is right-handed
+// everywhere with every layer's crease point on the bisector.
+TEST_F(GenerateVolumeTest, ConcaveCreaseIsReportedAndMarchedApart) {
+  MultiBlockGrid l;
+  for (int b = 0; b < 2; ++b) {
+    StructuredBlock block({33, 33, 1}, 3);
+    for (int j = 0; j < 33; ++j) {
+      for (int i = 0; i < 33; ++i) {
+        const double u = i / 32.0;
+        double* x = block.Point(i, j, 0);
+        x[0] = b == 0 ? u : 0.0;
+        x[1] = j / 32.0;
+        x[2] = b == 0 ? 0.0 : 1.0 - u;
+      }
+    }
+    l.blocks.push_back(std::move(block));
+  }
+  ASSERT_TRUE(client_->ImportPoints(l, "l", "l").ok());
+  ASSERT_TRUE(client_->Fit("l", v1::FitSpec()).ok());
+  v1::GenerateGridRequest request;
+  request.set_grid_id("l-volume");
+  request.mutable_stored_surface()->set_name("grids/l");
+  request.set_layers(16);
+  request.set_first_height(1e-3);
+  request.set_distance(0.3);
+  request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);  // into the L
+  request.set_symmetry_planes(false);
+  const absl::StatusOr<v1::GenerateGridResponse> r = client_->Generate(request);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->report().volume().crease_vertices(), 33);
+  EXPECT_GT(r->report().volume().min_scaled_jacobian(), 0.99 * std::sqrt(0.5));
+  const MultiBlockGrid grid = Evaluate("l-volume", 1);
+  ASSERT_EQ(grid.blocks.size(), 2u);
+  for (size_t b = 0; b < grid.blocks.size(); ++b) {
+    EXPECT_GT(MinCornerJacobian(grid.blocks[b]), 0.0) << "block " << b;
+  }
+  // Block 0's i = 0 is the crease: on the bisector x = z at every layer.
+  const StructuredBlock& block = grid.blocks[0];
+  for (int k = 1; k < block.extent(2); ++k) {
+    const double* x = block.Point(0, block.extent(1) / 2, k);
+    EXPECT_NEAR(x[0], x[2], 1e-9) << "layer " << k;
+    EXPECT_GT(x[0], 0.0) << "layer " << k;
   }
 }
 
