@@ -167,10 +167,19 @@ absl::Status ValidateGridFit(const MultiBlockGrid& grid, const GridFitOptions& o
   return absl::OkStatus();
 }
 
-// True for the fit without counts or tolerance: every block interpolates its points.
-bool Interpolates(const GridFitOptions& options) {
-  return !options.tolerance_mode() && options.control_counts == Extents{0, 0, 0} &&
-         options.block_control_counts.empty();
+// What a caller can do about a fit of `options` that folds (it is not repaired unless in the
+// tolerance mode: repairing would change the counts, or what is interpolated, silently).
+std::string FoldAdvice(const GridFitOptions& options) {
+  if (options.tolerance_mode()) {
+    return ". Local refinement and knot removal did not repair it; try a looser tolerance";
+  }
+  if (options.control_counts == Extents{0, 0, 0} && options.block_control_counts.empty()) {
+    return ". An interpolating fit (a control point per grid point: neither counts nor a "
+           "tolerance were given) is not repaired (that would change what it interpolates); "
+           "try a tolerance or control counts";
+  }
+  return ". A fit to control counts is not repaired (that would change the counts); try other "
+         "counts or a tolerance";
 }
 
 // FitGrid once the options are valid and every block fittable (ValidateGridFit, or a
@@ -223,18 +232,10 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
       if (!d.empty()) folds.push_back(std::move(d));
     }
     if (!folds.empty()) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "the fitted grid folds at refinement levels 0..", quality.max_level, ": ",
-          absl::StrJoin(folds, "; "),
-          options.tolerance_mode() ? ". Local refinement and knot removal did not repair it; "
-                                     "try a looser tolerance"
-          : Interpolates(options)
-              ? ". An interpolating fit (a control point per grid point: neither counts nor a "
-                "tolerance were given) is not repaired (that would change what it interpolates); "
-                "try a tolerance or control counts"
-              : ". A fit to control counts is not repaired (that would change the counts); try "
-                "other counts or a tolerance",
-          ", or set allow_folds to accept the folded grid"));
+      return absl::FailedPreconditionError(
+          absl::StrCat("the fitted grid folds at refinement levels 0..", quality.max_level, ": ",
+                       absl::StrJoin(folds, "; "), FoldAdvice(options),
+                       ", or set allow_folds to accept the folded grid"));
     }
   }
   return result;
