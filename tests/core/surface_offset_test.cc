@@ -19,6 +19,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/test_data.h"
+#include "tests/core/wedge_surface.h"
 
 namespace splinegrid {
 namespace {
@@ -454,28 +455,6 @@ TEST(SurfaceOffsetTest, M6WingToTheFarFieldIsWatertightAndPositive) {
             << nearest << " from the wing, first layer error " << worst_first
             << ", min scaled Jacobian " << worst_jacobian << ", retries " << grid->retries << ", "
             << seconds << " s\n";
-}
-
-// Two 33 x 33 unit squares meeting along the y axis at an opening angle `degrees` between them
-// (a wedge in x-z, y along the edge): z = 0 for x in [0, 1], and the face rotated by the angle
-// about the y axis, its i running towards the edge.
-MultiBlockGrid Wedge(double degrees) {
-  const double a = degrees * kPi / 180.0;
-  MultiBlockGrid grid;
-  for (int b = 0; b < 2; ++b) {
-    StructuredBlock block({33, 33, 1}, 3);
-    for (int j = 0; j < 33; ++j) {
-      for (int i = 0; i < 33; ++i) {
-        const double u = i / 32.0, v = j / 32.0;
-        double* x = block.Point(i, j, 0);
-        x[0] = b == 0 ? u : (1.0 - u) * std::cos(a);
-        x[1] = v;
-        x[2] = b == 0 ? 0.0 : (1.0 - u) * std::sin(a);
-      }
-    }
-    grid.blocks.push_back(std::move(block));
-  }
-  return grid;
 }
 
 // Distance of x inside the wedge from the nearer of its two faces' planes.

@@ -10,6 +10,7 @@
 #include "core/grid/connectivity.h"
 #include "gmock/gmock.h"
 #include "tests/core/hexahedron_checks.h"
+#include "tests/core/wedge_surface.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
@@ -92,24 +93,11 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
   }
 }
 
-// The inside of an L (two 33 x 33 unit squares at a right angle, the crease along y): the
+// The inside of an L (the right-angled wedge, wedge_surface.h, the crease along y): the
 // march reports the crease's 33 vertices, and the stored grid at level 1 is right-handed
 // everywhere with every layer's crease point on the bisector.
 TEST_F(GenerateVolumeTest, ConcaveCreaseIsReportedAndMarchedApart) {
-  MultiBlockGrid l;
-  for (int b = 0; b < 2; ++b) {
-    StructuredBlock block({33, 33, 1}, 3);
-    for (int j = 0; j < 33; ++j) {
-      for (int i = 0; i < 33; ++i) {
-        const double u = i / 32.0;
-        double* x = block.Point(i, j, 0);
-        x[0] = b == 0 ? u : 0.0;
-        x[1] = j / 32.0;
-        x[2] = b == 0 ? 0.0 : 1.0 - u;
-      }
-    }
-    l.blocks.push_back(std::move(block));
-  }
+  const MultiBlockGrid l = Wedge(90.0);
   ASSERT_TRUE(client_->ImportPoints(l, "l", "l").ok());
   ASSERT_TRUE(client_->Fit("l", v1::FitSpec()).ok());
   v1::GenerateGridRequest request;
