@@ -32,7 +32,9 @@
 // (their blocks' normals agree at shared edges) and convex edges (which fan out along the mean
 // normal) have none. The miter is capped at kMaxMiter: a crease sharper than 2 acos(1 / 4)
 // (151 degrees of turning) lags, and its layers may fold (the fold check names the cell).
-// Creases inside one block (a kinked grid line) are not detected: only where blocks meet.
+// Inside one block a crease is a grid line across which the block kinks: its faces are the
+// block's normals on either side (surface_offset.cc, KinkNormals), so it is found and marched
+// as one between blocks is.
 // Where three concave creases meet (the inside corner of a box) the creases' points are not
 // moved along their crease and the faces' points between two creases follow the nearer one
 // only: such a corner folds within a few layers and is refused.

@@ -10,6 +10,7 @@
 #include "Eigen/Geometry"
 #include "absl/strings/str_cat.h"
 #include "core/bspline/evaluation.h"
+#include "core/fit/adaptive/refinement.h"
 #include "core/fit/solve/tensor_fit.h"
 #include "core/generate/concave_crease.h"
 #include "core/generate/offset_march.h"
@@ -114,6 +115,9 @@ struct BlockMarch {
   std::array<std::vector<double>, 3> params;
   TensorSpline fit;
   const std::vector<int64_t>* vertex = nullptr;
+  // Per direction i, j: the indices of the grid lines across which the surface kinks
+  // (SurfaceKinks); the block's splines are only C0 there.
+  std::array<std::vector<int>, 2> kinks;
 
   int64_t V(int i, int j) const { return (*vertex)[s.At(i, j)]; }
 };
@@ -187,14 +191,32 @@ void LeanTowardsPlanes(const March& m, const Layer& p, double height, Layer& nor
   }
 }
 
+// The unit normals of `block` on either side of its kinked grid line (BlockMarch::kinks) at
+// index c of direction d, at point t along the line: X_d^- x X_t and X_d^+ x X_t (one-sided
+// differences of the layer `p` across the line, central along it) in the order of X_i x X_j,
+// times the block's side.
+std::array<Vec, 2> KinkNormals(const BlockMarch& block, const Layer& p, int d, int c, int t) {
+  const int along = d == 0 ? block.s.nj : block.s.ni;
+  auto at = [&](int across, int line) -> const Vec& {
+    return p[d == 0 ? block.V(across, line) : block.V(line, across)];
+  };
+  const Vec tangent = at(c, std::min(t + 1, along - 1)) - at(c, std::max(t - 1, 0));
+  const Vec before = at(c, t) - at(c - 1, t), after = at(c + 1, t) - at(c, t);
+  const double sign = block.side * (d == 0 ? 1.0 : -1.0);
+  return {(sign * before.cross(tangent)).normalized(), (sign * after.cross(tangent)).normalized()};
+}
+
 // Per vertex: the normalised mean of its block points' normals (from each block's layer
-// spline); with `faces`, also each block point's normal at every vertex joined from several
-// (what FindConcaveCreases needs; empty elsewhere). INVALID_ARGUMENT when a block's fitted
-// layer has no regular point.
-absl::StatusOr<Layer> VertexNormals(const March& m,
+// spline; on a kinked grid line, where the spline is only C0, the mean of the normals on either
+// side, KinkNormals); with `faces`, also the faces a crease needs (FindConcaveCreases): each
+// block point's normal at every vertex joined from several, and both sides' normals at the
+// points of a kinked line (empty elsewhere). INVALID_ARGUMENT when a block's fitted layer has no
+// regular point.
+absl::StatusOr<Layer> VertexNormals(const March& m, const Layer& p,
                                     std::vector<std::vector<Vec>>* faces = nullptr) {
   Layer normal(m.num_vertices(), Vec::Zero());
   std::vector<Layer> block_normals;
+  std::vector<std::vector<std::pair<int64_t, std::array<Vec, 2>>>> kink_faces;
   std::vector<int> joined(m.num_vertices(), 0);  // block points per vertex
   for (size_t b = 0; b < m.blocks.size(); ++b) {
     const BlockMarch& block = m.blocks[b];
@@ -210,6 +232,17 @@ absl::StatusOr<Layer> VertexNormals(const March& m,
                        ": the fitted surface has no regular point (X_u x X_v vanishes "
                        "everywhere)"));
     }
+    kink_faces.emplace_back();
+    for (int d = 0; d < 2; ++d) {
+      for (const int c : block.kinks[d]) {
+        for (int t = 0; t < (d == 0 ? s.nj : s.ni); ++t) {
+          const int64_t q = d == 0 ? s.At(c, t) : s.At(t, c);
+          const std::array<Vec, 2> sides = KinkNormals(block, p, d, c, t);
+          local[q] = (sides[0] + sides[1]).normalized();
+          kink_faces.back().emplace_back(q, sides);
+        }
+      }
+    }
     for (int64_t q = 0; q < s.size(); ++q) {
       const int64_t v = (*block.vertex)[q];
       normal[v] += local[q];
@@ -223,9 +256,15 @@ absl::StatusOr<Layer> VertexNormals(const March& m,
   if (faces != nullptr) {
     faces->assign(m.num_vertices(), {});
     for (size_t b = 0; b < m.blocks.size(); ++b) {
+      const std::vector<int64_t>& vertex = *m.blocks[b].vertex;
+      std::vector<char> kinked(m.blocks[b].s.size(), 0);
+      for (const auto& [q, sides] : kink_faces[b]) {
+        kinked[q] = 1;
+        (*faces)[vertex[q]].push_back(sides[0]);
+        (*faces)[vertex[q]].push_back(sides[1]);
+      }
       for (int64_t q = 0; q < m.blocks[b].s.size(); ++q) {
-        const int64_t v = (*m.blocks[b].vertex)[q];
-        if (joined[v] > 1) (*faces)[v].push_back(block_normals[b][q]);
+        if (joined[vertex[q]] > 1 && !kinked[q]) (*faces)[vertex[q]].push_back(block_normals[b][q]);
       }
     }
   }
@@ -393,11 +432,21 @@ struct Displacement {
 // interpolated, fairing weight `lambda` (fairing.h), and evaluated back at the parameters.
 absl::StatusOr<Displacement> FitDisplacement(const Layer& d, const Shape& s,
                                              const std::array<std::vector<double>, 3>& params,
-                                             const std::array<KnotVector, 3>& knots, double lambda,
-                                             const CancelCheck& cancel) {
+                                             const std::array<KnotVector, 3>& knots,
+                                             const std::array<std::vector<int>, 2>& kinks,
+                                             double lambda, const CancelCheck& cancel) {
+  // The control at a kink (a C0 knot line) interpolates it, as the end controls do a block's
+  // edge: the fairing rows beside the kink would otherwise pull a crease's displacement, which
+  // differs from its faces' by design (concave_crease.h), towards theirs.
+  DirectionPins pins;
+  for (int dir = 0; dir < 2; ++dir) {
+    for (const int c : kinks[dir]) {
+      pins[dir].push_back({knots[dir].FindSpan(params[dir][c]) - knots[dir].order() + 1, c});
+    }
+  }
   SG_ASSIGN_OR_RETURN(
       TensorSpline spline,
-      FitTensor(ToBlock(d, s), params, knots, EndCondition::kInterpolate, cancel, {}, lambda));
+      FitTensor(ToBlock(d, s), params, knots, EndCondition::kInterpolate, cancel, pins, lambda));
   const StructuredBlock at = EvaluateGrid(spline, params);
   Layer moved(s.size());
   for (int64_t i = 0; i < s.size(); ++i) {
@@ -610,7 +659,7 @@ absl::Status FairLayer(March& m, const Layer& p, double lambda, Layer& q, CellCh
       const int64_t v = (*block.vertex)[i];
       d[i] = q[v] - p[v];
     }
-    return FitDisplacement(d, block.s, block.params, block.fit.all_knots(), weight,
+    return FitDisplacement(d, block.s, block.params, block.fit.all_knots(), block.kinks, weight,
                            m.options.cancel);
   };
   std::vector<Displacement> faired;
@@ -690,6 +739,22 @@ absl::StatusOr<std::vector<int>> BlockSides(const MultiBlockGrid& surface,
   return sides;
 }
 
+// The interior grid lines across which a surface block kinks, per direction i, j: where its
+// boundary lines have a tangent discontinuity (DetectFeatures with kink_ratio 2, as the service's
+// fit of the volume grid finds them, grid_fit.cc FitBlocks), so that the layers' splines are C0
+// there and the crease is treated as one between blocks is (concave_crease.h).
+std::array<std::vector<int>, 2> SurfaceKinks(const StructuredBlock& block) {
+  FeatureOptions features;
+  features.kink_ratio = 2.0;
+  std::array<std::vector<int>, 2> kinks;
+  for (int d = 0; d < 2; ++d) {
+    for (const int c : DetectFeatures(block, d, features)) {
+      if (c > 0 && c < block.extent(d) - 1) kinks[d].push_back(c);
+    }
+  }
+  return kinks;
+}
+
 // The surface spline of every block (faired: for normals and curvatures only, k = 0 is the
 // surface as given), whose parameters and knots every layer keeps.
 absl::Status FitSurfaceBlocks(const MultiBlockGrid& surface, const SurfaceTopology& topology,
@@ -699,8 +764,20 @@ absl::Status FitSurfaceBlocks(const MultiBlockGrid& surface, const SurfaceTopolo
   fit_options.fairing = m.options.surface_fairing;
   for (size_t b = 0; b < surface.blocks.size(); ++b) {
     const StructuredBlock& block = surface.blocks[b];
-    SG_ASSIGN_OR_RETURN(const FittedBlock fitted, FitBlock(block, fit_options));
     BlockMarch march;
+    const std::array<std::vector<int>, 2> kinks = SurfaceKinks(block);
+    fit_options.breaks = {kinks[0], kinks[1], {}};
+    SG_ASSIGN_OR_RETURN(const FittedBlock fitted, FitBlock(block, fit_options));
+    // The kinks the fit could make C0 (a break too near an end, or another break, is not used:
+    // KnotVector::UsableBreaks); a kink left out is smooth to the march as to the fit.
+    for (int d = 0; d < 2; ++d) {
+      const KnotVector& knots = fitted.spline.knots(d);
+      for (const int c : kinks[d]) {
+        if (knots.Multiplicity(fitted.distribution.params(d)[c]) >= knots.order() - 1) {
+          march.kinks[d].push_back(c);
+        }
+      }
+    }
     march.s = Shape{block.extent(0), block.extent(1)};
     march.side = sides[b];
     march.params = {fitted.distribution.params(0), fitted.distribution.params(1), {0.0}};
@@ -808,7 +885,7 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
     out.steps.push_back(h);
     const double fraction = static_cast<double>(k + 1) / options.layers;
     std::vector<std::vector<Vec>> faces;  // the surface's, to find its creases
-    SG_ASSIGN_OR_RETURN(const Layer layer_normals, VertexNormals(m, k == 0 ? &faces : nullptr));
+    SG_ASSIGN_OR_RETURN(const Layer layer_normals, VertexNormals(m, p, k == 0 ? &faces : nullptr));
     if (k == 0) {
       m.creases = FindConcaveCreases(m.graph, p, layer_normals, faces);
       for (const int64_t v : m.creases.vertices) {

@@ -52,7 +52,8 @@
 // it is smoothed with all its blocks' stencils together, so the volume
 // blocks share their faces point for point (watertight) and a convex edge between blocks (a
 // blunt trailing edge's corner) fans out along the mean normal. A concave crease between blocks
-// (a wing-body junction, the inside of an L) is found on the surface and marched apart
+// (a wing-body junction, the inside of an L), or along a grid line across which one block kinks
+// (its splines are then C0 there), is found on the surface and marched apart
 // (concave_crease.h): its points go straight to their layer's height above both faces (along
 // the bisector, by the miter), the faces' points near it move with it along their face and
 // march along the face's normal, the normal smoothing does not cross it, and its edges do not
@@ -146,7 +147,8 @@ struct SurfaceOffsetGrid {
   int retries = 0;            // extra normal smoothing rounds over all layers
   int refits_dropped = 0;     // layers whose faired displacement would have folded a cell
   int64_t limited_steps = 0;  // point steps shortened by the curvature limit, over all layers
-  // Vertices of the surface on concave creases between blocks (concave_crease.h).
+  // Vertices of the surface on concave creases, between blocks or along a kinked grid line
+  // inside one (concave_crease.h).
   int64_t crease_vertices = 0;
   // Largest height the curvature limit left unreached at a point of the last layer, in the
   // surface's unit (at most max_shortfall * distance).

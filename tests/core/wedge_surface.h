@@ -1,8 +1,9 @@
-// A test surface shared by the kernel's and the service's crease tests: two 33 x 33 unit squares
-// meeting along the y axis at an opening angle between them.
+// Test surfaces shared by the kernel's and the service's crease tests: two 33 x 33 unit squares
+// meeting along the y axis at an opening angle between them, as two blocks or as one.
 #ifndef SPLINEGRID_TESTS_CORE_WEDGE_SURFACE_H_
 #define SPLINEGRID_TESTS_CORE_WEDGE_SURFACE_H_
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -29,6 +30,23 @@ inline MultiBlockGrid Wedge(double degrees) {
     }
     grid.blocks.push_back(std::move(block));
   }
+  return grid;
+}
+
+// The same two faces as one 65 x 33 block, kinked along its grid line i = 32 (the edge): i = 0
+// .. 32 are Wedge's block 1, i = 32 .. 64 its block 0, so X_i x X_j points into the wedge too.
+inline MultiBlockGrid FoldedWedge(double degrees) {
+  const MultiBlockGrid faces = Wedge(degrees);
+  StructuredBlock block({65, 33, 1}, 3);
+  for (int j = 0; j < 33; ++j) {
+    for (int i = 0; i < 65; ++i) {
+      const double* x =
+          i <= 32 ? faces.blocks[1].Point(i, j, 0) : faces.blocks[0].Point(i - 32, j, 0);
+      std::copy(x, x + 3, block.Point(i, j, 0));
+    }
+  }
+  MultiBlockGrid grid;
+  grid.blocks.push_back(std::move(block));
   return grid;
 }
 

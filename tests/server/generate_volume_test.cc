@@ -126,6 +126,38 @@ TEST_F(GenerateVolumeTest, ConcaveCreaseIsReportedAndMarchedApart) {
   }
 }
 
+// The same L as one block kinked along its grid line i = 32: the march finds the kink and treats
+// it as the crease between two blocks, and the volume's fit keeps it (a C0 knot line at the
+// kink of its boundary lines), so no hexahedron folds at level 1 beside it either. Before, the
+// march folded at layer 15 of 16.
+TEST_F(GenerateVolumeTest, ACreaseInsideOneBlockIsMarchedApart) {
+  ASSERT_TRUE(client_->ImportPoints(FoldedWedge(90.0), "l1", "l1").ok());
+  ASSERT_TRUE(client_->Fit("l1", v1::FitSpec()).ok());
+  v1::GenerateGridRequest request;
+  request.set_grid_id("l1-volume");
+  request.mutable_stored_surface()->set_name("grids/l1");
+  request.set_layers(16);
+  request.set_first_height(1e-3);
+  request.set_distance(0.3);
+  request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);  // into the L
+  request.set_symmetry_planes(false);
+  const absl::StatusOr<v1::GenerateGridResponse> r = client_->Generate(request);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->report().volume().crease_vertices(), 33);
+  EXPECT_GT(r->report().volume().min_scaled_jacobian(), 0.99 * std::sqrt(0.5));
+  const MultiBlockGrid grid = Evaluate("l1-volume", 1);
+  ASSERT_EQ(grid.blocks.size(), 1u);
+  EXPECT_GT(MinCornerJacobian(grid.blocks[0]), 0.0);
+  // The crease, i = 64 at level 1: on the bisector x = z at every layer.
+  const StructuredBlock& block = grid.blocks[0];
+  ASSERT_EQ(block.extent(0), 129);
+  for (int k = 1; k < block.extent(2); ++k) {
+    const double* x = block.Point(64, block.extent(1) / 2, k);
+    EXPECT_NEAR(x[0], x[2], 1e-9) << "layer " << k;
+    EXPECT_GT(x[0], 0.0) << "layer " << k;
+  }
+}
+
 TEST_F(GenerateVolumeTest, BadRequestsAreRefusedByNameAndNothingIsStored) {
   ImportShared("surfaces/m6_small.fmt", "m6");
   ASSERT_TRUE(client_->Fit("m6", v1::FitSpec()).ok());
