@@ -637,7 +637,10 @@ absl::Status FoldedLayerError(const March& m, const CellCheck& check, int k, dou
         "distance = ", options.distance, " is not reachable on the concave side: layer ", k + 1,
         " folds at ", cell,
         " while the curvature limit (max_curvature_step = ", options.max_curvature_step,
-        ") holds its steps up to ", held_back, " short; lower the distance"));
+        ") holds its steps up to ", held_back,
+        " short; lower the distance, or, if the surface is a fit within a tolerance, march off an "
+        "interpolating fit of its points (FitGrid without tolerances), which follows them "
+        "exactly"));
   }
   return absl::FailedPreconditionError(absl::StrCat(
       "layer ", k + 1, " folds at ", cell, " even with smoothed normals (step ", h,
