@@ -156,9 +156,12 @@ absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag() {
 absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   const double tol = absl::GetFlag(FLAGS_tol);
   const std::string ctl = absl::GetFlag(FLAGS_ctl);
+  // --edge below 0 means unset; anything else, NaN included, goes to the server to be checked.
+  const double edge = absl::GetFlag(FLAGS_edge);
+  const bool edge_set = !(edge < 0.0);
   const bool kinds = absl::GetFlag(FLAGS_kinds) || absl::GetFlag(FLAGS_wall) != 0.0 ||
                      absl::GetFlag(FLAGS_interface) != 0.0 || absl::GetFlag(FLAGS_outer) != 0.0 ||
-                     absl::GetFlag(FLAGS_interior) != 0.0 || absl::GetFlag(FLAGS_edge) >= 0.0 ||
+                     absl::GetFlag(FLAGS_interior) != 0.0 || edge_set ||
                      absl::GetFlag(FLAGS_ref_length) != 0.0 || !absl::GetFlag(FLAGS_face).empty();
   if ((tol != 0.0) + !ctl.empty() + kinds > 1) {
     return Usage("give one of --tol, --ctl and the tolerances by kind (--kinds, --wall, ...)");
@@ -174,7 +177,7 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
     t->set_interface(absl::GetFlag(FLAGS_interface));
     t->set_outer(absl::GetFlag(FLAGS_outer));
     t->set_interior(absl::GetFlag(FLAGS_interior));
-    if (absl::GetFlag(FLAGS_edge) >= 0.0) t->set_edge(absl::GetFlag(FLAGS_edge));
+    if (edge_set) t->set_edge(edge);
     spec.set_reference_length(absl::GetFlag(FLAGS_ref_length));
     spec.set_max_controls_per_direction(absl::GetFlag(FLAGS_max_ctl));
   } else if (!ctl.empty()) {

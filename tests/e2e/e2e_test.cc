@@ -222,6 +222,13 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   const Result usage = Cli("eval nope");
   EXPECT_EQ(usage.exit_code, 2);
   EXPECT_THAT(usage.out, HasSubstr("usage"));
+  // A NaN edge accuracy reaches the server and is refused by name; it used to read as unset, and
+  // the grid was stored with the default 0.5.
+  const Result nan_edge = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
+                                           " --name=nan-edge --kinds --edge=nan"));
+  EXPECT_EQ(nan_edge.exit_code, 2) << nan_edge.out;
+  EXPECT_THAT(nan_edge.out, HasSubstr("edge = nan"));
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/nan-edge")));
 }
 
 TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
