@@ -44,6 +44,28 @@ class GenerateVolumeTest : public ServiceTest {
     }
     return grid;
   }
+
+  // Imports `surface` as grids/`name`, fits it by interpolation and marches 16 layers (1e-3 to
+  // 0.3) along its normals, into the L, as grids/`name`-volume; checks the crease report (33
+  // vertices, smallest scaled Jacobian sin 45) and returns the volume at level 1.
+  MultiBlockGrid MarchIntoTheL(const MultiBlockGrid& surface, const std::string& name) {
+    EXPECT_TRUE(client_->ImportPoints(surface, name, name).ok());
+    EXPECT_TRUE(client_->Fit(name, v1::FitSpec()).ok());
+    v1::GenerateGridRequest request;
+    request.set_grid_id(name + "-volume");
+    request.mutable_stored_surface()->set_name("grids/" + name);
+    request.set_layers(16);
+    request.set_first_height(1e-3);
+    request.set_distance(0.3);
+    request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);
+    request.set_symmetry_planes(false);
+    const absl::StatusOr<v1::GenerateGridResponse> r = client_->Generate(request);
+    EXPECT_TRUE(r.ok()) << r.status();
+    if (!r.ok()) return {};
+    EXPECT_EQ(r->report().volume().crease_vertices(), 33);
+    EXPECT_GT(r->report().volume().min_scaled_jacobian(), 0.99 * std::sqrt(0.5));
+    return Evaluate(name + "-volume", 1);
+  }
 };
 
 TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
@@ -97,22 +119,7 @@ TEST_F(GenerateVolumeTest, M6WingToFiveIsWatertightAndFoldsNothing) {
 // march reports the crease's 33 vertices, and the stored grid at level 1 is right-handed
 // everywhere with every layer's crease point on the bisector.
 TEST_F(GenerateVolumeTest, ConcaveCreaseIsReportedAndMarchedApart) {
-  const MultiBlockGrid l = Wedge(90.0);
-  ASSERT_TRUE(client_->ImportPoints(l, "l", "l").ok());
-  ASSERT_TRUE(client_->Fit("l", v1::FitSpec()).ok());
-  v1::GenerateGridRequest request;
-  request.set_grid_id("l-volume");
-  request.mutable_stored_surface()->set_name("grids/l");
-  request.set_layers(16);
-  request.set_first_height(1e-3);
-  request.set_distance(0.3);
-  request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);  // into the L
-  request.set_symmetry_planes(false);
-  const absl::StatusOr<v1::GenerateGridResponse> r = client_->Generate(request);
-  ASSERT_TRUE(r.ok()) << r.status();
-  EXPECT_EQ(r->report().volume().crease_vertices(), 33);
-  EXPECT_GT(r->report().volume().min_scaled_jacobian(), 0.99 * std::sqrt(0.5));
-  const MultiBlockGrid grid = Evaluate("l-volume", 1);
+  const MultiBlockGrid grid = MarchIntoTheL(Wedge(90.0), "l");
   ASSERT_EQ(grid.blocks.size(), 2u);
   for (size_t b = 0; b < grid.blocks.size(); ++b) {
     EXPECT_GT(MinCornerJacobian(grid.blocks[b]), 0.0) << "block " << b;
@@ -131,21 +138,7 @@ TEST_F(GenerateVolumeTest, ConcaveCreaseIsReportedAndMarchedApart) {
 // kink of its boundary lines), so no hexahedron folds at level 1 beside it either. Before, the
 // march folded at layer 15 of 16.
 TEST_F(GenerateVolumeTest, ACreaseInsideOneBlockIsMarchedApart) {
-  ASSERT_TRUE(client_->ImportPoints(FoldedWedge(90.0), "l1", "l1").ok());
-  ASSERT_TRUE(client_->Fit("l1", v1::FitSpec()).ok());
-  v1::GenerateGridRequest request;
-  request.set_grid_id("l1-volume");
-  request.mutable_stored_surface()->set_name("grids/l1");
-  request.set_layers(16);
-  request.set_first_height(1e-3);
-  request.set_distance(0.3);
-  request.set_side(v1::MARCH_SIDE_ALONG_NORMAL);  // into the L
-  request.set_symmetry_planes(false);
-  const absl::StatusOr<v1::GenerateGridResponse> r = client_->Generate(request);
-  ASSERT_TRUE(r.ok()) << r.status();
-  EXPECT_EQ(r->report().volume().crease_vertices(), 33);
-  EXPECT_GT(r->report().volume().min_scaled_jacobian(), 0.99 * std::sqrt(0.5));
-  const MultiBlockGrid grid = Evaluate("l1-volume", 1);
+  const MultiBlockGrid grid = MarchIntoTheL(FoldedWedge(90.0), "l1");
   ASSERT_EQ(grid.blocks.size(), 1u);
   EXPECT_GT(MinCornerJacobian(grid.blocks[0]), 0.0);
   // The crease, i = 64 at level 1: on the bisector x = z at every layer.
