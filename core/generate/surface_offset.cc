@@ -239,7 +239,7 @@ absl::StatusOr<Layer> VertexNormals(const March& m, const Layer& p,
           const int64_t q = d == 0 ? s.At(c, t) : s.At(t, c);
           const std::array<Vec, 2> sides = KinkNormals(block, p, d, c, t);
           local[q] = (sides[0] + sides[1]).normalized();
-          kink_faces.back().emplace_back(q, sides);
+          if (faces != nullptr) kink_faces.back().emplace_back(q, sides);
         }
       }
     }
