@@ -107,6 +107,30 @@ absl::StatusOr<Extents> ParseTriple(const std::string& text, const std::string& 
   return values;
 }
 
+absl::StatusOr<std::optional<int>> LevelFlag() {
+  const std::optional<int> level = absl::GetFlag(FLAGS_level);
+  if (level.has_value() && *level < 0) {
+    return Usage(
+        absl::StrCat("--level = ", *level, " is negative; level 0 is the original points"));
+  }
+  return level;
+}
+
+absl::StatusOr<Extents> ResolutionFlag() {
+  const std::string text = absl::GetFlag(FLAGS_res);
+  SG_ASSIGN_OR_RETURN(Extents counts, ParseTriple(text, "--res"));
+  const size_t given = std::vector<std::string>(absl::StrSplit(text, ',')).size();
+  for (size_t d = 0; d < 3; ++d) {
+    if (d >= given) {
+      counts[d] = 1;
+    } else if (counts[d] < 1) {
+      return Usage(absl::StrCat("--res = '", text, "': ", counts[d], " points in direction ",
+                                std::string(1, "ijk"[d]), "; give at least 1 per direction"));
+    }
+  }
+  return counts;
+}
+
 std::string IdFromPath(const std::string& path) {
   std::string id;
   for (char c : std::filesystem::path(path).stem().string()) {
@@ -132,6 +156,11 @@ absl::Status PrepareConnection() {
                                           absl::GetFlag(FLAGS_tls_key), &options));
   options.tls_server_name = absl::GetFlag(FLAGS_tls_server_name);
   if (!options.tls_server_name.empty()) options.use_tls = true;
+  if (const absl::Duration timeout = absl::GetFlag(FLAGS_timeout);
+      !(timeout > absl::ZeroDuration())) {
+    return Usage(absl::StrCat("--timeout = ", absl::FormatDuration(timeout),
+                              " is not a positive duration (e.g. 30s, 10m)"));
+  }
   ConnectionOptions() = options;
   return absl::OkStatus();
 }
@@ -165,6 +194,11 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
                      absl::GetFlag(FLAGS_ref_length) != 0.0 || !absl::GetFlag(FLAGS_face).empty();
   if ((tol != 0.0) + !ctl.empty() + kinds > 1) {
     return Usage("give one of --tol, --ctl and the tolerances by kind (--kinds, --wall, ...)");
+  }
+  // 0 would read as unset on the wire and fit at the default order.
+  if (const int order = absl::GetFlag(FLAGS_order); order < 1) {
+    return Usage(
+        absl::StrCat("--order = ", order, " is not a spline order (degree + 1, at least 2)"));
   }
   v1::FitSpec spec;
   spec.set_order(absl::GetFlag(FLAGS_order));

@@ -29,6 +29,12 @@ std::unique_ptr<client::Client> Connect();
 // Prints `human`, or with --json `message` as JSON, to stdout.
 void Print(const std::string& human, const google::protobuf::Message& message);
 
+// --level when given (refused below 0, which is no level), else nullopt.
+absl::StatusOr<std::optional<int>> LevelFlag();
+
+// --res: "400,120" -> {400, 120, 1}. Each given count is at least 1; missing ones are 1.
+absl::StatusOr<Extents> ResolutionFlag();
+
 // "24,16" -> {24, 16, 0}; `what` names the flag in errors.
 absl::StatusOr<Extents> ParseTriple(const std::string& text, const std::string& what);
 

@@ -34,7 +34,8 @@ absl::Status Curvature(const Args& args) {
       blocks.push_back(b);
     }
   }
-  const int level = absl::GetFlag(FLAGS_level) < 0 ? 2 : absl::GetFlag(FLAGS_level);
+  SG_ASSIGN_OR_RETURN(const std::optional<int> level_flag, LevelFlag());
+  const int level = level_flag.value_or(2);
   SG_ASSIGN_OR_RETURN(
       const v1::GetWallCurvatureResponse curvature,
       Connect()->WallCurvature(args[0], absl::GetFlag(FLAGS_revision), level, blocks));

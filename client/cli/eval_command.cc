@@ -35,14 +35,14 @@ absl::Status Eval(const Args& args) {
   request.set_name(args[0]);
   SG_RETURN_IF_ERROR(RevisionOrStep([&](int64_t r) { request.set_revision(r); },
                                     [&](int64_t s) { request.set_step(s); }));
-  const int level = absl::GetFlag(FLAGS_level);
-  const std::string res = absl::GetFlag(FLAGS_res);
-  if ((level >= 0) == !res.empty()) return Usage("give exactly one of --level and --res");
-  if (level >= 0) {
-    request.set_refinement_level(level);
+  SG_ASSIGN_OR_RETURN(const std::optional<int> level, LevelFlag());
+  if (level.has_value() == !absl::GetFlag(FLAGS_res).empty()) {
+    return Usage("give exactly one of --level and --res");
+  }
+  if (level.has_value()) {
+    request.set_refinement_level(*level);
   } else {
-    SG_ASSIGN_OR_RETURN(Extents counts, ParseTriple(res, "--res"));
-    for (int& c : counts) c = std::max(c, 1);
+    SG_ASSIGN_OR_RETURN(const Extents counts, ResolutionFlag());
     request.mutable_counts()->set_i(counts[0]);
     request.mutable_counts()->set_j(counts[1]);
     request.mutable_counts()->set_k(counts[2]);

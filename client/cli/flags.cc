@@ -64,7 +64,8 @@ ABSL_FLAG(bool, allow_folds, false,
 ABSL_FLAG(int64_t, revision, 0, "get/eval/fair/curvature: revision (0: latest)");
 ABSL_FLAG(bool, full, false, "get: include knots, control points and distributions");
 
-ABSL_FLAG(int, level, -1, "eval/curvature: refinement level (0 = original points)");
+ABSL_FLAG(std::optional<int>, level, std::nullopt,
+          "eval/curvature: refinement level (0 = original points; curvature: default 2)");
 ABSL_FLAG(std::string, res, "", "eval: points per direction, e.g. 400,120");
 ABSL_FLAG(std::string, block, "", "eval/curvature: blocks, e.g. 0 or 0,3 (default: all)");
 ABSL_FLAG(std::string, box, "", "eval: index box i0:i1,j0:j1[,k0:k1] (inclusive)");

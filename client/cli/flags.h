@@ -45,7 +45,7 @@ ABSL_DECLARE_FLAG(bool, allow_folds);
 ABSL_DECLARE_FLAG(int64_t, revision);
 ABSL_DECLARE_FLAG(bool, full);
 // eval
-ABSL_DECLARE_FLAG(int, level);
+ABSL_DECLARE_FLAG(std::optional<int>, level);
 ABSL_DECLARE_FLAG(std::string, res);
 ABSL_DECLARE_FLAG(std::string, block);
 ABSL_DECLARE_FLAG(std::string, box);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -74,6 +75,8 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
   double scale = 0.0;
   for (double x : spline.control()) scale = std::max(scale, std::abs(x));
   const double negligible = 1e-12 * scale;
+  // Points nearer than this can round to the same coordinates: a few ulps of the largest one.
+  const double separable = 8.0 * std::numeric_limits<double>::epsilon() * scale;
   for (int c = 0; c < n[e2]; ++c) {
     for (int a = 0; a < n[e1]; ++a) {
       SG_RETURN_IF_ERROR(PollCancel(cancel));
@@ -102,11 +105,11 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
       t[0] = t0;  // a single point sits at the first index, as in the other distributions
       if (n[d] > 1) t[n[d] - 1] = t1;
       for (int q = 1; q < n[d]; ++q) {
-        if (!(t[q] > t[q - 1])) {
-          return absl::InvalidArgumentError(
-              absl::StrCat("distributions.", std::string(1, kNames[d]), ": points ", q - 1, " and ",
-                           q, " of ", line_name(), " are ", s[q] - s[q - 1],
-                           " apart, closer than double precision separates on that line"));
+        if (!(t[q] > t[q - 1]) || !(s[q] - s[q - 1] > separable)) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              "distributions.", std::string(1, kNames[d]), ": points ", q - 1, " and ", q, " of ",
+              line_name(), " are ", s[q] - s[q - 1],
+              " apart, closer than double precision separates at coordinates up to ", scale));
         }
       }
     }

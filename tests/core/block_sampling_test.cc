@@ -293,6 +293,18 @@ TEST(BlockSamplingTest, RefusalsNameTheField) {
   long_first.distributions[1] = {Distribution::Kind::kGeometric, 50.0};
   EXPECT_THAT(error(long_first), HasSubstr("is not below the length"));
   EXPECT_THAT(error(long_first), HasSubstr("the grid line at output i = 0"));
+  // A spacing that double precision cannot resolve at the grid's coordinates (up to 20 here)
+  // would give points with the same coordinates: refused, not sampled. 1e-12 is resolved.
+  for (double tiny : {1e-300, 1e-20, 1e-15}) {
+    Resolution spacing = Counts(9, 12);
+    spacing.distributions[1] = {Distribution::Kind::kGeometric, tiny};
+    EXPECT_THAT(error(spacing), HasSubstr("closer than double precision separates")) << tiny;
+  }
+  Resolution fine = Counts(9, 12);
+  fine.distributions[1] = {Distribution::Kind::kGeometric, 1e-12};
+  const BlockSampling sampling = BlockSampling::Create(spline, distribution, fine).value();
+  const auto x = Points(spline, sampling);
+  for (int i = 0; i < 9; ++i) EXPECT_GT(Distance(x[1][i], x[0][i]), 0.5e-12) << "i = " << i;
   Resolution stray = Counts(9, 12);
   stray.distributions[0] = {Distribution::Kind::kUniformArcLength, 0.1};
   EXPECT_THAT(error(stray), HasSubstr("distributions.i.first_spacing = 0.1 is only for"));

@@ -231,6 +231,30 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/nan-edge")));
 }
 
+// Flag values the request cannot carry as given are refused by name (exit 2), not read as
+// "unset": 0 is the wire's default for an order or a count, and a negative level or deadline has
+// no meaning. A first spacing that double precision cannot resolve is refused by the server.
+TEST_F(EndToEndTest, CliRefusesValuesThatWouldReadAsUnset) {
+  const std::string grid = SharedDataPath("grids/n0012_113-33.p2dfmt");
+  const std::string out = (dir_ / "x.vts").string();
+  const auto refused = [&](const std::string& args, const std::string& why) {
+    const Result result = Cli(args);
+    EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.out;
+    EXPECT_THAT(result.out, HasSubstr(why)) << args;
+  };
+  refused(absl::StrCat("fit ", grid, " --name=order0 --kinds --order=0"), "--order = 0");
+  ASSERT_EQ(Cli(absl::StrCat("fit ", grid, " --name=flags --kinds")).exit_code, 0);
+  refused(absl::StrCat("eval flags --res=0,0 -o ", out), "0 points in direction i");
+  refused(absl::StrCat("eval flags --res=40,0 -o ", out), "0 points in direction j");
+  refused(absl::StrCat("eval flags --level=-3 -o ", out), "--level = -3 is negative");
+  refused("curvature flags --level=-3", "--level = -3 is negative");
+  refused("list --timeout=-5s", "--timeout = -5s is not a positive duration");
+  refused(absl::StrCat("eval flags --level=1 --dist j=geometric:1e-300 -o ", out),
+          "closer than double precision separates");
+  EXPECT_EQ(Cli(absl::StrCat("eval flags --res=40,20 -o ", out)).exit_code, 0);
+  EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("order0")));
+}
+
 TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {
   const Result python = RunCommand(
       absl::StrCat("PYTHONPATH=", SPLINEGRID_BINARY_DIR, "/python /usr/bin/python3 ", kSource,
