@@ -170,8 +170,16 @@ absl::Status ValidateGridFit(const MultiBlockGrid& grid, const GridFitOptions& o
 // What a caller can do about a fit of `options` that folds (it is not repaired unless in the
 // tolerance mode: repairing would change the counts, or what is interpolated, silently).
 std::string FoldAdvice(const GridFitOptions& options) {
+  if (options.tolerance.has_value()) {
+    // One tolerance for every point holds a far field to the wall's accuracy: nearly a control
+    // per datum there. Tolerances by kind leave the interior to the edge criterion.
+    return ". Local refinement, knot removal, averaged knots and a weak fairing did not repair "
+           "it; try a looser tolerance, or tolerances by boundary kind (they hold the interior "
+           "to each cell's size, not to one length)";
+  }
   if (options.tolerance_mode()) {
-    return ". Local refinement and knot removal did not repair it; try a looser tolerance";
+    return ". Local refinement, knot removal, averaged knots and a weak fairing did not repair "
+           "it; try a looser tolerance";
   }
   if (options.control_counts == Extents{0, 0, 0} && options.block_control_counts.empty()) {
     return ". An interpolating fit (a control point per grid point: neither counts nor a "

@@ -5,12 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "core/bspline/evaluation.h"
 #include "core/fit/adaptive/refinement.h"
 #include "core/fit/grid_fit.h"
 #include "core/io/file_util.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/multiblock_checks.h"
 #include "tests/core/test_data.h"
 
 namespace splinegrid {
@@ -53,6 +55,42 @@ TEST(FoldRepairTest, BreakingRunsBoundsThemAndOnlyRemovesKnotsOnRuns) {
   EXPECT_EQ(BreakSingleDatumRuns(u, knots, 6), knots);
 }
 
+// Sub-cells of a 2D fitted block at refinement level `level` whose signed area has the other
+// sign than their original cell's (the shoelace area of the data cell), counted here by
+// evaluating the spline point by point, not by the fit's own quality check.
+int64_t FoldedSubCells(const StructuredBlock& data, const FittedBlock& fitted, int level) {
+  const int ni = data.extent(0), nj = data.extent(1);
+  const std::vector<double> u = fitted.distribution.Refined(0, 0, ni - 1, level);
+  const std::vector<double> v = fitted.distribution.Refined(1, 0, nj - 1, level);
+  std::vector<Point3> x(u.size() * v.size());
+  for (size_t j = 0; j < v.size(); ++j) {
+    for (size_t i = 0; i < u.size(); ++i) {
+      x[j * u.size() + i] = EvaluatePoint(fitted.spline, {u[i], v[j], 0.0});
+    }
+  }
+  // Twice the signed area of the quadrilateral abcd: the cross product of its diagonals.
+  const auto area = [](const auto& a, const auto& b, const auto& c, const auto& d) {
+    return (c[0] - a[0]) * (d[1] - b[1]) - (d[0] - b[0]) * (c[1] - a[1]);
+  };
+  const int sub = 1 << level;
+  int64_t folded = 0;
+  for (int j = 0; j + 1 < nj; ++j) {
+    for (int i = 0; i + 1 < ni; ++i) {
+      const double original = area(data.Point(i, j, 0), data.Point(i + 1, j, 0),
+                                   data.Point(i + 1, j + 1, 0), data.Point(i, j + 1, 0));
+      for (int b = j * sub; b < (j + 1) * sub; ++b) {
+        for (int a = i * sub; a < (i + 1) * sub; ++a) {
+          const size_t n = u.size();
+          const double refined =
+              area(x[b * n + a], x[b * n + a + 1], x[(b + 1) * n + a + 1], x[(b + 1) * n + a]);
+          folded += (refined > 0.0) != (original > 0.0);
+        }
+      }
+    }
+  }
+  return folded;
+}
+
 // Control counts that fold the NACA 0012 113 x 33 C-grid at levels 1-2: no repair is tried
 // (that would change the counts), the fit fails naming the block, the levels and the cells,
 // unless allow_folds, which returns it with quality_met = false. Interpolation folds it too, and
@@ -90,6 +128,33 @@ TEST(FoldRepairTest, ACountFitThatFoldsIsRefusedUnlessAllowed) {
   EXPECT_EQ(q.folded_by_level[0] + q.folded_by_level[1] + q.folded_by_level[2], q.folded);
   EXPECT_GT(q.num_folded_cells, 0);
   EXPECT_LE(q.num_folded_cells, q.num_bad_cells);
+  // The independent count sees them too (levels 1-2; the data cells themselves do not fold).
+  EXPECT_GT(FoldedSubCells(grid.blocks[0], allowed->blocks[0].fitted, 2), 0);
+}
+
+// One absolute tolerance for every point of a C-grid (500 chords of far field) asks for a
+// control per datum over much of the grid, where split knots leave the fit free to swing
+// between its data: 16,000-29,000 folded sub-cells at 1e-3 on both NACA 0012 C-grids before the
+// repairs of step 3b (adaptive_engine.h). Now every point is within the tolerance, and no
+// sub-cell folds at levels 0..2, counted here.
+TEST(FoldRepairTest, OneToleranceOnACGridFitsWithoutFolds) {
+  const std::string path = SharedDataPath("grids/n0012_113-33.p2dfmt");
+  const MultiBlockGrid grid = ParsePlot3d(ReadFileToString(path).value(), path).value();
+  for (const double tolerance : {1e-2, 1e-3}) {
+    GridFitOptions options;
+    options.tolerance = tolerance;
+    const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
+    ASSERT_TRUE(fit.ok()) << tolerance << ": " << fit.status();
+    EXPECT_TRUE(fit->report.tolerance_met) << fit->report.unmet_reason;
+    BoundaryTolerances held;
+    held.wall = held.interface = held.outer = held.interior = tolerance;
+    ExpectTolerancesMet(grid, *fit, held);
+    EXPECT_LT(fit->report.num_control_points, grid.blocks[0].num_points());
+    for (int level = 0; level <= 2; ++level) {
+      EXPECT_EQ(FoldedSubCells(grid.blocks[0], fit->blocks[0].fitted, level), 0)
+          << "tolerance " << tolerance << ", level " << level;
+    }
+  }
 }
 
 }  // namespace

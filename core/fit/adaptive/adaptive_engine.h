@@ -17,6 +17,10 @@
 //     swings between its data; refinement.h SingleDatumRun), removing knots there and refining
 //     again under that bound; kept only if every tolerance holds and the folds decrease.
 //  3. Remove knots one at a time where the tolerances still hold and the quality is no worse.
+//  3b. Repair what still folds (with a quality check), each kept only if every tolerance holds
+//     and the folds decrease: (i) classes that reach a control per datum get averaged knots,
+//     the well-posed interpolation; (ii) without a fairing of the caller's, a jump penalty of
+//     weight 1e-12 .. 1e-6, which damps the swing the data leave free.
 //  4. Fair (optional): a fixed weight for every fit, or, to tolerance, the largest weight that
 //     keeps every tolerance and the quality no worse (a search over decades, then bisection on
 //     a log scale). A fit that sits at its tolerance leaves fairing no room, so to fair to
