@@ -140,6 +140,12 @@ std::string FormatKindDeviations(
   return out;
 }
 
+// A block's largest size change either way (grown or shrunk), as the report's summary line
+// gives it for the grid (convert.cc); the quality's max_ratio alone is growth only.
+double SizeRatio(const v1::CellQualityReport& q) {
+  return q.min_ratio() > 0.0 ? std::max(q.max_ratio(), 1.0 / q.min_ratio()) : q.max_ratio();
+}
+
 }  // namespace
 
 std::string FormatReport(const v1::FitReport& r) {
@@ -212,7 +218,7 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
                   s.num_points(), s.num_control_points(), s.compression_ratio(), s.max_deviation(),
                   Optional(k.has_wall(), k.wall()), Optional(k.has_interface(), k.interface()),
                   Optional(k.has_outer(), k.outer()), Optional(k.has_interior(), k.interior()),
-                  q.min_ratio(), q.max_ratio(), q.num_bad_cells(),
+                  q.min_ratio(), SizeRatio(q), q.num_bad_cells(),
                   s.has_tolerance_met() && !s.tolerance_met()
                       ? absl::StrCat("  TOLERANCE NOT MET: ", s.unmet_reason())
                       : ""));

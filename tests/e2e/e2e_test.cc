@@ -280,6 +280,14 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
                                                "<= 0.008 met, interior [0-9.e-]+ \\(no tolerance\\)"
                                                "(.|\n)*"));
   EXPECT_THAT(fit.out, HasSubstr("connectivity: 1 matches"));
+  // The block table's "max size" is the summary's largest size ratio (either way, shrunk cells
+  // too), not growth alone: one block, so the same figure.
+  const std::string summary = "largest size ratio ";
+  const size_t at = fit.out.find(summary);
+  ASSERT_NE(at, std::string::npos) << fit.out;
+  const std::string ratio =
+      fit.out.substr(at + summary.size(), fit.out.find('\n', at) - at - summary.size());
+  EXPECT_THAT(fit.out.substr(fit.out.find("\n     0 ")), HasSubstr(absl::StrCat(" ", ratio, " ")));
   const Result fair = Cli("fair coarse");
   ASSERT_EQ(fair.exit_code, 0) << fair.out;
   EXPECT_THAT(fair.out, HasSubstr("revision 2"));
