@@ -148,10 +148,12 @@ double SizeRatio(const v1::CellQualityReport& q) {
 
 }  // namespace
 
-std::string FormatReport(const v1::FitReport& r) {
+std::string FormatReport(const v1::FitReport& r, bool interpolating) {
   std::string out;
   if (!r.tolerances_given()) {
-    absl::StrAppend(&out, "  tolerances: none given (a fit to control counts)\n");
+    absl::StrAppend(&out, interpolating
+                              ? "  tolerances: none given (interpolating: a control per point)\n"
+                              : "  tolerances: none given (a fit to control counts)\n");
   } else {
     absl::StrAppend(&out,
                     absl::StrFormat("  tolerances: %s%s\n", r.tolerance_met() ? "met" : "NOT MET",
@@ -203,7 +205,7 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   absl::StrAppend(&out, "  deviation: ",
                   kinds.empty() ? absl::StrFormat("max %.3g", fit.max_deviation()) : kinds,
                   fit.report().tolerances_given() ? "" : " (no tolerance given)", "\n");
-  absl::StrAppend(&out, FormatReport(fit.report()));
+  absl::StrAppend(&out, FormatReport(fit.report(), fit.num_control_points() == fit.num_points()));
   absl::StrAppend(
       &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %8s %8s %6s\n", "block",
                             "points", "controls", "ratio", "max dev", "wall", "interface", "outer",

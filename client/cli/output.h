@@ -44,8 +44,9 @@ std::string FormatDeformReport(const v1::DeformReport& report);
 // One line of `splinegrid watch`: "revision 3 origin DEFORM parent 1 time 0.02 step 2 ...".
 std::string FormatRevisionLine(const v1::RevisionInfo& revision);
 
-// The fit report's grid-wide lines (tolerances, quality, connectivity, fairing, curvature).
-std::string FormatReport(const v1::FitReport& report);
+// The fit report's grid-wide lines (tolerances, quality, connectivity, fairing, curvature);
+// `interpolating`: a control point per grid point (said when no tolerance was given).
+std::string FormatReport(const v1::FitReport& report, bool interpolating);
 
 // Wall curvature metrics, and where the samples were written (if anywhere).
 std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureResponse& curvature,

@@ -231,7 +231,7 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Never a folded grid unless asked for: the tolerance mode has already tried to repair the
-  // folds (adaptive_engine.h, steps 2 and 2b); a fit to control counts cannot be repaired
+  // folds (adaptive_engine.h, steps 2, 2b and 3b); a fit to control counts cannot be repaired
   // without changing the counts it was given, which would be a silent change.
   if (!options.allow_folds) {
     std::vector<std::string> folds;

@@ -172,6 +172,12 @@ TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
   // These counts fold sub-cells (issue 13.3): stored with --allow_folds, exit 3 says so.
   ASSERT_EQ(fit.exit_code, 3) << fit.out;
   EXPECT_THAT(fit.out, HasSubstr("grids/naca revision 1: 3729 points -> 640 control points"));
+  EXPECT_THAT(fit.out, HasSubstr("tolerances: none given (a fit to control counts)"));
+  // Neither counts nor tolerances: an interpolating fit, and the report says so.
+  const Result box =
+      Cli(absl::StrCat("fit ", SharedDataPath("surfaces/ffd_box_6x2x6.fmt"), " --name=box"));
+  ASSERT_EQ(box.exit_code, 0) << box.out;
+  EXPECT_THAT(box.out, HasSubstr("tolerances: none given (interpolating: a control per point)"));
 
   const Result tol = Cli(absl::StrCat("fit ", SharedDataPath("grids/rae2822_257x97.fmt"),
                                       " --name=rae --tol=1e-3 --json"));
