@@ -13,6 +13,7 @@
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/multiblock_checks.h"
+#include "tests/core/quadrilateral_checks.h"
 #include "tests/core/test_data.h"
 
 namespace splinegrid {
@@ -55,40 +56,19 @@ TEST(FoldRepairTest, BreakingRunsBoundsThemAndOnlyRemovesKnotsOnRuns) {
   EXPECT_EQ(BreakSingleDatumRuns(u, knots, 6), knots);
 }
 
-// Sub-cells of a 2D fitted block at refinement level `level` whose signed area has the other
-// sign than their original cell's (the shoelace area of the data cell), counted here by
-// evaluating the spline point by point, not by the fit's own quality check.
+// Folded sub-cells (quadrilateral_checks.h) of a 2D fitted block at refinement level `level`,
+// its spline evaluated point by point here, not by the fit's own quality check.
 int64_t FoldedSubCells(const StructuredBlock& data, const FittedBlock& fitted, int level) {
-  const int ni = data.extent(0), nj = data.extent(1);
-  const std::vector<double> u = fitted.distribution.Refined(0, 0, ni - 1, level);
-  const std::vector<double> v = fitted.distribution.Refined(1, 0, nj - 1, level);
-  std::vector<Point3> x(u.size() * v.size());
+  const std::vector<double> u = fitted.distribution.Refined(0, 0, data.extent(0) - 1, level);
+  const std::vector<double> v = fitted.distribution.Refined(1, 0, data.extent(1) - 1, level);
+  StructuredBlock fine({static_cast<int>(u.size()), static_cast<int>(v.size()), 1}, 2);
   for (size_t j = 0; j < v.size(); ++j) {
     for (size_t i = 0; i < u.size(); ++i) {
-      x[j * u.size() + i] = EvaluatePoint(fitted.spline, {u[i], v[j], 0.0});
+      const Point3 x = EvaluatePoint(fitted.spline, {u[i], v[j], 0.0});
+      std::copy_n(x.begin(), 2, fine.Point(static_cast<int>(i), static_cast<int>(j), 0));
     }
   }
-  // Twice the signed area of the quadrilateral abcd: the cross product of its diagonals.
-  const auto area = [](const auto& a, const auto& b, const auto& c, const auto& d) {
-    return (c[0] - a[0]) * (d[1] - b[1]) - (d[0] - b[0]) * (c[1] - a[1]);
-  };
-  const int sub = 1 << level;
-  int64_t folded = 0;
-  for (int j = 0; j + 1 < nj; ++j) {
-    for (int i = 0; i + 1 < ni; ++i) {
-      const double original = area(data.Point(i, j, 0), data.Point(i + 1, j, 0),
-                                   data.Point(i + 1, j + 1, 0), data.Point(i, j + 1, 0));
-      for (int b = j * sub; b < (j + 1) * sub; ++b) {
-        for (int a = i * sub; a < (i + 1) * sub; ++a) {
-          const size_t n = u.size();
-          const double refined =
-              area(x[b * n + a], x[b * n + a + 1], x[(b + 1) * n + a + 1], x[(b + 1) * n + a]);
-          folded += (refined > 0.0) != (original > 0.0);
-        }
-      }
-    }
-  }
-  return folded;
+  return FoldedSubCells(data, fine, level);
 }
 
 // Control counts that fold the NACA 0012 113 x 33 C-grid at levels 1-2: no repair is tried

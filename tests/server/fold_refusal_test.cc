@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/io/plot3d.h"
+#include "tests/core/quadrilateral_checks.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
@@ -19,15 +20,6 @@ using ::testing::HasSubstr;
 
 constexpr char kCGrid[] = "grids/n0012_225-65.p2dfmt";  // NACA 0012 C-grid, far field 500 c
 constexpr char kSmallCGrid[] = "grids/n0012_113-33.p2dfmt";
-
-// Signed area of the quadrilateral (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1) of a planar
-// block: half the cross product of its diagonals.
-double SignedArea(const StructuredBlock& b, int i, int j) {
-  auto x = [&](int a, int c, int d) { return b.coords()[2 * b.Index(a, c, 0) + d]; };
-  const double ax = x(i + 1, j + 1, 0) - x(i, j, 0), ay = x(i + 1, j + 1, 1) - x(i, j, 1);
-  const double bx = x(i, j + 1, 0) - x(i + 1, j, 0), by = x(i, j + 1, 1) - x(i + 1, j, 1);
-  return 0.5 * (ax * by - ay * bx);
-}
 
 // Folded sub-cells of revision `revision` of `name` at levels 0, 1, 2: sub-cells whose signed
 // area is not of the (nonzero) sign of the original cell they lie in.
@@ -45,15 +37,7 @@ std::vector<int64_t> IndependentFolds(client::Client& client, const std::string&
     const StructuredBlock& fine = grid->blocks.at(0).points;
     EXPECT_EQ(fine.spatial_dim(), 2);
     EXPECT_EQ(fine.extent(0), ((original.extent(0) - 1) << level) + 1);
-    int64_t folded = 0;
-    for (int J = 0; J + 1 < fine.extent(1); ++J) {
-      for (int I = 0; I + 1 < fine.extent(0); ++I) {
-        const double parent = SignedArea(original, I >> level, J >> level);
-        if (parent == 0.0) continue;
-        if (SignedArea(fine, I, J) * parent <= 0.0) ++folded;
-      }
-    }
-    folds.push_back(folded);
+    folds.push_back(FoldedSubCells(original, fine, level));
   }
   return folds;
 }

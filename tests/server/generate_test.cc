@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/airfoil.h"
 #include "gmock/gmock.h"
+#include "tests/core/quadrilateral_checks.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
@@ -34,15 +35,6 @@ v1::GenerateGridRequest SmallRequest(const std::string& id) {
 
 std::string AirfoilText(const std::string& file) {
   return ReadFileToString(SharedDataPath("airfoils/" + file)).value();
-}
-
-// Twice the signed area of cell (i, j) of a 2D block (positive counter-clockwise in (i, j)).
-double CellArea(const StructuredBlock& g, int i, int j) {
-  const double* a = g.Point(i, j, 0);
-  const double* b = g.Point(i + 1, j, 0);
-  const double* c = g.Point(i + 1, j + 1, 0);
-  const double* d = g.Point(i, j + 1, 0);
-  return (c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]);
 }
 
 class GenerateTest : public ServiceTest {
