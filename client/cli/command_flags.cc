@@ -67,11 +67,13 @@ std::vector<CommandSpec> MakeCommands() {
        {"revision", "level", "block", "o"},
        {}},
       {"airfoil",
-       "airfoil FILE.dat [--tol 1e-4] [--fair tol|LAMBDA|off] [-o OUT.csv]",
+       "airfoil FILE.dat [--tol T] [--fair tol|LAMBDA|off] [-o OUT.csv]",
        "fit an airfoil's coordinates locally (no server); curvature CSV with -o",
        /*client=*/false,
        {"tol", "fair", "o"},
-       {"Local: the connection flags (--server, --json, TLS ...) are refused, not ignored."}},
+       {"The default --tol is 1e-4 of the profile's chord (its largest distance from the first "
+        "point), so a file in millimetres is fitted as one in chords.",
+        "Local: the connection flags (--server, --json, TLS ...) are refused, not ignored."}},
       {"get",
        "get NAME [--revision R | --step N] [--full]",
        "a grid's description (with --full its knots and control points)",
@@ -105,7 +107,7 @@ std::vector<CommandSpec> MakeCommands() {
         "check_level", "propagation", "decay_radius", "rigid_radius", "smoothing"},
        {"A fold is FAILED_PRECONDITION (exit 1), nothing stored."}},
       {"offset",
-       "offset FILE.dat|SURFACE [--name N] [--layers 128] [--first 1e-5] [--far 50] "
+       "offset FILE.dat|SURFACE [--name N] [--layers 128] [--first H] [--far D] "
        "[--points 257] [--method offsets|transfinite|elliptic] [--side outward|along|against] "
        "[--normal_smoothing 80] [--symmetry=false] [--tol T | --kinds ... | --ctl a,b,c] "
        "[-o OUT.{vts,vtm,x,xyz,cgns}]",

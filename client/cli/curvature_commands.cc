@@ -12,6 +12,7 @@
 #include "client/cli/output.h"
 #include "client/client.h"
 #include "core/fit/airfoil/airfoil_fit.h"
+#include "core/generate/profile_grid.h"
 #include "core/io/airfoil.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"
@@ -51,7 +52,11 @@ absl::Status Airfoil(const Args& args) {
   }
   SG_ASSIGN_OR_RETURN(const AirfoilCoordinates coordinates, ReadAirfoilFile(args[0]));
   AirfoilFitOptions options;
-  if (absl::GetFlag(FLAGS_tol) != 0.0) options.tolerance = absl::GetFlag(FLAGS_tol);
+  // The default is a fraction of the chord, as GenerateGrid's: a file in millimetres is fitted
+  // as one in chords.
+  options.tolerance = absl::GetFlag(FLAGS_tol) != 0.0
+                          ? absl::GetFlag(FLAGS_tol)
+                          : kDefaultProfileFitTolerance * ProfileChord(coordinates.points);
   const std::string fair = absl::GetFlag(FLAGS_fair);
   if (fair == "off") {
     options.fairing.mode = FairingMode::kOff;

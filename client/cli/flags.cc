@@ -122,10 +122,11 @@ ABSL_FLAG(int, smoothing, 0, "deform: Laplacian smoothing sweeps of the interior
 ABSL_FLAG(std::optional<int>, layers, std::nullopt,
           "offset: cells outward from the wall (default: the server's, 128; a surface 32)");
 ABSL_FLAG(std::optional<double>, first, std::nullopt,
-          "offset: height of the first layer, in the profile's unit (default 1e-5; a surface "
-          "1e-3)");
+          "offset: height of the first layer, in the profile's unit (default 1e-5 of the "
+          "profile's chord; a surface 1e-3)");
 ABSL_FLAG(std::optional<double>, far, std::nullopt,
-          "offset: distance of the outermost layer from the wall (default 50; a surface 0.5)");
+          "offset: distance of the outermost layer from the wall (default 50 chords of the "
+          "profile; a surface 0.5)");
 ABSL_FLAG(std::optional<int>, points, std::nullopt,
           "offset: wall points around the profile, the first repeated as the last (default 257)");
 ABSL_FLAG(std::string, method, "",

@@ -57,8 +57,8 @@ absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& req
 
 absl::Status Offset(const Args& args) {
   constexpr char kUsage[] =
-      "usage: splinegrid offset FILE.dat|SURFACE [--name N] [--layers 128] [--first 1e-5] "
-      "[--far 50] [--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
+      "usage: splinegrid offset FILE.dat|SURFACE [--name N] [--layers 128] [--first H] "
+      "[--far D] [--points 257] [--method offsets|transfinite|elliptic] [--orthogonalize=false] "
       "[--profile_tol T] [--side outward|along|against] [--normal_smoothing 80] "
       "[--symmetry=false] "
       "[--tol T | --kinds [--wall W ...] | --ctl a,b,c] [-o OUT.{vts,vtm,x,xyz,cgns}]";

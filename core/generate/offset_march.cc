@@ -245,8 +245,9 @@ void ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool
 }  // namespace
 
 absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
-  if (layers < 1 || layers > 100000) {
-    return absl::InvalidArgumentError(absl::StrCat("layers = ", layers, " is outside [1, 100000]"));
+  if (layers < 1 || layers > kMaxLayers) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("layers = ", layers, " is outside [1, ", kMaxLayers, "]"));
   }
   if (!(first_height > 0.0) || !std::isfinite(first_height)) {
     return absl::InvalidArgumentError(

@@ -57,7 +57,7 @@ struct OffsetOptions {
   // The largest h' kappa left on a layer's concave parts before the next step h' (concave_fill.h),
   // in (0, 1): a concave part shrinks by 1 - h' kappa in that step.
   double max_concave_turning = 0.1;
-  int max_retries = 60;             // normal smoothing rounds for one layer before giving up
+  int max_retries = 60;  // normal smoothing rounds for one layer before giving up
   CancelCheck cancel;
 
   absl::Status Validate() const;
@@ -76,7 +76,10 @@ struct OffsetGrid {
 // message names the layer); CANCELLED.
 absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOptions& options);
 
-// OK for a stack of 1 .. 100000 layers growing from first_height to add up to distance (both
+// The most layers a stack may have.
+inline constexpr int kMaxLayers = 100000;
+
+// OK for a stack of 1 .. kMaxLayers layers growing from first_height to add up to distance (both
 // positive, finite, distance >= layers * first_height); INVALID_ARGUMENT naming the field.
 absl::Status ValidateLayerStack(int layers, double first_height, double distance);
 

@@ -114,7 +114,18 @@ absl::Status ProfileGridOptions::Validate() const {
   if (wall_points < 9) {
     return absl::InvalidArgumentError(absl::StrCat("wall_points = ", wall_points, " is below 9"));
   }
-  SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
+  if (first_height && distance) {
+    SG_RETURN_IF_ERROR(ValidateLayerStack(layers, *first_height, *distance));
+  } else {
+    // The stack (distance >= layers x first_height) is checked once the unset length is known
+    // from the profile's chord (GenerateProfileGrid).
+    if (layers < 1 || layers > kMaxLayers) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("layers = ", layers, " is outside [1, ", kMaxLayers, "]"));
+    }
+    if (first_height) SG_RETURN_IF_ERROR(CheckFinitePositive(*first_height, "first_height"));
+    if (distance) SG_RETURN_IF_ERROR(CheckFinitePositive(*distance, "distance"));
+  }
   if (static_cast<int64_t>(wall_points) * (layers + 1) > kMaxProfileGridPoints) {
     return absl::InvalidArgumentError(absl::StrCat(
         "wall_points * (layers + 1) = ", static_cast<int64_t>(wall_points) * (layers + 1),
@@ -215,6 +226,14 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
         ": ", out.profile.unmet_reason));
   }
   out.fit_seconds = SecondsSince(start);
+  out.first_height = options.first_height.value_or(kDefaultFirstHeight * chord);
+  out.distance = options.distance.value_or(kDefaultFarDistance * chord);
+  if (const absl::Status stack = ValidateLayerStack(options.layers, out.first_height, out.distance);
+      !stack.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(stack.message(), " (unset lengths default to ", kDefaultFirstHeight, " and ",
+                     kDefaultFarDistance, " of the profile's chord, ", chord, ")"));
+  }
 
   start = std::chrono::steady_clock::now();
   Profile profile;
@@ -230,8 +249,8 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
   if (options.method == LayerMethod::kOffsets) {
     OffsetOptions offsets;
     offsets.layers = options.layers;
-    offsets.first_height = options.first_height;
-    offsets.distance = options.distance;
+    offsets.first_height = out.first_height;
+    offsets.distance = out.distance;
     offsets.cancel = options.cancel;
     SG_ASSIGN_OR_RETURN(OffsetGrid grid, MarchOffsets(out.wall, offsets));
     out.block = std::move(grid.block);
@@ -240,8 +259,8 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
   } else {
     CompletionOptions completion;
     completion.layers = options.layers;
-    completion.first_height = options.first_height;
-    completion.distance = options.distance;
+    completion.first_height = out.first_height;
+    completion.distance = out.distance;
     completion.orthogonalize = options.orthogonalize;
     completion.orthogonal_reach = kOrthogonalReach * chord;
     const bool elliptic = options.method == LayerMethod::kElliptic;
@@ -266,7 +285,7 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
       out.fine_seconds = smoothed.fine.seconds;
       out.elliptic_converged = smoothed.fine.converged;
     }
-    out.growth_ratio = GeometricRatio(options.first_height, options.distance, options.layers);
+    out.growth_ratio = GeometricRatio(out.first_height, out.distance, options.layers);
   }
   out.layer_seconds = SecondsSince(start);
 

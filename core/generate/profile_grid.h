@@ -45,8 +45,12 @@ std::string_view LayerMethodName(LayerMethod method);
 // The most points a generated grid may have (2^24: 256 MiB of coordinates).
 inline constexpr int64_t kMaxProfileGridPoints = int64_t{1} << 24;
 
-// The default fit tolerance of a profile, as a fraction of its chord.
+// The defaults of a profile's grid that are lengths, as fractions of its chord (ProfileChord),
+// so that a file in millimetres gets the grid a file in chords gets, scaled: the fit tolerance,
+// the first layer's height and the outer boundary's distance from the wall.
 inline constexpr double kDefaultProfileFitTolerance = 1e-4;
+inline constexpr double kDefaultFirstHeight = 1e-5;
+inline constexpr double kDefaultFarDistance = 50.0;
 
 // The lengths of the completion and of elliptic smoothing, as fractions of the profile's chord
 // (so that a profile in millimetres gets the grid it gets in chords, scaled): how far the
@@ -66,11 +70,13 @@ double ProfileChord(const StructuredBlock& coordinates);
 
 struct ProfileGridOptions {
   LayerMethod method = LayerMethod::kOffsets;
-  int wall_points = 257;       // points around the loop, the first repeated as the last, >= 9
-  int layers = 128;            // cells across, >= 1 (the grid has layers + 1 lines)
-  double first_height = 1e-5;  // of the first layer, in the profile's unit (chords)
-  double distance = 50.0;      // of the outermost layer from the wall
-  bool orthogonalize = true;   // kTransfinite, kElliptic: lines leave the wall along its normals
+  int wall_points = 257;  // points around the loop, the first repeated as the last, >= 9
+  int layers = 128;       // cells across, >= 1 (the grid has layers + 1 lines)
+  // Of the first layer and of the outermost layer from the wall, in the profile's unit; unset:
+  // kDefaultFirstHeight and kDefaultFarDistance of the profile's chord.
+  std::optional<double> first_height;
+  std::optional<double> distance;
+  bool orthogonalize = true;  // kTransfinite, kElliptic: lines leave the wall along its normals
   // Of the profile spline to the coordinates (AirfoilFitOptions), in their unit; unset:
   // kDefaultProfileFitTolerance of the profile's chord (ProfileChord), so that a file in
   // millimetres is fitted as one in chords.
@@ -104,6 +110,8 @@ struct ProfileGrid {
   StructuredBlock block;     // wall_points x (layers + 1), spatial_dim 2
   AirfoilFit profile;        // the fitted outline
   double fit_tolerance = 0;  // the tolerance it was fitted to (options' or the default)
+  double first_height = 0;   // the layer stack built (options' or the defaults)
+  double distance = 0;
   WallLoop wall;             // its distributed loop (block's j = 0, maybe reversed: offset_march.h)
   std::vector<int> corners;  // the wall's corners as i indices of `block`
   double growth_ratio = 1.0;

@@ -69,8 +69,8 @@ void EncodeProfileGridOptions(const ProfileGridOptions& options, v1::GenerateGri
   }
   out->set_wall_points(options.wall_points);
   out->set_layers(options.layers);
-  out->set_first_height(options.first_height);
-  out->set_distance(options.distance);
+  if (options.first_height) out->set_first_height(*options.first_height);
+  if (options.distance) out->set_distance(*options.distance);
   out->set_orthogonalize(options.orthogonalize);
   if (options.fit_tolerance) out->set_fit_tolerance(*options.fit_tolerance);
 }

@@ -134,7 +134,10 @@ absl::StatusOr<GenerateResult> Generate(const OpsContext& context, GenerateReque
   SG_ASSIGN_OR_RETURN(result.grid, StoreGenerated(context, header, profile.name, std::move(source),
                                                   std::move(generated_grid), fit_options, cancel));
   result.options = request.options;
-  result.options.fit_tolerance = result.generated.fit_tolerance;  // the default resolved
+  // The defaults resolved (fractions of the profile's chord).
+  result.options.fit_tolerance = result.generated.fit_tolerance;
+  result.options.first_height = result.generated.first_height;
+  result.options.distance = result.generated.distance;
   result.options.cancel = {};
   result.profile_name = std::move(profile.name);
   result.profile_points = profile.points.num_points();

@@ -69,11 +69,12 @@ double WallOrthogonalityDegrees(const StructuredBlock& g, const std::vector<int>
 }
 
 // The 30P30N elements in the source's units (the main element's chord is about 830), each
-// alone, at 257 and 513 wall points, by each method: first layer 1e-5 chord, far field 50
-// chords, the default fit tolerance (1e-4 chord). Before the curvature reduction the offsets
-// folded in the slat's cove at layer 46 and in the main element's flap cove at layer 66
-// (FAILED_PRECONDITION); before the completion from an offset layer (cove_completion.h) the
-// transfinite grids of the slat and the main element had 163 and 384 folded cells, and their
+// alone, at 257 and 513 wall points, by each method, with the default lengths: first layer
+// 1e-5 chord, far field 50 chords, fit tolerance 1e-4 chord. (The first two were absolute,
+// 1e-5 and 50 in the file's unit, which folded the slat's interpolated grid.) Before the curvature
+// reduction the offsets folded in the slat's cove at layer 46 and in the main element's flap cove
+// at layer 66 (FAILED_PRECONDITION); before the completion from an offset layer (cove_completion.h)
+// the transfinite grids of the slat and the main element had 163 and 384 folded cells, and their
 // elliptic grids diverged or kept folds.
 class CoveProfileTest : public ::testing::TestWithParam<std::tuple<std::string, int, LayerMethod>> {
 };
@@ -85,10 +86,11 @@ TEST_P(CoveProfileTest, GridsNeitherFoldNorLeaveTheWallAskew) {
   ProfileGridOptions options;
   options.method = method;
   options.wall_points = wall_points;
-  options.first_height = 1e-5 * chord;
-  options.distance = 50.0 * chord;
   const auto grid = GenerateProfileGrid(points, options);
   ASSERT_TRUE(grid.ok()) << grid.status();
+  const double first_height = grid->first_height, distance = grid->distance;
+  EXPECT_NEAR(first_height, 1e-5 * chord, 1e-12 * first_height);
+  EXPECT_NEAR(distance, 50.0 * chord, 1e-12 * distance);
   const StructuredBlock& g = grid->block;
   ASSERT_EQ(g.extent(0), wall_points);
   ASSERT_EQ(g.extent(1), options.layers + 1);
@@ -106,8 +108,8 @@ TEST_P(CoveProfileTest, GridsNeitherFoldNorLeaveTheWallAskew) {
     first_min = std::min(first_min, h);
     first_max = std::max(first_max, h);
   }
-  EXPECT_NEAR(first_min, options.first_height, 0.05 * options.first_height);
-  EXPECT_NEAR(first_max, options.first_height, 0.05 * options.first_height);
+  EXPECT_NEAR(first_min, first_height, 0.05 * first_height);
+  EXPECT_NEAR(first_max, first_height, 0.05 * first_height);
   // Transfinite lines fan out over the 4 points beside a blunt corner (transfinite.cc).
   const int skip = method == LayerMethod::kOffsets ? 2 : 4;
   EXPECT_LE(WallOrthogonalityDegrees(g, grid->corners, skip), 5.0);
@@ -120,8 +122,8 @@ TEST_P(CoveProfileTest, GridsNeitherFoldNorLeaveTheWallAskew) {
     for (int w = 0; w < wall_points; ++w) {
       nearest = std::min(nearest, std::hypot(o[0] - At(g, w, 0)[0], o[1] - At(g, w, 0)[1]));
     }
-    EXPECT_GE(nearest, 0.999 * options.distance) << i;
-    EXPECT_LE(nearest, options.distance + chord) << i;
+    EXPECT_GE(nearest, 0.999 * distance) << i;
+    EXPECT_LE(nearest, distance + chord) << i;
   }
 }
 
@@ -136,9 +138,10 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 // A profile in millimetres gets the grid it gets in chords, scaled: the lengths of the completion
-// and of the elliptic smoothing (kOrthogonalReach, kHeldBoundaryLayer) are fractions of the
-// chord. (They were absolute lengths, right for unit chords only: the flap in its own units,
-// chord 300, got 164 folded cells from lines that bent off straight by only 0.2 units.)
+// and of the elliptic smoothing (kOrthogonalReach, kHeldBoundaryLayer) and the default layer
+// stack are fractions of the chord. (They were absolute lengths, right for unit chords only: the
+// flap in its own units, chord 300, got 164 folded cells from lines that bent off straight by only
+// 0.2 units.)
 TEST(CoveProfileUnitsTest, TheAlgebraicGridsScaleWithTheProfile) {
   const StructuredBlock flap = Coordinates("airfoils/30p30n/30p30n_flap.dat");
   const double chord = ProfileChord(flap);
@@ -149,8 +152,6 @@ TEST(CoveProfileUnitsTest, TheAlgebraicGridsScaleWithTheProfile) {
     ProfileGridOptions options;
     options.method = method;
     const ProfileGrid in_chords = GenerateProfileGrid(unit, options).value();
-    options.first_height *= chord;
-    options.distance *= chord;
     const ProfileGrid in_units = GenerateProfileGrid(flap, options).value();
     ASSERT_EQ(in_units.block.num_points(), in_chords.block.num_points());
     double largest = 0.0;
@@ -246,8 +247,8 @@ TEST(ProfileFitToleranceTest, TheDefaultScalesWithTheChord) {
   options.first_height = 1e-3;
   options.distance = 1.0;
   const ProfileGrid chords = GenerateProfileGrid(naca, options).value();
-  options.first_height *= 1000.0;
-  options.distance *= 1000.0;
+  options.first_height = 1.0;
+  options.distance = 1000.0;
   const ProfileGrid mm = GenerateProfileGrid(millimetres, options).value();
   EXPECT_NEAR(chords.fit_tolerance, 1e-4 * ProfileChord(naca), 1e-15);
   EXPECT_NEAR(mm.fit_tolerance, 1000.0 * chords.fit_tolerance, 1e-12);

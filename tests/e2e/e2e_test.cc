@@ -428,6 +428,22 @@ TEST_F(EndToEndTest, CliGeneratesAnOGridAroundAnAirfoilAndWritesIt) {
 }
 
 // The command: a volume grid off the stored M6 wing surface, written as multi-block
+
+// A profile in its source's units (the 30P30N slat, chord 153) with no length given: the
+// defaults are fractions of the chord (first layer 1e-5, far field 50 chords, fit tolerance
+// 1e-4), so it gets the grid a file in chords gets. With the first two absolute (1e-5 and 50
+// in the file's unit) the interpolated grid folded 175 sub-cells and was refused; with the
+// airfoil command's absolute 1e-4 the fit failed (178 control points for 211 points).
+TEST_F(EndToEndTest, CliDefaultLengthsScaleWithTheProfile) {
+  const std::string slat = SharedDataPath("airfoils/30p30n/30p30n_slat.dat");
+  const Result offset = Cli(absl::StrCat("offset ", slat, " --name=slat --layers=64"));
+  ASSERT_EQ(offset.exit_code, 0) << offset.out;
+  EXPECT_THAT(offset.out, HasSubstr("first height 0.00153, distance 7634"));
+  EXPECT_THAT(offset.out, HasSubstr("levels 0-2: 0 folded sub-cells"));
+  const Result fit = Cli(absl::StrCat("airfoil ", slat));
+  ASSERT_EQ(fit.exit_code, 0) << fit.out;
+  EXPECT_THAT(fit.out, HasSubstr("(within 0.0153)"));
+}
 // Plot3D; its hexahedra are checked here.
 TEST_F(EndToEndTest, CliMarchesAVolumeGridOffAStoredSurface) {
   const Result fit =
