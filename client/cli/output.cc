@@ -255,6 +255,19 @@ std::string FormatGenerate(const v1::GenerateGridResponse& response) {
                                           "would cross in a cove)\n",
                                           r.marched_layers()));
   }
+  if (r.has_elliptic()) {
+    const v1::EllipticReport& e = r.elliptic();
+    absl::StrAppend(
+        &out, absl::StrFormat(
+                  "  elliptic: %s, coarse level %d sweeps (%.1f ms), fine level %d "
+                  "sweeps (%.1f ms), relaxation %.3g, %d restarts%s\n",
+                  e.converged() ? "converged" : "NOT converged", e.coarse_sweeps(),
+                  1e3 * e.coarse_seconds(), e.fine_sweeps(), 1e3 * e.fine_seconds(), e.relaxation(),
+                  e.restarts(),
+                  e.converged() ? ""
+                                : " (the grid has no negative cell but does not "
+                                  "solve the equations: try fewer layers or the offsets method)"));
+  }
   absl::StrAppend(
       &out,
       absl::StrFormat("  quality: %d negative cells (min area %.3g), first layer %.4g .. %.4g, "

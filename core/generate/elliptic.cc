@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -37,6 +38,18 @@ constexpr int kMaxLevels = 2;
 // with a 1e-3 first layer and only the wall held) and the rest is relaxation alone from the
 // initial grid, which converges there.
 constexpr int kStallCycles = 20;
+// Over-relaxation (omega 1.3) can keep points by a sharp trailing edge's seam from settling: on
+// the RAE 2822 with 320 or more layers they jumped by 10-1000 times their spacing for 20,000
+// sweeps on both levels (277 s at 512 layers, never converged), where omega 1 converges in
+// 700-850 coarse sweeps. So when the largest move has not fallen to a new low for
+// kStallSweeps sweeps (kStallCycles cycles), or a move is not finite, the iteration starts again
+// from the initial grid with omega times kRelaxationBackoff, down to kMinRelaxation; a stall
+// there ends it, not converged (the 30P30N slat at 256 layers: points in the cove collapse at any
+// omega; it went on for 20,000 sweeps, 74 s). A converging run makes a new low nearly every
+// sweep (the slow far-field mode too).
+constexpr int kStallSweeps = 50;
+constexpr double kRelaxationBackoff = 0.75;
+constexpr double kMinRelaxation = 0.5;
 
 // B(z) = z / (e^z - 1), B(0) = 1: the weights of the exponentially fitted (Allen-Southwell,
 // Il'in) difference of x'' + c x': B(c) x_{i-1} + B(-c) x_{i+1} - (B(c) + B(-c)) x_i, exact
@@ -182,6 +195,9 @@ class LineRelaxation {
         omega_(omega),
         weights_(FittedWeights(control, g.num_points())) {}
 
+  double omega() const { return omega_; }
+  void set_omega(double omega) { omega_ = omega; }
+
   // Unknowns j = first .. nj - 2 per line of constant i.
   int rows() const { return rows_; }
 
@@ -309,7 +325,7 @@ class LineRelaxation {
   const int first_;  // the first unknown layer
   const int rows_;   // unknowns j = first .. nj - 2
   const int cols_;   // unknowns i = 0 .. ni - 2 (periodic)
-  const double omega_;
+  double omega_;
   const std::vector<double> weights_;
   std::vector<double> source_;
   LineSystem line_;
@@ -393,6 +409,40 @@ ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
   return c;
 }
 
+namespace {
+
+// Watches the largest move of successive sweeps (or cycles): stalled once it has not fallen to
+// a new low for `patience` of them.
+class StallWatch {
+ public:
+  explicit StallWatch(int patience) : patience_(patience) {}
+
+  bool Stalled(double largest) {
+    ++steps_;
+    if (largest < lowest_) {
+      lowest_ = largest;
+      lowest_step_ = steps_;
+    }
+    return steps_ - lowest_step_ >= patience_;
+  }
+
+  void Reset() { *this = StallWatch(patience_); }
+
+ private:
+  int patience_;
+  int steps_ = 0, lowest_step_ = 0;
+  double lowest_ = std::numeric_limits<double>::infinity();
+};
+
+// The next, smaller omega after a stall, or nullopt below kMinRelaxation.
+std::optional<double> BackedOff(double omega) {
+  const double next = omega * kRelaxationBackoff;
+  if (next < kMinRelaxation) return std::nullopt;
+  return next;
+}
+
+}  // namespace
+
 absl::Status EllipticOptions::Validate() const {
   if (max_sweeps < 0) {
     return absl::InvalidArgumentError(absl::StrCat("max_sweeps = ", max_sweeps, " is negative"));
@@ -424,19 +474,30 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
   result.grid = initial;
   const int first = std::clamp(held_layers, 1, nj - 1);
   LineRelaxation relaxation(result.grid, control, first, options.relaxation);
+  StallWatch watch(kStallSweeps);
   for (result.sweeps = 0; result.sweeps < options.max_sweeps && relaxation.rows() > 0;) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     ++result.sweeps;
     const double largest = relaxation.Sweep();
-    if (!std::isfinite(largest)) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("elliptic smoothing diverged in sweep ", result.sweeps));
-    }
     if (largest < options.tolerance) {
       result.converged = true;
       break;
     }
+    if (!std::isfinite(largest) || watch.Stalled(largest)) {
+      const std::optional<double> damped = BackedOff(relaxation.omega());
+      if (!damped) {
+        if (std::isfinite(largest)) break;  // no better: reported as not converged
+        return absl::FailedPreconditionError(absl::StrCat("elliptic smoothing diverged in sweep ",
+                                                          result.sweeps, " (relaxation factor ",
+                                                          relaxation.omega(), ")"));
+      }
+      relaxation.set_omega(*damped);
+      std::copy(initial.coords().begin(), initial.coords().end(), result.grid.coords().begin());
+      watch.Reset();
+      ++result.restarts;
+    }
   }
+  result.relaxation = relaxation.omega();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -475,22 +536,22 @@ class Multigrid {
   Multigrid(std::vector<std::unique_ptr<Level>> levels, const EllipticOptions& options)
       : levels_(std::move(levels)), options_(options) {}
 
-  // One sweep of level l; true once it moved no point by the tolerance.
-  absl::StatusOr<bool> Sweep(int l) {
+  // One sweep of level l: its largest move (LineRelaxation::Sweep).
+  double Sweep(int l) {
     Level& level = *levels_[l];
     ++level.sweeps;
-    const double largest = level.relax.Sweep();
-    if (!std::isfinite(largest)) {
-      return absl::FailedPreconditionError(
-          absl::StrCat("elliptic smoothing diverged in sweep ", level.sweeps, " of level ", l));
-    }
-    return largest < options_.tolerance;
+    return level.relax.Sweep();
+  }
+
+  double omega() const { return levels_[0]->relax.omega(); }
+  void set_omega(double omega) {
+    for (auto& level : levels_) level->relax.set_omega(omega);
   }
 
   // The coarse-level correction of level l - 1 by level l, the coarsest (file comment): its
   // problem from level l - 1's residual, solved by sweeps, and the correction interpolated onto
   // level l - 1's free points.
-  absl::Status Correct(int l) {
+  void Correct(int l) {
     Level& fine = *levels_[l - 1];
     Level& coarse = *levels_[l];
     const int ni = fine.grid.extent(0), nj = fine.grid.extent(1);
@@ -511,8 +572,9 @@ class Multigrid {
     }
     coarse.relax.SetSource(std::move(source));
     for (int k = 0; k < kCoarsestSweeps; ++k) {
-      SG_ASSIGN_OR_RETURN(const bool still, Sweep(l));
-      if (still) break;
+      const double largest = Sweep(l);
+      // Settled, or diverged: a move that is not finite reaches the fine level's next sweep.
+      if (!(largest >= options_.tolerance) || !std::isfinite(largest)) break;
     }
     // The correction, bilinear in index space (periodic in i), on the free points.
     auto correction = [&](int I, int J) -> Vec {
@@ -531,7 +593,6 @@ class Multigrid {
         if (i == 0) std::copy_n(x, 2, fine.grid.Point(ni - 1, j, 0));
       }
     }
-    return absl::OkStatus();
   }
 
   Level& level(int l) { return *levels_[l]; }
@@ -580,30 +641,47 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
   Multigrid multigrid(std::move(levels), options);
   EllipticResult result;
   Level& fine = multigrid.level(0);
-  // The largest move of the cycles' fine sweeps, and the cycle it last fell to a new low.
-  double lowest = std::numeric_limits<double>::infinity();
-  int cycle = 0, lowest_cycle = 0;
   bool cycling = multigrid.num_levels() > 1;
+  StallWatch watch(cycling ? kStallCycles : kStallSweeps);
   while (fine.sweeps < options.max_sweeps && fine.relax.rows() > 0) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
-    SG_ASSIGN_OR_RETURN(result.converged, multigrid.Sweep(0));
-    if (result.converged || fine.sweeps >= options.max_sweeps) break;
-    if (!cycling) continue;
-    SG_RETURN_IF_ERROR(multigrid.Correct(1));
-    SG_ASSIGN_OR_RETURN(result.converged, multigrid.Sweep(0));
-    if (result.converged) break;
-    ++cycle;
-    if (fine.relax.largest() < lowest) {
-      lowest = fine.relax.largest();
-      lowest_cycle = cycle;
-    } else if (cycle - lowest_cycle >= kStallCycles) {
-      // Stalled: relaxation alone, from the initial grid (the stalled iterate can be a worse
-      // start than that), within the same sweep budget.
+    double largest = multigrid.Sweep(0);
+    if (largest < options.tolerance) {
+      result.converged = true;
+      break;
+    }
+    if (fine.sweeps >= options.max_sweeps) break;
+    if (cycling && std::isfinite(largest)) {
+      multigrid.Correct(1);
+      largest = multigrid.Sweep(0);
+      if (largest < options.tolerance) {
+        result.converged = true;
+        break;
+      }
+    }
+    if (std::isfinite(largest) && !watch.Stalled(largest)) continue;
+    // Stalled or diverged: start again from the initial grid (the iterate can be a worse start
+    // than that), within the same sweep budget: cycles by relaxation alone (the cycles' fixed
+    // point can be another solution of the equations than relaxation's: RAE 2822 65 x 33 with
+    // only the wall held), then with a smaller omega while it can be lowered.
+    if (cycling) {
       cycling = false;
       result.stalled = true;
-      std::copy(initial.coords().begin(), initial.coords().end(), fine.grid.coords().begin());
+      watch = StallWatch(kStallSweeps);
+    } else if (const std::optional<double> damped = BackedOff(multigrid.omega())) {
+      multigrid.set_omega(*damped);
+    } else if (std::isfinite(largest)) {
+      break;  // no better: reported as not converged
+    } else {
+      return absl::FailedPreconditionError(
+          absl::StrCat("elliptic smoothing diverged in sweep ", fine.sweeps,
+                       " (relaxation factor ", multigrid.omega(), ")"));
     }
+    std::copy(initial.coords().begin(), initial.coords().end(), fine.grid.coords().begin());
+    watch.Reset();
+    ++result.restarts;
   }
+  result.relaxation = multigrid.omega();
   result.sweeps = fine.sweeps;
   for (int l = 1; l < multigrid.num_levels(); ++l) {
     result.coarse_work += multigrid.level(l).sweeps / std::pow(4.0, l);
@@ -660,7 +738,11 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
       std::copy(from, from + 2, guess.Point(i, j, 0));  // periodic: the last line is the first
     }
   }
-  SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, algebraic, out.held_layers, options));
+  // The fine level starts from the omega the coarse level ended with: one that had to be
+  // lowered there would stall the fine cycles too.
+  EllipticOptions fine_options = options;
+  fine_options.relaxation = out.coarse.relaxation;
+  SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, algebraic, out.held_layers, fine_options));
   if (compare) {
     SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,
                         SmoothElliptic(algebraic, TrackingControls(algebraic, out.held_layers - 1),

@@ -28,7 +28,10 @@
 // Solver: alternating line relaxation, every line of constant i solved at once (tridiagonal in
 // j: the flat cells near the wall couple strongly in j) then every line of constant j (cyclic
 // tridiagonal in i: the long far-field cells couple in i), each relaxed by omega, until no point
-// moves by more than `tolerance` times its smallest neighbouring spacing in a sweep.
+// moves by more than `tolerance` times its smallest neighbouring spacing in a sweep. Should the
+// largest move stop falling (over-relaxation can keep the points by a sharp trailing edge
+// jumping) or stop being finite, the iteration starts again from the initial grid with omega
+// lowered (elliptic.cc kStallSweeps).
 //
 // Coarse to fine: the coarse grid takes every second point and layer of the algebraic grid; it
 // is smoothed from there, interpolated by a B-spline surface (tensor_fit.h) and
@@ -76,7 +79,7 @@ struct EllipticOptions {
   // Converged when no point moves by more than this fraction of its smallest neighbouring
   // spacing in a sweep.
   double tolerance = 1e-3;
-  double relaxation = 1.3;  // omega, in (0, 2)
+  double relaxation = 1.3;  // omega, in (0, 2); lowered after a stall (file comment)
   CancelCheck cancel;
 
   absl::Status Validate() const;
@@ -90,12 +93,17 @@ struct EllipticResult {
   int levels = 1;
   double coarse_work = 0.0;
   bool stalled = false;  // the cycles stopped helping, and relaxation alone went on
+  // Starts from the initial grid after a stall or a move that was not finite, and the
+  // relaxation factor omega at the end (the options' unless lowered: elliptic.cc).
+  int restarts = 0;
+  double relaxation = 0.0;
   bool converged = false;
   double seconds = 0.0;
 };
 
 // Smooths `initial` with `control` (same points), holding layers 0 .. held_layers - 1 and the
-// outer loop. Not converging within max_sweeps is reported (converged = false), not an error.
+// outer loop. Not converging (within max_sweeps, or stalled at the smallest omega: file comment) is
+// reported (converged = false), not an error.
 // Errors: INVALID_ARGUMENT for bad options or a grid that is not a periodic planar O-grid of at
 // least 5 x 3 points; FAILED_PRECONDITION if the iteration diverges; CANCELLED.
 absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,

@@ -284,6 +284,8 @@ absl::StatusOr<ProfileGrid> GenerateProfileGrid(const StructuredBlock& coordinat
       out.coarse_seconds = smoothed.coarse.seconds;
       out.fine_seconds = smoothed.fine.seconds;
       out.elliptic_converged = smoothed.fine.converged;
+      out.elliptic_restarts = smoothed.coarse.restarts + smoothed.fine.restarts;
+      out.elliptic_relaxation = smoothed.fine.relaxation;
     }
     out.growth_ratio = GeometricRatio(out.first_height, out.distance, options.layers);
   }

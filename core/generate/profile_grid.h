@@ -121,10 +121,13 @@ struct ProfileGrid {
   int marched_layers = 0;
   // kElliptic: sweeps and seconds of the coarse level (from the algebraic grid) and of the
   // fine level (its multigrid cycles: fine sweeps, and the seconds of all levels); whether the
-  // fine level converged.
+  // fine level converged; the restarts of both levels after a stall and the fine level's omega
+  // at the end (EllipticResult).
   int coarse_sweeps = 0, fine_sweeps = 0;
   double coarse_seconds = 0.0, fine_seconds = 0.0;
   bool elliptic_converged = false;
+  int elliptic_restarts = 0;
+  double elliptic_relaxation = 0.0;
   OGridQuality quality;
   // Seconds of each stage.
   double fit_seconds = 0.0, wall_seconds = 0.0, layer_seconds = 0.0, measure_seconds = 0.0;

@@ -111,6 +111,16 @@ void EncodeGenerationReport(const ProfileGrid& grid, const Extents& extents, int
   out->set_growth_ratio(grid.growth_ratio);
   out->set_retries(grid.retries);
   out->set_marched_layers(grid.marched_layers);
+  if (grid.coarse_sweeps > 0 || grid.fine_sweeps > 0) {
+    v1::EllipticReport* elliptic = out->mutable_elliptic();
+    elliptic->set_converged(grid.elliptic_converged);
+    elliptic->set_coarse_sweeps(grid.coarse_sweeps);
+    elliptic->set_fine_sweeps(grid.fine_sweeps);
+    elliptic->set_restarts(grid.elliptic_restarts);
+    elliptic->set_relaxation(grid.elliptic_relaxation);
+    elliptic->set_coarse_seconds(grid.coarse_seconds);
+    elliptic->set_fine_seconds(grid.fine_seconds);
+  }
   const OGridQuality& q = grid.quality;
   v1::OGridQuality* quality = out->mutable_quality();
   quality->set_negative_cells(q.negative_cells);

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "absl/strings/str_cat.h"
+#include "core/generate/elliptic.h"
 #include "core/io/airfoil.h"
 #include "gmock/gmock.h"
 #include "tests/core/quadrilateral_checks.h"
@@ -167,6 +168,13 @@ TEST_F(GenerateTest, EllipticFromAnAirfoilFile) {
   EXPECT_EQ(r.report().quality().negative_cells(), 0);
   EXPECT_NEAR(r.report().quality().first_height_min(), kFirstHeight,
               kFirstLayerTolerance * kFirstHeight);
+  // How the smoothing went is reported: converged, both levels swept, omega as given.
+  const v1::EllipticReport& elliptic = r.report().elliptic();
+  EXPECT_TRUE(elliptic.converged());
+  EXPECT_GT(elliptic.coarse_sweeps(), 0);
+  EXPECT_GT(elliptic.fine_sweeps(), 0);
+  EXPECT_EQ(elliptic.restarts(), 0);
+  EXPECT_EQ(elliptic.relaxation(), EllipticOptions().relaxation);
   ExpectValidOGrid("rae-elliptic", kLayers - 1);
   // Coarse to fine halves the points and layers: an even number of wall points is refused.
   request.set_grid_id("rae-elliptic-even");
