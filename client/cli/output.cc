@@ -165,10 +165,12 @@ std::string FormatReport(const v1::FitReport& r, bool interpolating) {
   if (r.reference_length() > 0.0) {
     absl::StrAppend(&out, absl::StrFormat("  reference length %.6g (%s)%s\n", r.reference_length(),
                                           r.reference_length_description(),
-                                          r.tolerances_given() && r.has_tolerances()
-                                              ? ""
-                                              : ": the default tolerances by kind are fractions "
-                                                "of it"));
+                                          // A fit to counts or an interpolating one
+                                          // has no tolerances to be fractions of it.
+                                          r.tolerances_given() && !r.has_tolerances()
+                                              ? ": the default tolerances by kind are fractions "
+                                                "of it"
+                                              : ""));
   }
   absl::StrAppend(&out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original "
                                         "cells folded or resized beyond 2x; worst Jacobian ratio "

@@ -65,7 +65,9 @@ absl::Status ReportFit(const MultiBlockGrid& grid, const CellQualityOptions& qua
   report.max_deviation = 0.0;
   report.tolerance_met = tolerances != nullptr;
   report.unmet_reason =
-      tolerances ? "" : "no tolerance was given (a fit to control counts): see max_deviation";
+      tolerances ? ""
+                 : "no tolerance was given (a fit to control counts, or interpolating): see "
+                   "max_deviation";
   report.quality_met = true;
   std::vector<FittedBlock> fitted;
   for (int b = 0; b < static_cast<int>(fit.blocks.size()); ++b) {
