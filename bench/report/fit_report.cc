@@ -14,7 +14,10 @@
 // sub-cells, the wall curvature extrema, the wall time of the fit, and the units check: the same
 // grid scaled to millimetres (x1000) fitted alike, "same" when its control, bad-cell and folded
 // counts equal the unscaled fit's (else the counts that differ). A synthetic polar disk (one
-// block, its j = 0 edge collapsed to the centre, the rim a wall) follows the shared grids. Then
+// block, its j = 0 edge collapsed to the centre, the rim a wall) follows the shared grids. A
+// second table fits each grid again to one tolerance for every point (1e-3 of its reference
+// length, as `splinegrid fit --tol`): controls, the largest distance, folded sub-cells and the
+// repair's fairing weight. Then
 // every airfoil of airfoils/ is fitted from its coordinates (FitAirfoil: 1e-4 chord, faired to
 // tolerance): control points, the largest distance, curvature extrema before and after fairing
 // and the spurious ones. Exit status 1 if a tolerance is not met or a grid cell folds anywhere
@@ -117,9 +120,35 @@ std::string MillimetreCheck(MultiBlockGrid grid, const std::vector<FaceKindOverr
   return differ.empty() ? "same" : absl::StrJoin(differ, ", ");
 }
 
-// Fits `grid` by kind (and in millimetres) and prints its row named `name`; false if it is not
-// met or folds.
+// The one-tolerance fit of `grid` (as `splinegrid fit --tol`): every point within
+// kOneTolerance of `reference_length`, folds repaired where they can be (adaptive_engine.h step
+// 3b) and counted. Its row of the second table; `ok` is cleared when it misses or folds.
+constexpr double kOneTolerance = 1e-3;
+
+std::string OneToleranceRow(const std::string& name, const MultiBlockGrid& grid,
+                            double reference_length, bool& ok) {
+  GridFitOptions options;
+  options.tolerance = kOneTolerance * reference_length;
+  options.allow_folds = true;
+  const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
+  if (!fit.ok()) {
+    ok = false;
+    return absl::StrFormat("| %s | fit failed: %s |\n", name, fit.status().message());
+  }
+  const GridFitReport& r = fit->report;
+  const int64_t folded = CountCells(*fit).folded;
+  ok = ok && r.tolerance_met && folded == 0;
+  return absl::StrFormat("| %s | %.3g | %d | %d | %.1f | %.3g | %s | %d | %.3g | %.0f |\n", name,
+                         *options.tolerance, r.num_points, r.num_control_points,
+                         static_cast<double>(r.num_points) / r.num_control_points, r.max_deviation,
+                         r.tolerance_met ? "yes" : "NO", folded, r.fairing_weight,
+                         1e3 * r.seconds);
+}
+
+// Fits `grid` by kind (and in millimetres) and prints its row named `name`, and adds its row of
+// the one-tolerance table to `one_tolerance`; false if either is not met or folds.
 bool ReportGrid(const std::string& name, const MultiBlockGrid& grid,
+                std::vector<std::string>& one_tolerance,
                 const std::vector<FaceKindOverride>& face_kinds = {}) {
   absl::StatusOr<GridFit> fit = FitByKinds(grid, face_kinds);
   if (!fit.ok()) {
@@ -153,11 +182,12 @@ bool ReportGrid(const std::string& name, const MultiBlockGrid& grid,
       static_cast<long long>(counts.bad), static_cast<long long>(counts.folded),
       static_cast<long long>(r.wall_curvature.extrema), 1e3 * r.seconds, mm.c_str());
   std::fflush(stdout);
+  one_tolerance.push_back(OneToleranceRow(name, grid, r.reference.length, ok));
   return ok;
 }
 
 // Reads one file and reports it.
-bool ReportGridFile(const std::filesystem::path& file) {
+bool ReportGridFile(const std::filesystem::path& file, std::vector<std::string>& one_tolerance) {
   absl::StatusOr<MultiBlockGrid> read = ReadPlot3dFile(file.string());
   if (!read.ok()) {
     std::printf("| %s | read failed: %s |\n", file.filename().c_str(),
@@ -166,14 +196,14 @@ bool ReportGridFile(const std::filesystem::path& file) {
   }
   MultiBlockGrid grid = *std::move(read);
   if (IsTwoPlaneGrid(grid)) grid = PlanarView(grid).value();
-  return ReportGrid(file.filename().string(), grid);
+  return ReportGrid(file.filename().string(), grid, one_tolerance);
 }
 
 // The collapsed-edge case (poles.h), as tests/core/collapsed_edges_test.cc builds it: a polar
 // disk of one block of 65 x 17 points, i counter-clockwise with the periodic seam i = 0 ~ i = max,
 // j outwards from the centre (0.3, -0.2) (j = 0: every point at the centre) with a radius
 // clustered towards a wobbly rim; the rim is a wall.
-bool ReportPolarDisk() {
+bool ReportPolarDisk(std::vector<std::string>& one_tolerance) {
   constexpr int ni = 65, nj = 17;
   StructuredBlock block({ni, nj, 1}, 2);
   for (int j = 0; j < nj; ++j) {
@@ -188,7 +218,7 @@ bool ReportPolarDisk() {
   }
   MultiBlockGrid grid;
   grid.blocks.push_back(std::move(block));
-  return ReportGrid("polar disk 65x17 (synthetic)", grid,
+  return ReportGrid("polar disk 65x17 (synthetic)", grid, one_tolerance,
                     {{{.block = 0, .normal = 1, .upper = true}, BoundaryKind::kWall}});
 }
 
@@ -243,8 +273,15 @@ int Run(int argc, char** argv) {
       "folded | wall curvature extrema | ms | mm |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|"
       ":-:|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n");
   bool ok = true;
-  for (const std::filesystem::path& file : GridFiles(dir)) ok = ReportGridFile(file) && ok;
-  ok = ReportPolarDisk() && ok;
+  std::vector<std::string> one_tolerance;
+  for (const std::filesystem::path& file : GridFiles(dir)) {
+    ok = ReportGridFile(file, one_tolerance) && ok;
+  }
+  ok = ReportPolarDisk(one_tolerance) && ok;
+  std::printf(
+      "\n| grid, one tolerance | tolerance | points | controls | ratio | max dev | met | folded | "
+      "fairing weight | ms |\n|---|---:|---:|---:|---:|---:|:-:|---:|---:|---:|\n");
+  for (const std::string& row : one_tolerance) std::fputs(row.c_str(), stdout);
   std::printf(
       "\n| airfoil | points | trailing edge | controls | max distance | within 1e-4 | curvature "
       "extrema unfaired -> faired | spurious | fairing weight | ms |\n"
