@@ -42,11 +42,11 @@ constexpr int kStallCycles = 20;
 // the RAE 2822 with 320 or more layers they jumped by 10-1000 times their spacing for 20,000
 // sweeps on both levels (277 s at 512 layers, never converged), where omega 1 converges in
 // 700-850 coarse sweeps. So when the largest move has not fallen to a new low for
-// kStallSweeps sweeps (kStallCycles cycles), or a move is not finite, the iteration starts again
-// from the initial grid with omega times kRelaxationBackoff, down to kMinRelaxation; a stall
-// there ends it, not converged (the 30P30N slat at 256 layers: points in the cove collapse at any
-// omega; it went on for 20,000 sweeps, 74 s). A converging run makes a new low nearly every
-// sweep (the slow far-field mode too).
+// kStallSweeps sweeps, or a move is not finite, the iteration starts again from the initial grid
+// with omega times kRelaxationBackoff, down to kMinRelaxation (stalled cycles first go on as
+// relaxation alone, as above); a stall there ends it, not converged (the 30P30N slat at 256 layers:
+// points in the cove collapse at any omega; it went on for 20,000 sweeps, 74 s). A converging run
+// makes a new low nearly every sweep (the slow far-field mode too).
 constexpr int kStallSweeps = 50;
 constexpr double kRelaxationBackoff = 0.75;
 constexpr double kMinRelaxation = 0.5;
@@ -574,7 +574,7 @@ class Multigrid {
     for (int k = 0; k < kCoarsestSweeps; ++k) {
       const double largest = Sweep(l);
       // Settled, or diverged: a move that is not finite reaches the fine level's next sweep.
-      if (!(largest >= options_.tolerance) || !std::isfinite(largest)) break;
+      if (largest < options_.tolerance || !std::isfinite(largest)) break;
     }
     // The correction, bilinear in index space (periodic in i), on the free points.
     auto correction = [&](int I, int J) -> Vec {
@@ -673,9 +673,9 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
     } else if (std::isfinite(largest)) {
       break;  // no better: reported as not converged
     } else {
-      return absl::FailedPreconditionError(
-          absl::StrCat("elliptic smoothing diverged in sweep ", fine.sweeps,
-                       " (relaxation factor ", multigrid.omega(), ")"));
+      return absl::FailedPreconditionError(absl::StrCat("elliptic smoothing diverged in sweep ",
+                                                        fine.sweeps, " (relaxation factor ",
+                                                        multigrid.omega(), ")"));
     }
     std::copy(initial.coords().begin(), initial.coords().end(), fine.grid.coords().begin());
     watch.Reset();
