@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Iterator, Optional, Sequence, Union
 
+import numpy as np
 import numpy.typing as npt
 from google.protobuf.message import Message
 
@@ -52,6 +53,10 @@ def _points_header(blocks: Sequence[npt.ArrayLike], grid_id: str, display_name: 
                    ) -> tuple[service_pb2.ImportHeader, list[_wire.Array]]:
     """The ImportHeader of point blocks and the blocks as 4-D float64 arrays; ValueError for
     no block, a block of a wrong shape (named by its index) or mixed coordinate counts."""
+    if isinstance(blocks, np.ndarray):
+        # Iterating one array would split it along its first axis into blocks of one line each.
+        raise ValueError(f"blocks is one array of shape {blocks.shape}; give a list of blocks "
+                         "(e.g. [points] for one block)")
     arrays = [_as_block(b, n) for n, b in enumerate(blocks)]
     if not arrays:
         raise ValueError("blocks is empty: a grid needs a block")

@@ -178,6 +178,15 @@ def test_import_points_sends_every_coordinate_in_order(keeping):
     assert chunks == [(0, list(np.arange(24.0)))]
 
 
+def test_import_points_refuses_one_bare_array(keeping):
+    # Iterated, a (nj, ni, s) array was 3 blocks of one line each, stored without a word.
+    fake, client = keeping
+    with pytest.raises(ValueError, match=r"blocks is one array of shape \(3, 4, 2\); give a "
+                                         r"list of blocks \(e.g. \[points\] for one block\)"):
+        client.import_points(np.zeros((3, 4, 2)), grid_id="pts")
+    assert fake.uploads == []
+
+
 def test_list_follows_every_page(keeping):
     fake, client = keeping
     assert [g.name for g in client.list()] == [f"grids/{g}" for g in "abcde"]
