@@ -35,10 +35,10 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
   const WorkKind kind =
       parsed->ok() && ops::HasKeptDeformer(Ops(), **parsed) ? WorkKind::kCheap : WorkKind::kLong;
   return RunOnPool(context, log, Role::kWrite, kind,
-                   [this, parsed, response, cancel](const Caller&) -> absl::Status {
+                   [this, parsed, response, cancel](const Caller& caller) -> absl::Status {
                      SG_RETURN_IF_ERROR(parsed->status());
                      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> published,
-                                         ops::Deform(Ops(), **parsed, cancel));
+                                         ops::Deform(Ops(caller), **parsed, cancel));
                      response->set_revision(published->number);
                      EncodeDeformReport(published->deform, response->mutable_report());
                      return absl::OkStatus();

@@ -14,12 +14,12 @@ grpc::ServerUnaryReactor* SplineGridService::FitGrid(grpc::CallbackServerContext
   CallLog log("FitGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, Role::kWrite, WorkKind::kLong,
-                   [this, request, response, cancel](const Caller&) -> absl::Status {
+                   [this, request, response, cancel](const Caller& caller) -> absl::Status {
                      SG_ASSIGN_OR_RETURN(const std::string id,
                                          ParseGridName(request->name(), "name"));
                      SG_ASSIGN_OR_RETURN(GridFitOptions options, ParseFitSpec(request->spec()));
                      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> revision,
-                                         ops::Fit(Ops(), id, std::move(options), cancel));
+                                         ops::Fit(Ops(caller), id, std::move(options), cancel));
                      EncodeFitResponse(*revision, response);
                      return absl::OkStatus();
                    });
@@ -31,7 +31,7 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
   CallLog log("FairGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   return RunOnPool(context, log, Role::kWrite, WorkKind::kLong,
-                   [this, request, response, cancel](const Caller&) -> absl::Status {
+                   [this, request, response, cancel](const Caller& caller) -> absl::Status {
                      ops::FairRequest fair;
                      SG_ASSIGN_OR_RETURN(fair.grid_id, ParseGridName(request->name(), "name"));
                      fair.revision = request->revision();
@@ -41,7 +41,7 @@ grpc::ServerUnaryReactor* SplineGridService::FairGrid(grpc::CallbackServerContex
                      }
                      fair.allow_folds = request->allow_folds();
                      SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> revision,
-                                         ops::Fair(Ops(), fair, cancel));
+                                         ops::Fair(Ops(caller), fair, cancel));
                      EncodeFitResponse(*revision, response);
                      return absl::OkStatus();
                    });

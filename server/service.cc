@@ -132,6 +132,17 @@ grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerConte
   return reactor;
 }
 
+ops::OpsContext SplineGridService::Ops(const Caller& caller) const {
+  ops::OpsContext context = state_->Ops();
+  if (caller.role < Role::kAdmin) {
+    context.may_change = [caller](const std::string& owner, const std::string& name,
+                                  absl::string_view action) {
+      return MayChangeGrid(caller, owner, name, action);
+    };
+  }
+  return context;
+}
+
 grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext* context,
                                                      const v1::GetGridRequest* request,
                                                      v1::Grid* response) {
@@ -194,7 +205,7 @@ grpc::ServerUnaryReactor* SplineGridService::DeleteGrid(grpc::CallbackServerCont
     GridStore::DeleteCheck check;
     if (caller.role < Role::kAdmin) {  // a writer deletes only its own grids
       check = [&](const std::string& owner) {
-        return MayDeleteGrid(caller, owner, request->name());
+        return MayChangeGrid(caller, owner, request->name(), "deleting");
       };
     }
     SG_RETURN_IF_ERROR(state_->store->Delete(id, check));

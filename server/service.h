@@ -158,6 +158,8 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
                                       Role needed, const Work& work);
 
   ops::OpsContext Ops() const { return state_->Ops(); }
+  // The operations' view for `caller`: a writer changes only its own grids (MayChangeGrid).
+  ops::OpsContext Ops(const Caller& caller) const;
 
   ServiceState* state_;
 };

@@ -16,24 +16,28 @@ const char* RoleName(Role role) {
   return "unknown";
 }
 
-absl::Status MayDeleteGrid(const Caller& caller, const std::string& owner,
-                           const std::string& name) {
+absl::Status MayChangeGrid(const Caller& caller, const std::string& owner, const std::string& name,
+                           absl::string_view action) {
   if (caller.role >= Role::kAdmin) return absl::OkStatus();
   if (caller.role == Role::kWrite && !owner.empty() && caller.owner() == owner) {
     return absl::OkStatus();
   }
   if (caller.role < Role::kWrite) {
     return absl::PermissionDeniedError(absl::StrCat(
-        "deleting ", name, " needs the role write (own grids) or admin; the caller has ",
+        action, " ", name, " needs the role write (own grids) or admin; the caller has ",
         RoleName(caller.role)));
   }
   if (owner.empty()) {
-    return absl::PermissionDeniedError(absl::StrCat(
-        name, " was created without a token and has no owner: only an admin may delete it"));
+    return absl::PermissionDeniedError(absl::StrCat(name,
+                                                    " was created without a token and has no "
+                                                    "owner: ",
+                                                    action, " it needs the role admin"));
   }
-  return absl::PermissionDeniedError(absl::StrCat(
-      name, " belongs to '", owner, "': the role write deletes only the caller's own grids ('",
-      caller.principal, "'); an admin may delete any"));
+  return absl::PermissionDeniedError(
+      absl::StrCat(name, " belongs to '", owner, "': ", action,
+                   " it needs the role admin; the role write changes and deletes only the "
+                   "caller's own grids ('",
+                   caller.principal, "')"));
 }
 
 }  // namespace splinegrid::server

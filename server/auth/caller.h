@@ -6,15 +6,16 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "absl/strings/string_view.h"
 
 namespace splinegrid::server {
 
 // Ordered: each role may do everything the roles before it may.
 //   read:  GetGrid, ListGrids, EvaluateGrid, EvaluatePoints, GetWallCurvature, WatchGrid,
 //          ExportGrid (and health, which is open to everyone).
-//   write: also ImportGrid, ImportArchive, FitGrid, FairGrid, DeformGrid, GenerateGrid, and
-//          DeleteGrid of grids the same principal created.
-//   admin: everything, including DeleteGrid of any grid.
+//   write: also ImportGrid, ImportArchive and GenerateGrid (new grids, owned by the caller),
+//          and FitGrid, FairGrid, DeformGrid and DeleteGrid of grids the same principal created.
+//   admin: everything, including changing and deleting any grid.
 enum class Role { kRead = 0, kWrite = 1, kAdmin = 2 };
 
 // "read", "write" or "admin".
@@ -31,10 +32,12 @@ struct Caller {
   std::string owner() const { return from_token ? principal : std::string(); }
 };
 
-// Whether `caller` may delete the grid `name` created by `owner` (StoredGrid::owner): an admin
-// any grid, a writer only its own (a grid created without tokens has no owner: admin only).
-// PERMISSION_DENIED naming the owner otherwise.
-absl::Status MayDeleteGrid(const Caller& caller, const std::string& owner, const std::string& name);
+// Whether `caller` may change (fit, fair, deform) or delete the grid `name` created by `owner`
+// (StoredGrid::owner): an admin any grid, a writer only its own (a grid created without tokens
+// has no owner: admin only). PERMISSION_DENIED naming the owner and `action` ("deleting",
+// "deforming", ...) otherwise.
+absl::Status MayChangeGrid(const Caller& caller, const std::string& owner, const std::string& name,
+                           absl::string_view action);
 
 }  // namespace splinegrid::server
 

@@ -101,6 +101,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
                       context.store.GetHolding(
                           request.grid_id, {request.base_revision, request.reference_revision}));
+  SG_RETURN_IF_ERROR(context.MayChange(grid->owner, request.grid_id, "deforming"));
   SG_RETURN_IF_ERROR(Validate(request));
   const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
   if (request.base_revision != 0 && request.base_revision != latest) {

@@ -83,6 +83,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Fit(const OpsContext& contex
                                                         GridFitOptions options,
                                                         const CancelCheck& cancel) {
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid, context.store.Get(id));
+  SG_RETURN_IF_ERROR(context.MayChange(grid->owner, id, "fitting"));
   // The imported file's boundary conditions are the default kinds of their faces.
   options.face_kinds =
       WithDefaultFaceKinds(std::move(options.face_kinds), grid->source->boundaries.face_kinds);
@@ -94,6 +95,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Fair(const OpsContext& conte
                                                          const CancelCheck& cancel) {
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
                       context.store.Get(request.grid_id));
+  SG_RETURN_IF_ERROR(context.MayChange(grid->owner, request.grid_id, "fairing"));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
                       grid->ResolveRevision(request.revision));
   SG_ASSIGN_OR_RETURN(const GridFitOptions options, FairOptions(*parent, request));

@@ -87,13 +87,13 @@ TEST_F(AuthTest, WithoutAKnownTokenEveryCallIsUnauthenticatedButHealthIsOpen) {
   }
 }
 
-// Every role (and none) against one call of each class: read (GetGrid), write (ImportGrid,
-// FitGrid), delete of the caller's own grid and of another principal's (bob's).
+// Every role (and none) against one call of each class: read (GetGrid), write (ImportGrid),
+// changing (FitGrid) and deleting the caller's own grid, and another principal's (bob's).
 TEST_F(AuthTest, RoleMatrix) {
   using Code = absl::StatusCode;
   const struct {
     std::string token;
-    Code read, write, delete_own, delete_other;
+    Code read, write, own, other;
   } rows[] = {
       {"", Code::kUnauthenticated, Code::kUnauthenticated, Code::kUnauthenticated,
        Code::kUnauthenticated},
@@ -117,15 +117,17 @@ TEST_F(AuthTest, RoleMatrix) {
     auto client = As(row.token);
     ExpectCode(client->Get("bobs").status(), row.read);
     ExpectCode(Import(*client, "mine").status(), row.write);
-    ExpectCode(client->Fit("bobs", spec).status(), row.write);
     if (row.write != Code::kOk) {
-      // Nothing of its own to delete: a grid that does not belong to it.
-      ExpectCode(client->Delete("bobs"), row.delete_own);
+      // Nothing of its own to change or delete: a grid that does not belong to it.
+      ExpectCode(client->Fit("bobs", spec).status(), row.own);
+      ExpectCode(client->Delete("bobs"), row.own);
     } else {
-      ExpectCode(client->Delete("mine"), row.delete_own);
+      ExpectCode(client->Fit("mine", spec).status(), row.own);
+      ExpectCode(client->Delete("mine"), row.own);
     }
-    ExpectCode(client->Delete("bobs"), row.delete_other);
-    if (row.delete_other != Code::kOk) {
+    ExpectCode(client->Fit("bobs", spec).status(), row.other);
+    ExpectCode(client->Delete("bobs"), row.other);
+    if (row.other != Code::kOk) {
       ASSERT_TRUE(bob->Delete("bobs").ok());
     }
   }
@@ -192,6 +194,38 @@ TEST_F(AuthTest, AWriterDeletesOnlyItsOwnGridsAndAnAdminAny) {
   EXPECT_TRUE(admin->Delete("alice-2").ok());  // another principal's grid
   EXPECT_TRUE(admin->Delete("bob-1").ok());
   EXPECT_TRUE(admin->List().value().empty());
+}
+
+// A writer fits, fairs and deforms only its own grids, as it deletes only those; an admin any.
+// (Only DeleteGrid checked the owner: a writer could deform another principal's grid.)
+TEST_F(AuthTest, AWriterChangesOnlyItsOwnGridsAndAnAdminAny) {
+  auto alice = As("write-token-a1");
+  auto bob = As("write-token-b1");
+  auto admin = As("admin-token-z1");
+  ASSERT_TRUE(Import(*alice, "alices").ok());
+  v1::FitSpec spec;
+  spec.mutable_boundary_tolerances();  // the defaults by kind: no fold, so deforms are checked
+  ASSERT_TRUE(alice->Fit("alices", spec).ok());
+  v1::DeformGridRequest deform;
+  deform.set_name("alices");
+  for (double d : {1e-4, 0.0}) deform.mutable_rigid()->add_translation(d);
+
+  const absl::Status fit = bob->Fit("alices", spec).status();
+  ExpectCode(fit, absl::StatusCode::kPermissionDenied);
+  EXPECT_THAT(fit.message(), HasSubstr("grids/alices belongs to 'alice': fitting it needs the "
+                                       "role admin; the role write changes and deletes only the "
+                                       "caller's own grids ('bob')"));
+  const absl::Status fair = bob->Fair("alices", 0, nullptr, true).status();
+  ExpectCode(fair, absl::StatusCode::kPermissionDenied);
+  EXPECT_THAT(fair.message(), HasSubstr("fairing it needs the role admin"));
+  const absl::Status deformed = bob->Deform(deform).status();
+  ExpectCode(deformed, absl::StatusCode::kPermissionDenied);
+  EXPECT_THAT(deformed.message(), HasSubstr("deforming it needs the role admin"));
+  EXPECT_EQ(alice->Get("alices").value().latest_revision(), 1);  // nothing stored
+
+  EXPECT_EQ(alice->Deform(deform).value().revision(), 2);
+  EXPECT_EQ(admin->Deform(deform).value().revision(), 3);
+  EXPECT_TRUE(admin->Fair("alices", 0, nullptr, true).ok());
 }
 
 TEST_F(AuthTest, AReloadChangesRolesAndABadFileKeepsThem) {

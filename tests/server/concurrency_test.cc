@@ -82,11 +82,7 @@ TEST_F(ServiceTest, ConcurrentClientsMixingEveryMethod) {
       surface->mutable_end()->set_j(sphere.blocks[moved].extent(1) - 1);
       deform.set_decay_radius(0.5);
       for (double d : {1e-3, 0.0, 0.0}) deform.mutable_rigid()->add_translation(d);
-      {
-        auto st = client_->Deform(deform).status();
-        fprintf(stderr, "DEFORM %s\n", st.ToString().c_str());
-        check(st, "deform");
-      }
+      check(client_->Deform(deform).status(), "deform");
       if (fitted.ok()) check(WatchBriefly(*client_, mine), "watch");
       v1::EvaluateGridRequest eval;
       eval.set_name(rng() % 2 ? "shared" : theirs);

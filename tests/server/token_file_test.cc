@@ -181,22 +181,23 @@ TEST(AuthenticatorTest, AFileWithoutTokensIsRefusedAtStart) {
   EXPECT_EQ(authenticator.num_tokens(), 0);
 }
 
-TEST(MayDeleteGridTest, AdminAnyWriterOwnReaderNone) {
+TEST(MayChangeGridTest, AdminAnyWriterOwnReaderNone) {
   const Caller admin{"root", Role::kAdmin, true};
   const Caller alice{"alice", Role::kWrite, true};
   const Caller reader{"carol", Role::kRead, true};
-  EXPECT_TRUE(MayDeleteGrid(admin, "alice", "grids/a").ok());
-  EXPECT_TRUE(MayDeleteGrid(admin, "", "grids/a").ok());
-  EXPECT_TRUE(MayDeleteGrid(alice, "alice", "grids/a").ok());
-  EXPECT_THAT(MayDeleteGrid(alice, "bob", "grids/a"),
-              StatusIs(absl::StatusCode::kPermissionDenied, "grids/a belongs to 'bob'"));
-  EXPECT_THAT(MayDeleteGrid(alice, "", "grids/a"),
-              StatusIs(absl::StatusCode::kPermissionDenied, "only an admin"));
-  EXPECT_THAT(MayDeleteGrid(reader, "carol", "grids/a"),
+  EXPECT_TRUE(MayChangeGrid(admin, "alice", "grids/a", "deleting").ok());
+  EXPECT_TRUE(MayChangeGrid(admin, "", "grids/a", "deleting").ok());
+  EXPECT_TRUE(MayChangeGrid(alice, "alice", "grids/a", "deleting").ok());
+  EXPECT_THAT(MayChangeGrid(alice, "bob", "grids/a", "deleting"),
+              StatusIs(absl::StatusCode::kPermissionDenied,
+                       "grids/a belongs to 'bob': deleting it needs the role admin"));
+  EXPECT_THAT(MayChangeGrid(alice, "", "grids/a", "deleting"),
+              StatusIs(absl::StatusCode::kPermissionDenied, "has no owner: deleting it needs"));
+  EXPECT_THAT(MayChangeGrid(reader, "carol", "grids/a", "deleting"),
               StatusIs(absl::StatusCode::kPermissionDenied, "the caller has read"));
   // Without tokens the principal is a peer address, never an owner.
   const Caller peer{"alice", Role::kWrite, false};
-  EXPECT_FALSE(MayDeleteGrid(peer, "alice", "grids/a").ok());
+  EXPECT_FALSE(MayChangeGrid(peer, "alice", "grids/a", "deleting").ok());
 }
 
 TEST(TransportTest, LoopbackAddresses) {
