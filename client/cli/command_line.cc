@@ -1,13 +1,13 @@
 #include "client/cli/command_line.h"
 
 #include <algorithm>
-#include <numeric>
 #include <optional>
 
 #include "absl/flags/reflection.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/time/time.h"
 
 namespace splinegrid::cli {
 namespace {
@@ -15,7 +15,8 @@ namespace {
 // A flag as written: its name without dashes and "=value".
 struct GivenFlag {
   std::string name;
-  std::string spelled;  // as typed, for messages ("-o", "--levl")
+  std::string spelled;               // as typed, for messages ("-o", "--levl")
+  std::optional<std::string> value;  // after '=' or as the next argument
 };
 
 bool IsBoolFlag(absl::string_view name) {
@@ -87,19 +88,21 @@ absl::StatusOr<const CommandSpec*> Command(const std::string& name) {
 }  // namespace
 
 int EditDistance(absl::string_view a, absl::string_view b) {
-  // One row of the dynamic programme (Wagner-Fischer), O(|a| |b|) time, O(|b|) memory.
-  std::vector<int> row(b.size() + 1);
-  std::iota(row.begin(), row.end(), 0);
+  // The optimal string alignment distance (Damerau-Levenshtein, each substring edited once):
+  // d[i][j] of a's first i and b's first j characters, O(|a| |b|); names are short.
+  std::vector<std::vector<int>> d(a.size() + 1, std::vector<int>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = static_cast<int>(i);
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = static_cast<int>(j);
   for (size_t i = 1; i <= a.size(); ++i) {
-    int diagonal = row[0];
-    row[0] = static_cast<int>(i);
     for (size_t j = 1; j <= b.size(); ++j) {
-      const int above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
+      d[i][j] = std::min(
+          {d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);  // two neighbours swapped
+      }
     }
   }
-  return row[b.size()];
+  return d[a.size()][b.size()];
 }
 
 std::string ClosestName(absl::string_view typed, const std::vector<std::string>& candidates) {
@@ -142,13 +145,15 @@ absl::StatusOr<CommandLine> CheckCommandLine(const std::vector<std::string>& arg
       version = true;
       continue;
     }
-    flags.push_back({name, std::string(arg.substr(0, arg.find('=')))});
+    GivenFlag& flag =
+        flags.emplace_back(GivenFlag{name, std::string(arg.substr(0, arg.find('=')))});
+    if (equals != absl::string_view::npos) flag.value = std::string(body.substr(equals + 1));
     // `--name VALUE`: the next argument is the value, except for bool flags (and --noFLAG).
     const bool stands_alone = IsBoolFlag(name) || (absl::StartsWith(name, "no") &&
                                                    IsBoolFlag(absl::string_view(name).substr(2)));
     if (equals == absl::string_view::npos && !stands_alone &&
         absl::FindCommandLineFlag(name) != nullptr && i + 1 < args.size()) {
-      ++i;
+      flag.value = args[++i];
     }
   }
 
@@ -189,8 +194,32 @@ absl::StatusOr<CommandLine> CheckCommandLine(const std::vector<std::string>& arg
     const std::optional<std::string> name = AcceptedName(flag.name, accepted);
     if (!name) return ForeignOrUnknownFlag(flag, **command);
     line.given_flags.push_back(*name);
+    if (flag.value && *name == flag.name) line.flag_values.emplace_back(*name, *flag.value);
   }
   return line;
+}
+
+absl::Status ParseFlagValues(const CommandLine& line) {
+  for (const auto& [name, value] : line.flag_values) {
+    absl::CommandLineFlag* flag = absl::FindCommandLineFlag(name);
+    std::string error;
+    if (flag == nullptr || flag->ParseFrom(value, &error)) continue;
+    std::string expected;
+    if (flag->IsOfType<absl::Duration>()) {
+      expected = "give a duration with its unit (30s, 500ms, 2m)";
+    } else if (flag->IsOfType<int>() || flag->IsOfType<int64_t>() ||
+               flag->IsOfType<std::optional<int>>() || flag->IsOfType<std::optional<int64_t>>()) {
+      expected = "give an integer";
+    } else if (flag->IsOfType<double>() || flag->IsOfType<std::optional<double>>()) {
+      expected = "give a number";
+    } else if (flag->IsOfType<bool>() || flag->IsOfType<std::optional<bool>>()) {
+      expected = "give true or false";
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", name, " = '", value,
+                     "' is not a valid value: ", expected.empty() ? error : expected));
+  }
+  return absl::OkStatus();
 }
 
 namespace {

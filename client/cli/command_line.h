@@ -7,6 +7,7 @@
 #define SPLINEGRID_CLIENT_CLI_COMMAND_LINE_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -25,6 +26,8 @@ struct CommandLine {
   const CommandSpec* command = nullptr;
   // The flags given (kRun), by the name the command reads: --noFLAG and --FLAG=false as FLAG.
   std::vector<std::string> given_flags;
+  // The values given with them (`--name=V` or `--name V`; not --noFLAG), by the same names.
+  std::vector<std::pair<std::string, std::string>> flag_values;
 };
 
 // Checks argv[1..] (the arguments after the program name). `help`, `help CMD`, `--help`, `-h`
@@ -35,6 +38,12 @@ struct CommandLine {
 // flags stand alone (Abseil's rule).
 absl::StatusOr<CommandLine> CheckCommandLine(const std::vector<std::string>& args);
 
+// Parses every value of line.flag_values into its flag, as Abseil will: INVALID_ARGUMENT (usage,
+// exit 2) naming the flag, the value and what it takes ("--timeout = '2' is not a valid value:
+// give a duration with its unit (30s, 500ms, 2m)"). Abseil's own parse prints its error and
+// exits 1.
+absl::Status ParseFlagValues(const CommandLine& line);
+
 // Records line.given_flags for FlagGiven (main.cc, once, before the command runs).
 void RememberGivenFlags(const CommandLine& line);
 
@@ -44,7 +53,8 @@ void RememberGivenFlags(const CommandLine& line);
 // CGNS ignores, while the default is not.
 bool FlagGiven(absl::string_view name);
 
-// Levenshtein distance of `a` and `b` (insertions, deletions, substitutions).
+// Edit distance of `a` and `b`: insertions, deletions, substitutions and swaps of two
+// neighbouring characters ("nmae" is one edit from "name"), each substring edited once.
 int EditDistance(absl::string_view a, absl::string_view b);
 
 // The candidate closest to `typed` by EditDistance when it is close enough to be a typo (at

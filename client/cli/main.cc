@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
       break;
   }
 
+  if (const absl::Status values = splinegrid::cli::ParseFlagValues(*line); !values.ok()) {
+    std::fprintf(stderr, "splinegrid: %s\n", std::string(values.message()).c_str());
+    return 2;
+  }
   splinegrid::cli::RememberGivenFlags(*line);  // FlagGiven: explicit flags vs defaults
   std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   using Command = absl::Status (*)(const splinegrid::cli::Args&);

@@ -1,6 +1,8 @@
 // The command table of the CLI (client/cli/command_flags.h) against the flags really defined,
 // and the command-line check (command_line.h) on the forms users type, including every
 // `splinegrid ...` span the READMEs quote.
+#include "client/cli/command_flags.h"
+
 #include <fstream>
 #include <regex>
 #include <set>
@@ -12,7 +14,6 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
-#include "client/cli/command_flags.h"
 #include "client/cli/command_help.h"
 #include "client/cli/command_line.h"
 #include "gmock/gmock.h"
@@ -135,6 +136,27 @@ TEST(CommandLineCheck, SkipsValuesAndKnowsBoolFlags) {
   EXPECT_FALSE(Check("eval g --nolevel -o x.vts").ok());
 }
 
+// A value its flag cannot take is a usage error naming the flag, the value and what it takes;
+// Abseil alone printed "Illegal value '2' specified for flag 'timeout'" and exited 1.
+TEST(CommandLineCheck, ValuesAreParsedBeforeAbseilWouldExit) {
+  const auto line = Check("list --timeout 2 --json");
+  ASSERT_TRUE(line.ok()) << line.status();
+  ASSERT_EQ(line->flag_values.size(), 1u);  // --json stands alone
+  EXPECT_EQ(line->flag_values[0], std::make_pair(std::string("timeout"), std::string("2")));
+  // The status as text: code and message.
+  auto refusal = [](const std::string& command) {
+    return ParseFlagValues(Check(command).value()).ToString();
+  };
+  EXPECT_EQ(ParseFlagValues(*line).ToString(),
+            "INVALID_ARGUMENT: --timeout = '2' is not a valid value: give a duration with its "
+            "unit (30s, 500ms, 2m)");
+  EXPECT_EQ(refusal("serve --threads=1.5"),
+            "INVALID_ARGUMENT: --threads = '1.5' is not a valid value: give an integer");
+  EXPECT_THAT(refusal("offset x.dat --first abc"), HasSubstr("'abc' is not a valid value: give a "
+                                                             "number"));
+  EXPECT_THAT(refusal("fit x --allow_folds=maybe"), HasSubstr("give true or false"));
+}
+
 TEST(CommandLineCheck, HelpAndVersionForms) {
   for (const char* form : {"help", "--help", "-h", "-help"}) {
     const auto line = Check(form);
@@ -175,6 +197,11 @@ TEST(EditDistance, CountsEdits) {
   EXPECT_EQ(EditDistance("kitten", "sitting"), 3);
   EXPECT_EQ(ClosestName("revison", {"revision", "reference"}), "revision");
   EXPECT_EQ(ClosestName("xyz", {"revision"}), "");
+  // Two neighbours swapped are one edit, so short names get their suggestion too.
+  EXPECT_EQ(EditDistance("nmae", "name"), 1);
+  EXPECT_EQ(EditDistance("ca", "abc"), 3);  // each substring edited once
+  EXPECT_EQ(ClosestName("nmae", {"name", "level"}), "name");
+  EXPECT_EQ(ClosestName("levle", {"name", "level"}), "level");
 }
 
 // Every `splinegrid CMD ...` the READMEs quote in backticks or in code blocks uses flags its
@@ -184,9 +211,9 @@ TEST(EditDistance, CountsEdits) {
 std::vector<std::string> ReadmeCommandLines() {
   std::vector<std::string> lines;
   const std::regex span(R"((?:build/)?\bsplinegrid ([a-z]+)((?: [^`\n#&]*)?))");
-  for (const char* file : {"/README.md", "/python/README.md", "/deploy/README.md",
-                           "/docker/README.md", "/docs/formats.md", "/docs/c-api.md",
-                           "/docs/operations.md"}) {
+  for (const char* file :
+       {"/README.md", "/python/README.md", "/deploy/README.md", "/docker/README.md",
+        "/docs/formats.md", "/docs/c-api.md", "/docs/operations.md"}) {
     std::ifstream in(std::string(SPLINEGRID_SOURCE_DIR) + file);
     std::stringstream text;
     text << in.rdbuf();
