@@ -85,7 +85,7 @@ absl::Status Eval(const Args& args) {
     std::fwrite(summary.data(), 1, summary.size(), stdout);
     return absl::OkStatus();
   }
-  SG_RETURN_IF_ERROR(CheckGridOutput(out));
+  SG_RETURN_IF_ERROR(CheckGridOutput(out, ", or .pvd with --steps A:B"));
   auto client = Connect();
   // A CGNS file also carries the grid's boundary conditions and connectivity at the level.
   std::optional<CgnsOutputContext> cgns;

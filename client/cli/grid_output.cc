@@ -7,11 +7,11 @@
 
 namespace splinegrid::cli {
 
-absl::Status CheckGridOutput(const std::string& out) {
+absl::Status CheckGridOutput(const std::string& out, absl::string_view also) {
   const std::string ext = std::filesystem::path(out).extension().string();
   if (ext != ".vts" && ext != ".vtm" && ext != ".x" && ext != ".xyz" && ext != ".cgns") {
     return absl::InvalidArgumentError(
-        absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x, .xyz or .cgns"));
+        absl::StrCat("-o ", out, ": the extension must be .vts, .vtm, .x, .xyz or .cgns", also));
   }
   // Checked before a call that stores something (offset), so a typo does not leave a grid
   // stored and its file unwritten.

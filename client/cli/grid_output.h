@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "client/cli/cgns_output.h"
 #include "client/cli/eval_output.h"
 #include "client/client.h"
@@ -17,8 +18,9 @@ namespace splinegrid::cli {
 
 // OK when `out` ends in an extension WriteGridOutput writes (.vts, .vtm, .x, .xyz, .cgns) and
 // its directory exists; INVALID_ARGUMENT (extension) or NOT_FOUND (directory) naming it
-// otherwise. Checked before any call, so a bad -o fails before the work is done.
-absl::Status CheckGridOutput(const std::string& out);
+// otherwise. Checked before any call, so a bad -o fails before the work is done. `also` is
+// appended to the list of extensions in the message (eval: ", or .pvd with --steps A:B").
+absl::Status CheckGridOutput(const std::string& out, absl::string_view also = "");
 
 // Writes `result` to `out` by its extension: .cgns with WriteCgnsOutput (boundary conditions and
 // connectivity from `cgns`, points only when it is null), the others with WriteEvaluation

@@ -321,7 +321,12 @@ TEST_F(FormatsOutputTest, DeviationLeavesNoTemporaryFiles) {
   EXPECT_EQ(bad.exit_code, 1) << bad.out;
   EXPECT_THAT(bad.out, HasSubstr("--deviation: "));
   EXPECT_THAT(bad.out, HasSubstr("set TMPDIR"));
-  EXPECT_FALSE(std::filesystem::exists(Path("e.vts")));
+  EXPECT_FALSE(std::filesystem::exists(
+      Path("e.vts")));  // An extension eval does not write: the list names the series too.
+  const Result txt = Cli("eval naca --level=0 -o out.txt");
+  EXPECT_EQ(txt.exit_code, 2) << txt.out;
+  EXPECT_THAT(txt.out, HasSubstr("-o out.txt: the extension must be .vts, .vtm, .x, .xyz or "
+                                 ".cgns, or .pvd with --steps A:B"));
 }
 
 // offset -o goes through eval's writers: the same extensions (.vtm and .cgns too), checked
