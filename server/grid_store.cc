@@ -48,6 +48,9 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
     return absl::InvalidArgumentError(absl::StrCat(field, " = ", number, " is negative"));
   }
   if (step) {
+    if (*step < 0) {
+      return absl::InvalidArgumentError(absl::StrCat("step = ", *step, " is negative"));
+    }
     if (number != 0) {
       return absl::InvalidArgumentError(
           absl::StrCat(field, " = ", number, " and step = ", *step, " are both given; give one"));

@@ -46,6 +46,10 @@ absl::Status Validate(const DeformRequest& request) {
     return absl::InvalidArgumentError(absl::StrCat("check_level = ", request.check_level,
                                                    " is outside [0, ", kMaxDeformCheckLevel, "]"));
   }
+  if (request.step < 0) {  // looked up by its number later (ResolveRevision refuses < 0)
+    return absl::InvalidArgumentError(
+        absl::StrCat("step = ", request.step, " is negative (a time step number: 0 or more)"));
+  }
   if (!std::isfinite(request.time)) {
     return absl::InvalidArgumentError(absl::StrCat("time = ", request.time, " is not finite"));
   }

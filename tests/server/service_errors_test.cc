@@ -277,6 +277,19 @@ TEST_F(ServiceErrorsTest, RevisionsResolveAlikeInEveryCall) {
   stale_base.mutable_rigid()->set_angle_degrees(1.0);
   EXPECT_THAT(client_->Deform(stale_base).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, "base_revision = -2 is negative"));
+  // A negative time step is refused when stored and when looked up (it was stored as given,
+  // and then could not be found by it).
+  v1::DeformGridRequest negative_step;
+  negative_step.set_name("naca");
+  negative_step.set_step(-5);
+  negative_step.mutable_rigid()->set_angle_degrees(1.0);
+  EXPECT_THAT(client_->Deform(negative_step).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "step = -5 is negative"));
+  v1::EvaluateGridRequest by_step;
+  by_step.set_name("naca");
+  by_step.set_step(-1);
+  EXPECT_THAT(client_->Evaluate(by_step).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "step = -1 is negative"));
 }
 
 TEST_F(ServiceErrorsTest, UnfittedGridHasNoRevisionToEvaluate) {
