@@ -1,17 +1,20 @@
 #include "core/deform/rigid_motion.h"
 
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 
 namespace splinegrid {
 
 absl::Status RigidMotion::Validate() const {
-  for (int c = 0; c < 3; ++c) {
-    if (!std::isfinite(center[c]) || !std::isfinite(axis[c]) || !std::isfinite(translation[c])) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("motion: center, axis and translation must be finite; coordinate ", c,
-                       " is ", center[c], ", ", axis[c], ", ", translation[c]));
+  for (const auto& [field, vector] :
+       {std::pair{"center", &center}, {"axis", &axis}, {"translation", &translation}}) {
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite((*vector)[c])) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("motion: ", field, "[", c, "] = ", (*vector)[c], " is not finite"));
+      }
     }
   }
   if (!std::isfinite(angle)) {

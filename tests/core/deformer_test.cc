@@ -350,6 +350,12 @@ TEST(DeformerTest, BadInputIsAnErrorNamingIt) {
   const Deformer deformer = Deformer::Create(f.blocks, f.kinds, DeformOptions()).value();
   RigidMotion nan = Pitch(std::nan(""));
   EXPECT_THAT(deformer.Rigid(nan).status().message(), HasSubstr("angle = nan"));
+  // The vector and its coordinate are named (a C API user saw "coordinate 0 is 0.25, 0, inf").
+  RigidMotion far;
+  far.center = {0.25, 0.0, 0.0};
+  far.translation = {INFINITY, 0.0, 0.0};
+  EXPECT_THAT(deformer.Rigid(far).status().message(),
+              HasSubstr("motion: translation[0] = inf is not finite"));
   RigidMotion no_axis;
   no_axis.axis = {0, 0, 0};
   EXPECT_EQ(deformer.Rigid(no_axis).status().code(), absl::StatusCode::kInvalidArgument);
