@@ -265,8 +265,20 @@ absl::Status ValidateLayerStack(int layers, double first_height, double distance
   return absl::OkStatus();
 }
 
+absl::Status ValidateMarchedGrowth(int layers, double first_height, double distance) {
+  if (const double ratio = GeometricRatio(first_height, distance, layers);
+      !(ratio <= kMaxGrowthRatio)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("distance = ", distance, " needs a growth ratio of ", ratio,
+                     " between layers (", layers, " layers from first_height = ", first_height,
+                     "), above ", kMaxGrowthRatio, "; use more layers or a larger first_height"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status OffsetOptions::Validate() const {
   SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
+  SG_RETURN_IF_ERROR(ValidateMarchedGrowth(layers, first_height, distance));
   if (normal_smoothing < 0 || !(fairing >= 0.0) || !std::isfinite(fairing) ||
       !(uniformity >= 0.0 && uniformity <= 1.0) ||
       !(min_segment_ratio > 0.0 && min_segment_ratio < 1.0) || max_retries < 0 ||

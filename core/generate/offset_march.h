@@ -79,9 +79,19 @@ absl::StatusOr<OffsetGrid> MarchOffsets(const WallLoop& wall, const OffsetOption
 // The most layers a stack may have.
 inline constexpr int kMaxLayers = 100000;
 
+// The largest growth ratio between consecutive marched layers: beyond it a layer is more than 10
+// times the one below (and a far field of 1e300 overflowed the steps). The algebraic methods
+// (transfinite, elliptic) take any stack.
+inline constexpr double kMaxGrowthRatio = 10.0;
+
 // OK for a stack of 1 .. kMaxLayers layers growing from first_height to add up to distance (both
 // positive, finite, distance >= layers * first_height); INVALID_ARGUMENT naming the field.
 absl::Status ValidateLayerStack(int layers, double first_height, double distance);
+
+// OK when a stack of `layers` from `first_height` reaching `distance` grows by at most
+// kMaxGrowthRatio per layer (GeometricRatio); INVALID_ARGUMENT naming distance, the ratio and
+// the way out otherwise. For the marched methods (MarchOffsets, OffsetSurfaceGrid).
+absl::Status ValidateMarchedGrowth(int layers, double first_height, double distance);
 
 }  // namespace splinegrid
 

@@ -635,9 +635,8 @@ absl::Status FoldedLayerError(const March& m, const CellCheck& check, int k, dou
   if (held_back > 0.0) {
     return absl::FailedPreconditionError(absl::StrCat(
         "distance = ", options.distance, " is not reachable on the concave side: layer ", k + 1,
-        " folds at ", cell,
-        " while the curvature limit (max_curvature_step = ", options.max_curvature_step,
-        ") holds its steps up to ", held_back,
+        " folds at ", cell, " while the curvature limit (max_curvature_step = ",
+        options.max_curvature_step, ") holds its steps up to ", held_back,
         " short; lower the distance, or, if the surface is a fit within a tolerance, march off an "
         "interpolating fit of its points (FitGrid without tolerances), which follows them "
         "exactly"));
@@ -800,13 +799,7 @@ absl::Status SurfaceOffsetOptions::Validate() const {
                                                    " cannot reach distance = ", distance,
                                                    ": one layer is first_height high"));
   }
-  if (const double ratio = GeometricRatio(first_height, distance, layers);
-      !(ratio <= kMaxGrowthRatio)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("distance = ", distance, " needs a growth ratio of ", ratio,
-                     " between layers (", layers, " layers from first_height = ", first_height,
-                     "), above ", kMaxGrowthRatio, "; use more layers or a larger first_height"));
-  }
+  SG_RETURN_IF_ERROR(ValidateMarchedGrowth(layers, first_height, distance));
   if (side != 1 && side != -1) {
     return absl::InvalidArgumentError(absl::StrCat("side = ", side, " is neither +1 nor -1"));
   }

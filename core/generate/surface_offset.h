@@ -93,9 +93,6 @@ namespace splinegrid {
 // than this smooth a grid's normals flat; each retry smooths 2 * attempt sweeps more.
 inline constexpr int kMaxNormalSmoothing = 1000;
 inline constexpr int kMaxRetries = 100;
-// The largest growth ratio between consecutive layers: beyond it a layer is more than 10 times
-// the one below (and a far field of 1e300 overflowed the steps).
-inline constexpr double kMaxGrowthRatio = 10.0;
 
 struct SurfaceOffsetOptions {
   int layers = 32;
@@ -130,7 +127,7 @@ struct SurfaceOffsetOptions {
 
   // OK, or INVALID_ARGUMENT naming the field and its value: a layer stack as offset_march.h's
   // ValidateLayerStack, one layer exactly first_height high, a growth ratio of at most
-  // kMaxGrowthRatio, options in range.
+  // kMaxGrowthRatio (offset_march.h), options in range.
   absl::Status Validate() const;
 };
 

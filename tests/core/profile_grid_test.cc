@@ -444,6 +444,19 @@ TEST(ProfileGridTest, BadInputNamesTheField) {
   o.first_height = 0.1;
   o.distance = 5.0;
   EXPECT_THAT(error(naca, o).message(), HasSubstr("below layers x first_height"));
+  // A far field the marched layers cannot reach at a sane growth is refused by name; it folded
+  // at layer 68 with a step of 8e155.
+  o = ProfileGridOptions();
+  o.distance = 1e300;
+  EXPECT_THAT(error(naca, o).message(),
+              HasSubstr("distance = 1e+300 needs a growth ratio of 252.093 between layers (128 "
+                        "layers from first_height = 1e-05), above 10"));
+  // With the default lengths unset, a stack that cannot reach says what the defaults were.
+  o = ProfileGridOptions();
+  o.layers = 60000;  // 60000 x 1e-5 chord = 0.6, above 0.5
+  o.distance = 0.5;
+  EXPECT_THAT(error(naca, o).message(),
+              HasSubstr("unset lengths default to 1e-05 and 50 of the profile's chord"));
   o = ProfileGridOptions();
   o.wall_points = 4;
   EXPECT_THAT(error(naca, o).message(), HasSubstr("wall_points = 4"));
