@@ -40,6 +40,9 @@ absl::Status Fit(const Args& args) {
   const std::string& path = args[0];
   SG_ASSIGN_OR_RETURN(const v1::FitSpec spec, SpecFromFlags());
   SG_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
+  if (bytes.empty()) {  // the server would name only its header field, total_bytes = 0
+    return absl::InvalidArgumentError(absl::StrCat(path, " is empty: no grid to fit"));
+  }
   const std::string id =
       absl::GetFlag(FLAGS_name).empty() ? IdFromPath(path) : absl::GetFlag(FLAGS_name);
   auto client = Connect();

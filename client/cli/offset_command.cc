@@ -12,6 +12,7 @@
 #include "client/cli/grid_output.h"
 #include "client/cli/output.h"
 #include "client/client.h"
+#include "core/io/airfoil.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"
 
@@ -44,6 +45,9 @@ absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& req
     request.set_grid_id(name.empty() ? IdFromPath(argument) : client::GridName(name).substr(6));
     request.set_display_name(std::filesystem::path(argument).filename().string());
     SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(argument));
+    // Parsed here too, so that a bad file is named by its path (the server knows only the
+    // request's field, airfoil_file).
+    SG_RETURN_IF_ERROR(ParseAirfoil(request.airfoil_file(), argument).status());
     return absl::OkStatus();
   }
   const std::string surface = client::GridName(argument);

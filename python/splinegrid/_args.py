@@ -56,10 +56,18 @@ def _grid_id(grid_id: str) -> str:
 
 
 def _read_bytes(path_or_bytes: PathOrBytes) -> memoryview:
+    """The bytes given, or a file's; ValueError when there are none (the server would name
+    only its header field, total_bytes = 0)."""
     if isinstance(path_or_bytes, (bytes, bytearray, memoryview)):
-        return memoryview(path_or_bytes).cast("B")
-    with open(path_or_bytes, "rb") as file:
-        return memoryview(file.read())
+        data = memoryview(path_or_bytes).cast("B")
+        what = "the bytes given are"
+    else:
+        with open(path_or_bytes, "rb") as file:
+            data = memoryview(file.read())
+        what = f"{os.fspath(path_or_bytes)} is"
+    if len(data) == 0:
+        raise ValueError(f"{what} empty: no grid to import")
+    return data
 
 
 def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:

@@ -187,6 +187,17 @@ def test_import_points_refuses_one_bare_array(keeping):
     assert fake.uploads == []
 
 
+def test_empty_files_are_refused_before_the_call(keeping, tmp_path):
+    fake, client = keeping
+    with pytest.raises(ValueError, match="the bytes given are empty: no grid to import"):
+        client.import_plot3d(b"", grid_id="e")
+    empty = tmp_path / "empty.cgns"
+    empty.write_bytes(b"")
+    with pytest.raises(ValueError, match=r"empty.cgns is empty: no grid to import"):
+        client.import_cgns(empty, grid_id="e")
+    assert fake.uploads == []
+
+
 def test_list_follows_every_page(keeping):
     fake, client = keeping
     assert [g.name for g in client.list()] == [f"grids/{g}" for g in "abcde"]

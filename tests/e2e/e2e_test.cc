@@ -240,6 +240,18 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   EXPECT_EQ(nan_edge.exit_code, 2) << nan_edge.out;
   EXPECT_THAT(nan_edge.out, HasSubstr("edge = nan"));
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/nan-edge")));
+  // Files named by their path: an empty grid file, and a profile with a bad number (the server
+  // knows only its request fields, total_bytes and airfoil_file).
+  const std::string empty = (dir_ / "empty.fmt").string();
+  ASSERT_TRUE(WriteFileAtomically(empty, "").ok());
+  const Result nothing = Cli(absl::StrCat("fit ", empty, " --kinds"));
+  EXPECT_EQ(nothing.exit_code, 2) << nothing.out;
+  EXPECT_THAT(nothing.out, HasSubstr(absl::StrCat(empty, " is empty: no grid to fit")));
+  const std::string nanfoil = (dir_ / "nanfoil.dat").string();
+  ASSERT_TRUE(WriteFileAtomically(nanfoil, "nanfoil\n1 0\nnan 0.1\n0 0\n1 0\n").ok());
+  const Result bad_profile = Cli(absl::StrCat("offset ", nanfoil));
+  EXPECT_EQ(bad_profile.exit_code, 2) << bad_profile.out;
+  EXPECT_THAT(bad_profile.out, HasSubstr(absl::StrCat("airfoil '", nanfoil, "': line 3")));
 }
 
 // Flag values the request cannot carry as given are refused by name (exit 2), not read as
