@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"
@@ -212,6 +213,14 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
         result = absl::Status(result.code(),
                               absl::StrCat(result.message(), " [attempt ", attempts,
                                            "; the earlier ones failed with UNAVAILABLE]"));
+      }
+      // A TLS server closes a plaintext connection at once; say what that usually means.
+      if (absl::IsUnavailable(result) && !options_.use_tls &&
+          absl::StrContains(result.message(), "Socket closed")) {
+        result = absl::Status(
+            result.code(), absl::StrCat(result.message(),
+                                        " (the server closed the connection: if it uses TLS, "
+                                        "give its CA: --tls_ca, ClientOptions.tls_root_certs)"));
       }
       return result;
     }
