@@ -149,7 +149,9 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                          max(1, int(self.retry.initial_backoff * 1000))),
                         ("grpc.max_reconnect_backoff_ms",
                          max(1, int(self.retry.max_backoff * 1000)))]
-        if tls or tls_ca is not None or tls_cert is not None or tls_server_name is not None:
+        self._tls = (tls or tls_ca is not None or tls_cert is not None
+                     or tls_server_name is not None)
+        if self._tls:
             credentials = grpc.ssl_channel_credentials(
                 root_certificates=_read_pem(tls_ca, "tls_ca"),
                 private_key=_read_pem(tls_key, "tls_key"),
@@ -222,6 +224,12 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                         translated = SplinegridError(
                             translated.code, f"{translated.message} [attempt {attempts}; the "
                             "earlier ones failed with UNAVAILABLE]")
+                    if (translated.code == "UNAVAILABLE" and not self._tls
+                            and "Socket closed" in translated.message):
+                        # A TLS server closes a plaintext connection at once.
+                        translated = SplinegridError(
+                            translated.code, f"{translated.message} (the server closed the "
+                            "connection: if it uses TLS, give its CA: tls_ca=)")
                     raise translated from error
             self._pause_before_retry(wait)
 

@@ -33,8 +33,6 @@ def _code(error: grpc.RpcError) -> grpc.StatusCode:
 
 
 @contextlib.contextmanager
-
-
 def _translated_errors() -> Iterator[None]:
     """grpc.RpcError -> SplinegridError (chained)."""
     try:

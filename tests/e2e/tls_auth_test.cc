@@ -196,10 +196,10 @@ TEST_F(TlsAuthTest, TlsRoundTripsAndAPlaintextClientFails) {
       "try:\n"
       "    client.Client(target, timeout=2, retry=client.RetryPolicy(max_attempts=1)).list()\n"
       "except client.SplinegridError as e:\n"
-      "    print('plaintext', e.code)\n");
+      "    print('plaintext', e.code, 'tls_ca=' in e.message)\n");
   EXPECT_EQ(python.exit_code, 0) << python.out;
   EXPECT_THAT(python.out, HasSubstr("grids 1"));
-  EXPECT_THAT(python.out, HasSubstr("plaintext UNAVAILABLE"));
+  EXPECT_THAT(python.out, HasSubstr("plaintext UNAVAILABLE True"));
 
   EXPECT_EQ(server.Stop(), 0) << server.Log();
   EXPECT_THAT(server.Log(), HasSubstr("splinegrid: TLS, no tokens"));
