@@ -46,11 +46,22 @@ elapsed() { awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }
 log() { echo "start.sh [$(elapsed) s]: $*" >&2; }
 die() {
   log "FAILED: $*"
+  # Every replica that has exited by now, not only the one being waited for (a busy port range
+  # fails several).
+  local r
+  for ((r = 0; r < ${#pids[@]}; r++)); do
+    if ! kill -0 "${pids[$r]}" 2>/dev/null; then
+      log "splinegrid replica $r has exited"
+      [[ " ${show_logs[*]} " == *" $RUN_DIR/logs/splinegrid-$r.log "* ]] ||
+          show_logs+=("$RUN_DIR/logs/splinegrid-$r.log")
+    fi
+  done
   for f in "${show_logs[@]}"; do [[ -s $f ]] && { echo "--- $f (last 20 lines)" >&2; tail -n 20 "$f" >&2; }; done
   RUN_DIR=$RUN_DIR "$here/stop.sh" >&2 || true
   exit 1
 }
 show_logs=()
+pids=()
 
 [[ $STORE == redis || $STORE == memory ]] || { echo "start.sh: STORE must be redis or memory" >&2; exit 2; }
 [[ -x $SPLINEGRID ]] || { echo "start.sh: no splinegrid binary at $SPLINEGRID (set SPLINEGRID)" >&2; exit 2; }
