@@ -68,9 +68,8 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   const std::vector<BoundaryMatch>& matches = grid.source->connectivity().matches;
   src->set_num_matches(static_cast<int>(matches.size()));
-  if (view == v1::GRID_VIEW_FULL) {
-    for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
-  }
+  // Every view: a writer of CGNS needs the connectivity without the nets (ListGrids drops it).
+  for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
   if (!grid.source->boundaries.empty()) {  // small: every view (the import notes are here)
     EncodeSourceBoundaries(grid.source->boundaries, src->mutable_boundaries());
   }

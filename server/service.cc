@@ -186,7 +186,9 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
     bool more = false;
     SG_ASSIGN_OR_RETURN(const auto page, state_->store->List(after, size == 0 ? 50 : size, &more));
     for (const auto& grid : page) {
-      SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response->add_grids()));
+      v1::Grid* listed = response->add_grids();
+      SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, listed));
+      listed->mutable_source()->clear_connectivity();  // num_matches says how many
     }
     if (more && !page.empty()) {
       response->set_next_page_token(absl::WebSafeBase64Escape(page.back()->id));

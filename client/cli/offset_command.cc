@@ -1,10 +1,12 @@
 // `splinegrid offset`: an O-grid generated around an airfoil file's profile, or a volume grid
 // marched off a stored surface grid (GenerateGrid).
 #include <filesystem>
+#include <optional>
 
 #include "absl/flags/flag.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "client/cli/cgns_output.h"
 #include "client/cli/command_util.h"
 #include "client/cli/commands.h"
 #include "client/cli/eval_output.h"
@@ -111,11 +113,16 @@ absl::Status Offset(const Args& args) {
                         client->Evaluate(evaluate, download.callback()));
     download.Done();
     const int64_t revision = result.revision;
-    // Points only, through eval's writers: no source layout (a generated grid has no file),
-    // parametric dimensions from the extents, no boundary conditions in a .cgns.
-    SG_ASSIGN_OR_RETURN(
-        const int64_t points,
-        WriteGridOutput(out, std::move(result), EvalGridFacts{}, EvalOutputOptions{}, nullptr));
+    // Through eval's writers: no source layout (a generated grid has no file), parametric
+    // dimensions from the extents; a .cgns carries the grid's connectivity (an O-grid's seam, a
+    // volume's block interfaces) as eval writes it.
+    std::optional<CgnsOutputContext> cgns;
+    if (IsCgnsPath(out)) {
+      SG_ASSIGN_OR_RETURN(cgns, FetchCgnsOutputContext(*client, evaluate));
+    }
+    SG_ASSIGN_OR_RETURN(const int64_t points,
+                        WriteGridOutput(out, std::move(result), EvalGridFacts{},
+                                        EvalOutputOptions{}, cgns ? &*cgns : nullptr));
     absl::StrAppend(&human, "wrote ", out, ": ", points, " points (revision ", revision, ")\n");
   }
   Print(human, response);

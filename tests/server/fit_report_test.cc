@@ -44,7 +44,7 @@ TEST_F(FitReportTest, FitByBoundaryKindMeetsEachKindsToleranceAndReportsIt) {
   EXPECT_GT(fit.blocks(0).quality().cells_checked(), 32 * 112 * (1 + 4 + 16) / 2);
   EXPECT_GT(fit.compression_ratio(), 1.5);
 
-  // The stored revision carries the same report; the FULL view lists the connectivity.
+  // The stored revision carries the same report, and the grid its connectivity.
   const v1::Grid grid = client_->Get("naca", 0, v1::GRID_VIEW_FULL).value();
   EXPECT_EQ(grid.revision().report().SerializeAsString(), report.SerializeAsString());
   EXPECT_EQ(grid.source().num_matches(), report.num_matches());
@@ -54,10 +54,15 @@ TEST_F(FitReportTest, FitByBoundaryKindMeetsEachKindsToleranceAndReportsIt) {
   EXPECT_EQ(cut.b().block(), 0);
   EXPECT_EQ(cut.a().face(), v1::BLOCK_FACE_J_MIN);
   EXPECT_THAT(cut.description(), ::testing::HasSubstr("reversed"));
-  // The basic view counts the matches without listing them.
+  // The basic view lists them too (a CGNS writer needs them without the nets: a large grid's
+  // FULL view is over the message limit); a listing only counts them.
   const v1::Grid basic = client_->Get("naca").value();
   EXPECT_EQ(basic.source().num_matches(), report.num_matches());
-  EXPECT_EQ(basic.source().connectivity_size(), 0);
+  EXPECT_EQ(basic.source().connectivity_size(), report.num_matches());
+  const std::vector<v1::Grid> listed = client_->List().value();
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].source().num_matches(), report.num_matches());
+  EXPECT_EQ(listed[0].source().connectivity_size(), 0);
 }
 
 TEST_F(FitReportTest, FairGridAddsAFairedRevisionWithinTheSameTolerances) {
