@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <optional>
+#include <string>
+#include <tuple>
 #include <vector>
 
 #include "absl/flags/flag.h"
@@ -21,6 +23,29 @@
 #include "proto/convert/convert.h"
 
 namespace splinegrid::cli {
+
+namespace {
+
+// --res and --box give a value for every direction of the grid (its largest parametric
+// dimension): left out, a 2-D grid's j read as one point (--res 10: a line of 10 points at
+// j = 0) or as the range 0:0 (--box 0:5), without a word.
+absl::Status CheckEveryDirectionGiven(const EvalGridFacts& facts, const std::string& name) {
+  int dims = 1;
+  for (const auto& [block, dim] : facts.parametric_dim) dims = std::max(dims, dim);
+  for (const auto& [flag, text, what] : {std::tuple{"res", absl::GetFlag(FLAGS_res), "counts"},
+                                         std::tuple{"box", absl::GetFlag(FLAGS_box), "ranges"}}) {
+    if (text.empty()) continue;
+    const int given = static_cast<int>(std::vector<std::string>(absl::StrSplit(text, ',')).size());
+    if (given < dims) {
+      return Usage(absl::StrCat("--", flag, " = '", text, "' gives ", given, " of the ", dims,
+                                " directions of ", name, ": give ", dims, " ", what, " (i,j",
+                                dims == 3 ? ",k" : "", ")"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
 
 absl::Status Eval(const Args& args) {
   const std::string out = absl::GetFlag(FLAGS_o);
@@ -80,6 +105,7 @@ absl::Status Eval(const Args& args) {
     auto series_client = Connect();
     SG_ASSIGN_OR_RETURN(const EvalGridFacts facts,
                         FetchEvalFacts(*series_client, request, eval_options));
+    SG_RETURN_IF_ERROR(CheckEveryDirectionGiven(facts, args[0]));
     SG_ASSIGN_OR_RETURN(const std::string summary,
                         RunEvalSeries(*series_client, request, out, facts, eval_options));
     std::fwrite(summary.data(), 1, summary.size(), stdout);
@@ -95,6 +121,7 @@ absl::Status Eval(const Args& args) {
   EvalGridFacts facts;  // VTK and Plot3D outputs (eval_output.h)
   if (!cgns) {
     SG_ASSIGN_OR_RETURN(facts, FetchEvalFacts(*client, request, eval_options));
+    SG_RETURN_IF_ERROR(CheckEveryDirectionGiven(facts, args[0]));
   }
   ProgressLine download("evaluate");
   SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client->Evaluate(request, download.callback()));

@@ -269,6 +269,11 @@ TEST_F(EndToEndTest, CliRefusesValuesThatWouldReadAsUnset) {
   ASSERT_EQ(Cli(absl::StrCat("fit ", grid, " --name=flags --kinds")).exit_code, 0);
   refused(absl::StrCat("eval flags --res=0,0 -o ", out), "0 points in direction i");
   refused(absl::StrCat("eval flags --res=40,0 -o ", out), "0 points in direction j");
+  // A direction left out of --res or --box read as one point or the range 0:0.
+  refused(absl::StrCat("eval flags --res=10 -o ", out),
+          "--res = '10' gives 1 of the 2 directions of flags: give 2 counts (i,j)");
+  refused(absl::StrCat("eval flags --level=0 --box=0:5 -o ", out),
+          "--box = '0:5' gives 1 of the 2 directions of flags: give 2 ranges (i,j)");
   refused(absl::StrCat("eval flags --level=-3 -o ", out), "--level = -3 is negative");
   refused("curvature flags --level=-3", "--level = -3 is negative");
   refused("list --timeout=-5s", "--timeout = -5s is not a positive duration");
