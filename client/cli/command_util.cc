@@ -230,12 +230,23 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   return spec;
 }
 
-absl::Status FoldsStored(const std::string& name, const v1::FitGridResponse& fit) {
-  if (fit.report().folded_cells() == 0) return absl::OkStatus();
-  absl::Status status = absl::FailedPreconditionError(absl::StrCat(
-      name, " revision ", fit.revision(), " was stored with ", fit.report().folded_cells(),
-      " folded sub-cells (--allow_folds); do not use it as a valid grid"));
-  return WithExitCode(std::move(status), kExitQualityNotMet);
+absl::Status StoredNotAsAsked(const std::string& name, const v1::FitGridResponse& fit) {
+  const v1::FitReport& report = fit.report();
+  if (report.folded_cells() > 0) {
+    return WithExitCode(
+        absl::FailedPreconditionError(absl::StrCat(
+            name, " revision ", fit.revision(), " was stored with ", report.folded_cells(),
+            " folded sub-cells (--allow_folds); do not use it as a valid grid")),
+        kExitQualityNotMet);
+  }
+  if (report.tolerances_given() && !report.tolerance_met()) {
+    return WithExitCode(
+        absl::FailedPreconditionError(
+            absl::StrCat(name, " revision ", fit.revision(),
+                         " was stored, but its tolerances are NOT met: ", report.unmet_reason())),
+        kExitQualityNotMet);
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace splinegrid::cli

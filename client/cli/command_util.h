@@ -60,10 +60,11 @@ absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag();
 // The FitSpec of the fit flags.
 absl::StatusOr<v1::FitSpec> SpecFromFlags();
 
-// After a stored fit: FAILED_PRECONDITION with exit status kExitQualityNotMet (3) when
-// --allow_folds let the server store a revision whose cells fold (its report says quality_met =
-// false), so that a script cannot mistake it for a good grid, nor for a call that failed (1).
-absl::Status FoldsStored(const std::string& name, const v1::FitGridResponse& fit);
+// After a stored fit: FAILED_PRECONDITION with exit status kExitQualityNotMet (3) when the
+// server stored a revision that is not what was asked: its cells fold (--allow_folds let it), or
+// it misses its tolerances (a control cap held it back), so that a script cannot mistake it for
+// a good grid, nor for a call that failed (1).
+absl::Status StoredNotAsAsked(const std::string& name, const v1::FitGridResponse& fit);
 
 }  // namespace splinegrid::cli
 

@@ -81,7 +81,7 @@ absl::Status Fit(const Args& args) {
     return fit.status();
   }
   Print(FormatFit(grid.name(), *fit), *fit);
-  return FoldsStored(grid.name(), *fit);
+  return StoredNotAsAsked(grid.name(), *fit);
 }
 
 absl::Status Fair(const Args& args) {
@@ -93,7 +93,7 @@ absl::Status Fair(const Args& args) {
       Connect()->Fair(args[0], absl::GetFlag(FLAGS_revision), fairing ? &*fairing : nullptr,
                       absl::GetFlag(FLAGS_allow_folds)));
   Print(FormatFit(client::GridName(args[0]), fit), fit);
-  return FoldsStored(client::GridName(args[0]), fit);
+  return StoredNotAsAsked(client::GridName(args[0]), fit);
 }
 
 }  // namespace splinegrid::cli

@@ -126,7 +126,7 @@ absl::Status Offset(const Args& args) {
     absl::StrAppend(&human, "wrote ", out, ": ", points, " points (revision ", revision, ")\n");
   }
   Print(human, response);
-  return FoldsStored(response.grid().name(), response.fit());
+  return StoredNotAsAsked(response.grid().name(), response.fit());
 }
 
 }  // namespace splinegrid::cli

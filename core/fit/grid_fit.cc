@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -190,6 +192,38 @@ std::string FoldAdvice(const GridFitOptions& options) {
          "counts or a tolerance";
 }
 
+// Tolerances below kResolvableUlps units in the last place of the grid's largest coordinate
+// cannot be met or measured: a fit to 1e-300 was stored with every tolerance missed ("inf times
+// its tolerance"). INVALID_ARGUMENT naming the field (and the reference length it came from).
+constexpr double kResolvableUlps = 8.0;
+
+absl::Status CheckResolvable(const MultiBlockGrid& grid, const GridFitOptions& options,
+                             const BoundaryTolerances& tolerances,
+                             const ReferenceLength& reference) {
+  double largest = 0.0;
+  for (const StructuredBlock& block : grid.blocks) {
+    for (double v : block.coords()) largest = std::max(largest, std::abs(v));
+  }
+  const double floor = kResolvableUlps * std::numeric_limits<double>::epsilon() * largest;
+  const std::pair<const char*, double> kinds[] = {{"wall", tolerances.wall},
+                                                  {"interface", tolerances.interface},
+                                                  {"outer", tolerances.outer},
+                                                  {"interior", tolerances.interior}};
+  for (const auto& [kind, value] : kinds) {
+    if (!(value < floor)) continue;
+    const std::string field =
+        options.tolerance ? std::string("tolerance") : absl::StrCat("boundary_tolerances.", kind);
+    const std::string scaled =
+        !options.tolerance && options.relative_kinds != 0
+            ? absl::StrCat(" (with the reference length ", reference.length, ")")
+            : std::string();
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, " = ", value, scaled, " is below what double precision resolves in this grid ",
+        "(coordinates up to ", largest, "): give at least ", floor));
+  }
+  return absl::OkStatus();
+}
+
 // FitGrid once the options are valid and every block fittable (ValidateGridFit, or a
 // FittableGrid).
 absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectivity& connectivity,
@@ -207,9 +241,11 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
   CellQualityOptions quality = options.quality;
   quality.cancel = cancel;
   if (options.tolerance_mode()) {
-    SG_ASSIGN_OR_RETURN(internal::MultiBlockRun run,
-                        internal::FitMultiBlock(grid, connectivity, result.kinds, options,
-                                                options.Tolerances(reference.length), cancel));
+    const BoundaryTolerances tolerances = options.Tolerances(reference.length);
+    SG_RETURN_IF_ERROR(CheckResolvable(grid, options, tolerances, reference));
+    SG_ASSIGN_OR_RETURN(
+        internal::MultiBlockRun run,
+        internal::FitMultiBlock(grid, connectivity, result.kinds, options, tolerances, cancel));
     result = std::move(run.fit);
   } else {
     SG_RETURN_IF_ERROR(FitBlocks(grid, connectivity, options, cancel, result));

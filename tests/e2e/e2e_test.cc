@@ -281,6 +281,15 @@ TEST_F(EndToEndTest, CliRefusesValuesThatWouldReadAsUnset) {
           "closer than double precision separates");
   EXPECT_EQ(Cli(absl::StrCat("eval flags --res=40,20 -o ", out)).exit_code, 0);
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("order0")));
+  // A tolerance double precision cannot resolve is refused; one a control cap holds the fit
+  // back from is stored, but not as asked: exit 3, as for stored folds (it exited 0).
+  refused(absl::StrCat("fit ", grid, " --name=tiny --tol=1e-300"),
+          "tolerance = 1e-300 is below what double precision resolves");
+  const Result capped = Cli(absl::StrCat("fit ", SharedDataPath("surfaces/m6_small.fmt"),
+                                         " --name=capped --tol=1e-6 --max_ctl=12"));
+  EXPECT_EQ(capped.exit_code, 3) << capped.out;
+  EXPECT_THAT(capped.out, HasSubstr("grids/capped revision 1 was stored, but its tolerances are "
+                                    "NOT met"));
 }
 
 TEST_F(EndToEndTest, PythonExampleFitsAndRefines) {

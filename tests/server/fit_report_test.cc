@@ -202,6 +202,23 @@ TEST_F(FitReportTest, AnImpossibleToleranceIsReportedNotLooped) {
   EXPECT_LE(grid.revision().blocks(0).directions(0).num_controls(), 20);
 }
 
+// A tolerance double precision cannot resolve in the grid is refused, naming the field: a fit
+// to 1e-300 was stored with every tolerance missed ("inf times its tolerance").
+TEST_F(FitReportTest, AnUnresolvableToleranceIsRefused) {
+  v1::FitSpec spec;
+  spec.set_tolerance(1e-300);
+  EXPECT_THAT(client_->Fit("naca", spec).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "tolerance = 1e-300 is below what double precision resolves in this grid"));
+  v1::FitSpec relative;
+  relative.mutable_boundary_tolerances();
+  relative.set_reference_length(1e-300);
+  EXPECT_THAT(client_->Fit("naca", relative).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "boundary_tolerances.wall = 1.5e-304 (with the reference length 1e-300)"));
+  EXPECT_EQ(client_->Get("naca").value().latest_revision(), 0);  // nothing stored
+}
+
 // A fit whose deadline passes stops at the next poll of the refinement loop: DEADLINE_EXCEEDED,
 // no revision, the work's memory back, the server still answering.
 TEST_F(FitReportTest, ALongFitHonoursItsDeadline) {
