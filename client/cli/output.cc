@@ -189,7 +189,9 @@ std::string FormatReport(const v1::FitReport& r, bool interpolating) {
     absl::StrAppend(&out, absl::StrFormat("  fairing weight %.3g\n", r.fairing_weight()));
   }
   if (r.has_unfaired_wall_curvature()) {
-    absl::StrAppend(&out, FormatCurvatureLine("walls unfaired", r.unfaired_wall_curvature()));
+    // The same knots without the fairing (not the parent revision, whose knots differ).
+    absl::StrAppend(
+        &out, FormatCurvatureLine("walls, same knots unfaired", r.unfaired_wall_curvature()));
   }
   if (r.wall_curvature().lines() > 0) {
     absl::StrAppend(&out, FormatCurvatureLine("walls", r.wall_curvature()));

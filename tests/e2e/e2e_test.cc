@@ -325,7 +325,7 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
   const Result fair = Cli("fair coarse");
   ASSERT_EQ(fair.exit_code, 0) << fair.out;
   EXPECT_THAT(fair.out, HasSubstr("revision 2"));
-  EXPECT_THAT(fair.out, HasSubstr("walls unfaired"));
+  EXPECT_THAT(fair.out, HasSubstr("walls, same knots unfaired"));
   const std::string csv = (dir_ / "wall.csv").string();
   const Result curvature = Cli(absl::StrCat("curvature coarse --revision=1 -o ", csv));
   ASSERT_EQ(curvature.exit_code, 0) << curvature.out;
