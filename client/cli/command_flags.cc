@@ -91,7 +91,7 @@ std::vector<CommandSpec> MakeCommands() {
       {"eval",
        "eval NAME (--level L | --res a,b,c) [--revision R | --step N | --steps A:B] [--block b] "
        "[--box i0:i1,j0:j1[,k0:k1]] [--dist DIR=KIND,...] [--derivs] [--float32] "
-       "-o OUT.{vts,vtm,x,xyz,pvd}",
+       "-o OUT.{vts,vtm,x,xyz,cgns,pvd}",
        "evaluate a revision at a refinement level or resolution into a file",
        /*client=*/true,
        {"o", "level", "res", "revision", "step", "block", "box", "dist", "derivs", "float32",

@@ -81,7 +81,9 @@ ABSL_FLAG(std::string, o, "",
 ABSL_FLAG(bool, derivs, false,
           "eval: also dX/du, dX/dv[, dX/dw] (VTK point arrays; with .x/.xyz a Plot3D function "
           "file NAME.f beside it)");
-ABSL_FLAG(bool, float32, false, "eval: transfer single precision");
+ABSL_FLAG(bool, float32, false,
+          "eval: transfer single precision (values rounded to float; .cgns stores them as float, "
+          "the other files as double)");
 ABSL_FLAG(
     std::string, steps, "",
     "eval: a:b, the deformed revisions of time steps a to b as a ParaView series (-o NAME.pvd)");

@@ -266,6 +266,11 @@ absl::Status ValidateLayerStack(int layers, double first_height, double distance
 }
 
 absl::Status ValidateMarchedGrowth(int layers, double first_height, double distance) {
+  if (layers == 1 && distance > first_height * (1.0 + 1e-12)) {  // no ratio reaches it
+    return absl::InvalidArgumentError(absl::StrCat("layers = 1 with first_height = ", first_height,
+                                                   " cannot reach distance = ", distance,
+                                                   ": one layer is first_height high"));
+  }
   if (const double ratio = GeometricRatio(first_height, distance, layers);
       !(ratio <= kMaxGrowthRatio)) {
     return absl::InvalidArgumentError(

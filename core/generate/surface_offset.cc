@@ -794,11 +794,6 @@ absl::Status FitSurfaceBlocks(const MultiBlockGrid& surface, const SurfaceTopolo
 
 absl::Status SurfaceOffsetOptions::Validate() const {
   SG_RETURN_IF_ERROR(ValidateLayerStack(layers, first_height, distance));
-  if (layers == 1 && distance > first_height * (1.0 + 1e-12)) {
-    return absl::InvalidArgumentError(absl::StrCat("layers = 1 with first_height = ", first_height,
-                                                   " cannot reach distance = ", distance,
-                                                   ": one layer is first_height high"));
-  }
   SG_RETURN_IF_ERROR(ValidateMarchedGrowth(layers, first_height, distance));
   if (side != 1 && side != -1) {
     return absl::InvalidArgumentError(absl::StrCat("side = ", side, " is neither +1 nor -1"));

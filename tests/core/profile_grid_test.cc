@@ -451,6 +451,10 @@ TEST(ProfileGridTest, BadInputNamesTheField) {
   EXPECT_THAT(error(naca, o).message(),
               HasSubstr("distance = 1e+300 needs a growth ratio of 252.093 between layers (128 "
                         "layers from first_height = 1e-05), above 10"));
+  o = ProfileGridOptions();
+  o.layers = 1;  // it said "a growth ratio of inf"
+  EXPECT_THAT(error(naca, o).message(),
+              HasSubstr("layers = 1 with first_height = 1e-05 cannot reach distance = 50"));
   // With the default lengths unset, a stack that cannot reach says what the defaults were.
   o = ProfileGridOptions();
   o.layers = 60000;  // 60000 x 1e-5 chord = 0.6, above 0.5
