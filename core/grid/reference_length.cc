@@ -5,10 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "core/util/union_find.h"
 
 namespace splinegrid {
@@ -186,11 +188,11 @@ void JoinCoinciding(const std::vector<Point3>& points, const Point3& lo, double 
 // when every wall is a single point.
 ReferenceLength LargestWall(const WallPoints& w, UnionFind& joined, double diagonal) {
   std::map<int, std::vector<Point3>> members;
-  std::map<int, int> first_block;
+  std::map<int, std::set<int>> blocks;  // of each wall
   for (size_t p = 0; p < w.points.size(); ++p) {
     const int root = static_cast<int>(joined.Find(static_cast<int64_t>(p)));
     members[root].push_back(w.points[p]);
-    first_block.try_emplace(root, w.point_block[p]);
+    blocks[root].insert(w.point_block[p]);
   }
   // In the order of the walls' first points, so that ties resolve the same way every time.
   std::vector<int> roots;
@@ -206,10 +208,14 @@ ReferenceLength LargestWall(const WallPoints& w, UnionFind& joined, double diago
   r.length = best.length;
   r.source = ReferenceLengthSource::kWall;
   const size_t count = members[best_root].size();
+  const std::set<int>& from = blocks[best_root];
   r.description = absl::StrFormat(
-      "the largest extent of %d wall%s: %d points from block %d, from %s to %s%s", roots.size(),
-      roots.size() == 1 ? "" : "s", count, first_block[best_root], FormatPoint(best.from, w.dim),
-      FormatPoint(best.to, w.dim),
+      "the largest extent of %d wall%s: %d points from %s, from %s to %s%s", roots.size(),
+      roots.size() == 1 ? "" : "s", count,
+      from.size() == 1   ? absl::StrCat("block ", *from.begin())
+      : from.size() <= 8 ? absl::StrCat(from.size(), " blocks (", absl::StrJoin(from, ", "), ")")
+                         : absl::StrCat(from.size(), " blocks"),
+      FormatPoint(best.from, w.dim), FormatPoint(best.to, w.dim),
       best.exact ? "" : " (farthest-point estimate: a lower bound of the diameter)");
   if (!(r.length > 0.0)) {
     // Every wall a single point: the bounding box.

@@ -87,6 +87,8 @@ TEST(ReferenceLengthTest, LargestOfSeparateWallsAndJoinedAcrossBlocks) {
   EXPECT_EQ(r.source, ReferenceLengthSource::kWall);
   EXPECT_NEAR(r.length, 5.0, 1e-12) << r.description;
   EXPECT_THAT(r.description, HasSubstr("of 2 walls"));
+  // The joined wall's points come from both blocks (it said "from block 0").
+  EXPECT_THAT(r.description, HasSubstr("18 points from 2 blocks (0, 1)"));
 }
 
 TEST(ReferenceLengthTest, ScaleTolerancesScalesOnlyTheRelativeKinds) {
