@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -132,9 +133,18 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
     lo[x % s] = std::min(lo[x % s], coords[x]);
     hi[x % s] = std::max(hi[x % s], coords[x]);
   }
-  double diagonal = 0.0;
+  double diagonal = 0.0, widest = 0.0;
   for (int c = 0; c < s; ++c) diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  for (int c = 0; c < s; ++c) widest = std::max(widest, hi[c] - lo[c]);
   diagonal = std::sqrt(diagonal);
+  // Lengths whose squares underflow (the fit's normal equations and distances square them): a
+  // grid in units of 1e-300 read as "all points equal".
+  if (widest > 0.0 && widest < std::sqrt(std::numeric_limits<double>::min())) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": the coordinates are too small to measure the block (its bounding box spans ",
+        widest, "; squares of lengths below ", std::sqrt(std::numeric_limits<double>::min()),
+        " underflow): scale the grid to its length unit"));
+  }
   if (!std::isfinite(diagonal)) {
     return absl::InvalidArgumentError(
         absl::StrCat(what,

@@ -1,12 +1,13 @@
 // FittableGrid: a grid checked and matched once (the service does it when a grid arrives) fits
 // exactly like the same grid given as points, in both modes; the check refuses what FitGrid
 // refuses, naming the block, and its connectivity options are the ones used.
+#include "core/grid/fittable_grid.h"
+
 #include <algorithm>
 #include <span>
 
 #include "core/fit/grid_fit.h"
 #include "core/grid/connectivity.h"
-#include "core/grid/fittable_grid.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -77,6 +78,11 @@ TEST(FittableGridTest, TheCheckRefusesWhatCannotBeFittedNamingTheBlock) {
   huge.blocks[0].coords()[9] = -1e300;
   EXPECT_THAT(FittableGrid::Check(huge).status().message(),
               HasSubstr("block 0: the coordinates are too large to measure the block"));
+  // Nor a grid whose lengths' squares underflow (a valid grid in units of 1e-300).
+  MultiBlockGrid tiny = Naca();
+  for (double& v : tiny.blocks[0].coords()) v *= 1e-300;
+  EXPECT_THAT(FittableGrid::Check(tiny).status().message(),
+              HasSubstr("block 0: the coordinates are too small to measure the block"));
 
   EXPECT_THAT(FittableGrid::Check(MultiBlockGrid()).status().message(), HasSubstr("no blocks"));
   EXPECT_FALSE(FitGrid(FittableGrid(), GridFitOptions()).ok());
