@@ -50,7 +50,8 @@ ABSL_FLAG(double, interface, 0.0, "fit: block interface tolerance (implies --kin
 ABSL_FLAG(double, outer, 0.0, "fit: outer boundary tolerance (implies --kinds; 0: default)");
 ABSL_FLAG(double, interior, 0.0, "fit: tolerance inside blocks (implies --kinds; 0: none)");
 ABSL_FLAG(double, edge, -1.0,
-          "fit: relative accuracy of grid edges inside blocks (implies --kinds; <0: default 0.5)");
+          "fit: relative accuracy of grid edges inside blocks, in (0, 1]: the error of an edge "
+          "vector over its length (implies --kinds; 0: off; <0: default 0.5)");
 ABSL_FLAG(std::string, fair, "",
           "fit/fair: fairing: 'tol' (largest weight within the tolerances) or a weight lambda");
 ABSL_FLAG(std::string, face, "",

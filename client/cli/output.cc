@@ -146,9 +146,14 @@ double SizeRatio(const v1::CellQualityReport& q) {
   return q.min_ratio() > 0.0 ? std::max(q.max_ratio(), 1.0 / q.min_ratio()) : q.max_ratio();
 }
 
+// A block's cell figure, or "-" for a block without cells (a curve, a point).
+std::string CellFigure(const v1::CellQualityReport& q, double value) {
+  return q.cells_checked() > 0 ? absl::StrFormat("%.3g", value) : "-";
+}
+
 }  // namespace
 
-std::string FormatReport(const v1::FitReport& r, bool interpolating) {
+std::string FormatReport(const v1::FitReport& r, bool interpolating, bool has_cells) {
   std::string out;
   if (!r.tolerances_given()) {
     absl::StrAppend(&out, interpolating
@@ -172,11 +177,16 @@ std::string FormatReport(const v1::FitReport& r, bool interpolating) {
                                                 "of it"
                                               : ""));
   }
-  absl::StrAppend(&out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original "
-                                        "cells folded or resized beyond 2x; worst Jacobian ratio "
-                                        "%.3g, largest size ratio %.3g\n",
-                                        r.folded_cells(), r.bad_cells(), r.min_jacobian_ratio(),
-                                        r.max_size_ratio()));
+  if (has_cells) {
+    absl::StrAppend(
+        &out, absl::StrFormat("  cells at levels 0-2: %d folded sub-cells, %d original cells "
+                              "folded or resized beyond 2x; worst Jacobian ratio %.3g, largest "
+                              "size ratio %.3g\n",
+                              r.folded_cells(), r.bad_cells(), r.min_jacobian_ratio(),
+                              r.max_size_ratio()));
+  } else {  // the ratios would read 0, as if every cell were degenerate
+    absl::StrAppend(&out, "  cells: none (a curve or a point)\n");
+  }
   absl::StrAppend(&out, absl::StrFormat("  connectivity: %d matches, largest gap %.3g\n",
                                         r.num_matches(), r.max_gap()));
   if (r.iterations() > 0 || r.knots_inserted() > 0) {
@@ -190,8 +200,8 @@ std::string FormatReport(const v1::FitReport& r, bool interpolating) {
   }
   if (r.has_unfaired_wall_curvature()) {
     // The same knots without the fairing (not the parent revision, whose knots differ).
-    absl::StrAppend(
-        &out, FormatCurvatureLine("walls, same knots unfaired", r.unfaired_wall_curvature()));
+    absl::StrAppend(&out,
+                    FormatCurvatureLine("walls, same knots unfaired", r.unfaired_wall_curvature()));
   }
   if (r.wall_curvature().lines() > 0) {
     absl::StrAppend(&out, FormatCurvatureLine("walls", r.wall_curvature()));
@@ -209,7 +219,10 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   absl::StrAppend(&out, "  deviation: ",
                   kinds.empty() ? absl::StrFormat("max %.3g", fit.max_deviation()) : kinds,
                   fit.report().tolerances_given() ? "" : " (no tolerance given)", "\n");
-  absl::StrAppend(&out, FormatReport(fit.report(), fit.num_control_points() == fit.num_points()));
+  int64_t cells = 0;
+  for (const v1::BlockFitSummary& block : fit.blocks()) cells += block.quality().cells_checked();
+  absl::StrAppend(
+      &out, FormatReport(fit.report(), fit.num_control_points() == fit.num_points(), cells > 0));
   absl::StrAppend(
       &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %8s %8s %6s\n", "block",
                             "points", "controls", "ratio", "max dev", "wall", "interface", "outer",
@@ -220,11 +233,11 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
     const v1::CellQualityReport& q = s.quality();
     absl::StrAppend(
         &out, absl::StrFormat(
-                  "%6d %10d %9d %7.1f %10.3g %10s %10s %10s %10s %8.3g %8.3g %6d%s\n", b,
+                  "%6d %10d %9d %7.1f %10.3g %10s %10s %10s %10s %8s %8s %6d%s\n", b,
                   s.num_points(), s.num_control_points(), s.compression_ratio(), s.max_deviation(),
                   Optional(k.has_wall(), k.wall()), Optional(k.has_interface(), k.interface()),
                   Optional(k.has_outer(), k.outer()), Optional(k.has_interior(), k.interior()),
-                  q.min_ratio(), SizeRatio(q), q.num_bad_cells(),
+                  CellFigure(q, q.min_ratio()), CellFigure(q, SizeRatio(q)), q.num_bad_cells(),
                   s.has_tolerance_met() && !s.tolerance_met()
                       ? absl::StrCat("  TOLERANCE NOT MET: ", s.unmet_reason())
                       : ""));

@@ -45,8 +45,9 @@ std::string FormatDeformReport(const v1::DeformReport& report);
 std::string FormatRevisionLine(const v1::RevisionInfo& revision);
 
 // The fit report's grid-wide lines (tolerances, quality, connectivity, fairing, curvature);
-// `interpolating`: a control point per grid point (said when no tolerance was given).
-std::string FormatReport(const v1::FitReport& report, bool interpolating);
+// `interpolating`: a control point per grid point (said when no tolerance was given);
+// `has_cells`: some block has cells (a curve or a point has none, and no cell figures).
+std::string FormatReport(const v1::FitReport& report, bool interpolating, bool has_cells = true);
 
 // Wall curvature metrics, and where the samples were written (if anywhere).
 std::string FormatCurvature(const std::string& name, const v1::GetWallCurvatureResponse& curvature,

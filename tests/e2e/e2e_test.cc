@@ -180,6 +180,14 @@ TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
   EXPECT_THAT(box.out, HasSubstr("tolerances: none given (interpolating: a control per point)"));
   // Nothing is a fraction of the reference length when no tolerance applies.
   EXPECT_THAT(box.out, ::testing::Not(HasSubstr("fractions of it")));
+  // A curve has no cells: no cell figures (they read 0, as if every cell were degenerate).
+  const std::string curve = (dir_ / "curve.p2d").string();
+  ASSERT_TRUE(
+      WriteFileAtomically(curve, "1\n5 1\n0 0.25 0.5 0.75 1\n0 0.0625 0.25 0.5625 1\n").ok());
+  const Result line = Cli(absl::StrCat("fit ", curve, " --name=curve"));
+  ASSERT_EQ(line.exit_code, 0) << line.out;
+  EXPECT_THAT(line.out, HasSubstr("cells: none (a curve or a point)"));
+  EXPECT_THAT(line.out, ::testing::Not(HasSubstr("worst Jacobian ratio")));
 
   const Result tol = Cli(absl::StrCat("fit ", SharedDataPath("grids/rae2822_257x97.fmt"),
                                       " --name=rae --tol=1e-3 --json"));
