@@ -34,7 +34,8 @@ absl::StatusOr<GridFitOptions> FairOptions(const GridRevision& parent, const Fai
   } else {
     return absl::InvalidArgumentError(
         absl::StrCat("fairing is unset and revision ", parent.number,
-                     " was fitted with control counts: give a fairing weight (mode WEIGHT)"));
+                     " was fitted with control counts: give a fairing weight (fairing.mode WEIGHT "
+                     "with fairing.weight; CLI fair --fair LAMBDA)"));
   }
   if (options.fairing.mode == FairingMode::kOff) {
     return absl::InvalidArgumentError("fairing.mode = OFF; FairGrid needs WEIGHT or TO_TOLERANCE");
