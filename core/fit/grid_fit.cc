@@ -169,6 +169,57 @@ absl::Status ValidateGridFit(const MultiBlockGrid& grid, const GridFitOptions& o
   return absl::OkStatus();
 }
 
+// The source cells of no thickness along a direction (every edge of the cell along it has zero
+// length: a grid line repeated), which any spline through the points folds, so that the fold
+// refusal blames the data, not the fit: "" when there are none, else a sentence naming the count
+// and the first. (A pole, a grid edge collapsed to a point, is no such cell: the edges across
+// it have length.) O(points).
+std::string RepeatedLines(const MultiBlockGrid& grid) {
+  int64_t count = 0;
+  std::string first;
+  for (size_t b = 0; b < grid.blocks.size(); ++b) {
+    const StructuredBlock& block = grid.blocks[b];
+    const Extents n = block.extents();
+    const int s = block.spatial_dim();
+    auto same = [&](const Extents& p, const Extents& q) {
+      return std::equal(block.Point(p[0], p[1], p[2]), block.Point(p[0], p[1], p[2]) + s,
+                        block.Point(q[0], q[1], q[2]));
+    };
+    for (int k = 0; k < std::max(n[2] - 1, 1); ++k) {
+      for (int j = 0; j < std::max(n[1] - 1, 1); ++j) {
+        for (int i = 0; i < std::max(n[0] - 1, 1); ++i) {
+          const Extents cell = {i, j, k};
+          bool flat = false;
+          for (int d = 0; d < 3 && !flat; ++d) {
+            if (n[d] < 2) continue;
+            flat = true;  // until an edge along d has length
+            for (int corner = 0; corner < 8 && flat; ++corner) {
+              Extents p = cell;
+              bool inside = true;
+              for (int e = 0; e < 3; ++e) {
+                if (e == d || !((corner >> e) & 1)) continue;
+                if (n[e] < 2) inside = false;
+                ++p[e];
+              }
+              if (!inside || ((corner >> d) & 1)) continue;
+              Extents q = p;
+              ++q[d];
+              flat = same(p, q);
+            }
+          }
+          if (!flat) continue;
+          if (count++ == 0) first = absl::StrCat("block ", b, " cell (", i, ", ", j, ", ", k, ")");
+        }
+      }
+    }
+  }
+  if (count == 0) return "";
+  return absl::StrCat(". The points themselves have ", count,
+                      " cells of no thickness (a grid line repeated), the first ", first,
+                      ": no spline through them can avoid folding there; remove the repeated "
+                      "lines");
+}
+
 // What a caller can do about a fit of `options` that folds (it is not repaired unless in the
 // tolerance mode: repairing would change the counts, or what is interpolated, silently).
 std::string FoldAdvice(const GridFitOptions& options) {
@@ -278,7 +329,7 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
     if (!folds.empty()) {
       return absl::FailedPreconditionError(
           absl::StrCat("the fitted grid folds at refinement levels 0..", quality.max_level, ": ",
-                       absl::StrJoin(folds, "; "), FoldAdvice(options),
+                       absl::StrJoin(folds, "; "), RepeatedLines(grid), FoldAdvice(options),
                        ", or set allow_folds to accept the folded grid"));
     }
   }

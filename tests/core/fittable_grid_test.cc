@@ -88,6 +88,28 @@ TEST(FittableGridTest, TheCheckRefusesWhatCannotBeFittedNamingTheBlock) {
   EXPECT_FALSE(FitGrid(FittableGrid(), GridFitOptions()).ok());
 }
 
+// A grid line repeated in the points (j = 6 a copy of j = 5) makes cells of no area that any
+// spline through them folds: the refusal says the points cause it (it blamed the fit alone).
+// A pole (a polar disk's collapsed edge) is no such cell; collapsed_edges_test.cc fits one.
+TEST(FittableGridTest, AFoldFromARepeatedGridLineBlamesThePoints) {
+  MultiBlockGrid grid = Naca();
+  StructuredBlock& block = grid.blocks[0];
+  for (int i = 0; i < block.extent(0); ++i) {
+    std::copy_n(block.Point(i, 5, 0), 2, block.Point(i, 6, 0));
+  }
+  const absl::Status refused = FitGrid(grid, GridFitOptions()).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.message(),
+              HasSubstr("The points themselves have 224 cells of no thickness (a grid line "
+                        "repeated), the first block 0 cell (0, 5, 0)"));
+  // Without the repeated line, a fold refusal does not mention it.
+  GridFitOptions counts;
+  counts.control_counts = {12, 8, 1};
+  const absl::Status folded = FitGrid(Naca(), counts).status();
+  ASSERT_EQ(folded.code(), absl::StatusCode::kFailedPrecondition) << folded;
+  EXPECT_THAT(folded.message(), ::testing::Not(HasSubstr("no thickness")));
+}
+
 TEST(FittableGridTest, ItsConnectivityOptionsAreTheOnesUsed) {
   // Matches must join at least 1000 points: the wake cut (33) is ignored, so the checked grid
   // has no match, and a fit of it shares no boundary.
