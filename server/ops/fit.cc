@@ -24,6 +24,29 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> FitAndPublish(
   return stored->revisions.back();
 }
 
+// FairGrid refits the grid's imported points with a revision's spec: a deformed revision's
+// geometry is not in them, so fairing it would silently undo the deformation (it did: the
+// "faired" latest revision was the undeformed grid). FAILED_PRECONDITION naming the fitted
+// revision the deformations start from.
+absl::Status CheckFairable(const StoredGrid& grid, const GridRevision& revision) {
+  if (revision.origin != RevisionOrigin::kDeform) return absl::OkStatus();
+  int64_t fitted = revision.parent;
+  for (int hops = 0; hops < 1000; ++hops) {  // walk the deformations back to their fit
+    const absl::StatusOr<std::shared_ptr<const GridRevision>> up = grid.ResolveRevision(fitted);
+    if (!up.ok() || (*up)->origin != RevisionOrigin::kDeform) break;
+    fitted = (*up)->parent;
+  }
+  return absl::FailedPreconditionError(absl::StrCat(
+      "grids/", grid.id, " revision ", revision.number,
+      " is deformed: FairGrid refits the grid's imported points, which do not carry the "
+      "deformation, so the faired grid would undo it; fair revision ",
+      fitted, " (the fit the deformations start from) and deform that"));
+}
+
+bool SameFairing(const FairingOptions& a, const FairingOptions& b) {
+  return a.mode == b.mode && (a.mode != FairingMode::kWeight || a.weight == b.weight);
+}
+
 // The options of refairing `parent` as `request` asks.
 absl::StatusOr<GridFitOptions> FairOptions(const GridRevision& parent, const FairRequest& request) {
   GridFitOptions options = parent.fit_options;
@@ -99,7 +122,15 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Fair(const OpsContext& conte
   SG_RETURN_IF_ERROR(context.MayChange(grid->owner, request.grid_id, "fairing"));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> parent,
                       grid->ResolveRevision(request.revision));
+  SG_RETURN_IF_ERROR(CheckFairable(*grid, *parent));
   SG_ASSIGN_OR_RETURN(const GridFitOptions options, FairOptions(*parent, request));
+  if (parent->origin == RevisionOrigin::kFair &&
+      SameFairing(parent->fit_options.fairing, options.fairing)) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "grids/", request.grid_id, " revision ", parent->number,
+        " is faired already, as asked: fairing it again would store the same grid (fair revision ",
+        parent->parent, " with another fairing instead)"));
+  }
   return FitAndPublish(context, *grid, options, RevisionOrigin::kFair, parent->number, cancel);
 }
 

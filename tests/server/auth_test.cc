@@ -225,7 +225,7 @@ TEST_F(AuthTest, AWriterChangesOnlyItsOwnGridsAndAnAdminAny) {
 
   EXPECT_EQ(alice->Deform(deform).value().revision(), 2);
   EXPECT_EQ(admin->Deform(deform).value().revision(), 3);
-  EXPECT_TRUE(admin->Fair("alices", 0, nullptr, true).ok());
+  EXPECT_TRUE(admin->Fair("alices", 1, nullptr, true).ok());  // the fit, not a deformed one
 }
 
 TEST_F(AuthTest, AReloadChangesRolesAndABadFileKeepsThem) {

@@ -325,6 +325,18 @@ TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
   EXPECT_EQ(client_->Fair("naca", 1, &fairing).value().revision(), 8);
   EXPECT_EQ(client_->Deform(Pitch("naca", 7.0, 7)).value().revision(), 9);
   EXPECT_THAT(numbers(), ::testing::ElementsAre(1, 6, 7, 8, 9));
+  // Fairing refits the imported points: a deformed revision is refused, naming the fit the
+  // deformations start from (it stored the undeformed grid as the latest revision), and so is
+  // fairing a faired revision again as it was faired (it stored the same grid again).
+  EXPECT_THAT(client_->Fair("naca", 0, &fairing).status(),
+              StatusIs(absl::StatusCode::kFailedPrecondition,
+                       "grids/naca revision 9 is deformed: FairGrid refits the grid's imported "
+                       "points, which do not carry the deformation, so the faired grid would "
+                       "undo it; fair revision 1"));
+  EXPECT_THAT(client_->Fair("naca", 8, &fairing).status(),
+              StatusIs(absl::StatusCode::kFailedPrecondition,
+                       "revision 8 is faired already, as asked"));
+  EXPECT_THAT(numbers(), ::testing::ElementsAre(1, 6, 7, 8, 9));  // nothing stored
 }
 
 }  // namespace
