@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -167,6 +168,12 @@ absl::StatusOr<EvalGridFacts> FetchEvalFacts(client::Client& client,
   if (request.has_step()) get.set_step(request.step());
   SG_ASSIGN_OR_RETURN(const v1::Grid grid, client.Get(get));
   SG_ASSIGN_OR_RETURN(EvalGridFacts facts, EvalFactsFromGrid(grid));
+  if (options.deviation && grid.revision().origin() == v1::REVISION_ORIGIN_DEFORM) {
+    std::fprintf(stderr,
+                 "note: revision %lld is deformed: its deviation from the imported points is "
+                 "mostly the deformation\n",
+                 static_cast<long long>(grid.revision().revision()));
+  }
   if (options.deviation) {
     // The archive goes to a private directory (mkdtemp: mode 0700, an unpredictable name under
     // $TMPDIR), so that no other user can read, replace or pre-create it; the directory and

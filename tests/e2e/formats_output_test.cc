@@ -321,8 +321,17 @@ TEST_F(FormatsOutputTest, DeviationLeavesNoTemporaryFiles) {
   EXPECT_EQ(bad.exit_code, 1) << bad.out;
   EXPECT_THAT(bad.out, HasSubstr("--deviation: "));
   EXPECT_THAT(bad.out, HasSubstr("set TMPDIR"));
-  EXPECT_FALSE(std::filesystem::exists(
-      Path("e.vts")));  // An extension eval does not write: the list names the series too.
+  EXPECT_FALSE(
+      std::filesystem::exists(Path("e.vts")));  // Of a deformed revision the deviation is mostly
+                                                // the deformation, and eval says so.
+  ASSERT_EQ(Cli("deform naca --rotate 2 --about 0.25,0").exit_code, 0);
+  const Result deformed = Shell(absl::StrCat("TMPDIR=", Path("tmp"), " ", eval,
+                                             " --revision=2 "
+                                             "-o dd.vts"));
+  EXPECT_EQ(deformed.exit_code, 0) << deformed.out;
+  EXPECT_THAT(deformed.out, HasSubstr("note: revision 2 is deformed: its deviation from the "
+                                      "imported points is mostly the deformation"));
+  // An extension eval does not write: the list names the series too.
   const Result txt = Cli("eval naca --level=0 -o out.txt");
   EXPECT_EQ(txt.exit_code, 2) << txt.out;
   EXPECT_THAT(txt.out, HasSubstr("-o out.txt: the extension must be .vts, .vtm, .x, .xyz or "
