@@ -138,7 +138,8 @@ class _GenerateCalls(_Calls):
         ``wall_points``, even ``layers``),
         ``wall_points`` (257; the first repeated as the last), ``layers`` (128 cells outward),
         ``first_height`` (in the profile's unit; 1e-5 of its chord), ``distance`` (of the
-        outer boundary from the wall; 50 chords), ``orthogonalize`` (transfinite: lines leave the wall normally; True),
+        outer boundary from the wall; 50 chords), ``orthogonalize`` (transfinite: lines leave
+        the wall normally; True),
         ``fit_tolerance`` (of the profile spline to the points, in their unit; default 1e-4 of
         the profile's chord).
 
