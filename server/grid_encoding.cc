@@ -48,7 +48,7 @@ void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
 }
 
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
-                        const std::vector<int>& blocks, v1::Grid* out) {
+                        const std::vector<int>& blocks, v1::Grid* out, bool with_connectivity) {
   out->set_name(absl::StrCat("grids/", grid.id));
   out->set_display_name(grid.display_name);
   out->set_owner(grid.owner);
@@ -68,8 +68,10 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   const std::vector<BoundaryMatch>& matches = grid.source->connectivity().matches;
   src->set_num_matches(static_cast<int>(matches.size()));
-  // Every view: a writer of CGNS needs the connectivity without the nets (ListGrids drops it).
-  for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
+  // GetGrid, every view: a writer of CGNS needs the connectivity without the nets.
+  if (with_connectivity) {
+    for (const BoundaryMatch& m : matches) EncodeBoundaryMatch(m, src->add_connectivity());
+  }
   if (!grid.source->boundaries.empty()) {  // small: every view (the import notes are here)
     EncodeSourceBoundaries(grid.source->boundaries, src->mutable_boundaries());
   }
@@ -129,9 +131,13 @@ absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView v
   }
   const int64_t bytes = static_cast<int64_t>(out->ByteSizeLong());
   if (bytes > kMaxMessageBytes) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        "the FULL view of grids/", grid.id, " is ", bytes >> 10,
-        " KiB, over the 4 MiB message limit; ask for fewer blocks at a time (field blocks)"));
+    return absl::ResourceExhaustedError(
+        full ? absl::StrCat("the FULL view of grids/", grid.id, " is ", bytes >> 10,
+                            " KiB, over the 4 MiB message limit; ask for fewer blocks at a time "
+                            "(field blocks)")
+             : absl::StrCat("the description of grids/", grid.id, " is ", bytes >> 10, " KiB (",
+                            matches.size(), " matched boundary ranges, ", rev.blocks.size(),
+                            " blocks), over the 4 MiB message limit"));
   }
   return absl::OkStatus();
 }

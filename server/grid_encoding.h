@@ -15,10 +15,12 @@ namespace splinegrid::server {
 inline constexpr int64_t kMaxMessageBytes = (int64_t{4} << 20) - (64 << 10);
 
 // Fills `out` with `grid` and its revision `revision` (0: latest; none before the first fit).
-// FULL view adds knots, control points and distributions of `blocks` (empty: all); a result
-// over kMaxMessageBytes is RESOURCE_EXHAUSTED, naming the size and suggesting `blocks`.
+// FULL view adds knots, control points and distributions of `blocks` (empty: all);
+// `with_connectivity` the source's matches (GetGrid, every view; other responses count them). A
+// result over kMaxMessageBytes is RESOURCE_EXHAUSTED, naming the size and what to ask for.
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,
-                        const std::vector<int>& blocks, v1::Grid* out);
+                        const std::vector<int>& blocks, v1::Grid* out,
+                        bool with_connectivity = false);
 
 // One entry of a grid's revision history (time and step for deformed revisions only).
 void EncodeRevisionInfo(const RevisionSummary& revision, v1::RevisionInfo* out);

@@ -157,7 +157,8 @@ grpc::ServerUnaryReactor* SplineGridService::GetGrid(grpc::CallbackServerContext
                           grid->ResolveRevision(revision, OptionalStep(*request)));
       revision = found->number;
     }
-    return EncodeGrid(*grid, revision, request->view(), blocks, response);
+    return EncodeGrid(*grid, revision, request->view(), blocks, response,
+                      /*with_connectivity=*/true);
   };
   // Encoding a FULL view copies control nets: pool work; the basic view is a lookup.
   if (request->view() == v1::GRID_VIEW_FULL) {
@@ -186,9 +187,7 @@ grpc::ServerUnaryReactor* SplineGridService::ListGrids(grpc::CallbackServerConte
     bool more = false;
     SG_ASSIGN_OR_RETURN(const auto page, state_->store->List(after, size == 0 ? 50 : size, &more));
     for (const auto& grid : page) {
-      v1::Grid* listed = response->add_grids();
-      SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, listed));
-      listed->mutable_source()->clear_connectivity();  // num_matches says how many
+      SG_RETURN_IF_ERROR(EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response->add_grids()));
     }
     if (more && !page.empty()) {
       response->set_next_page_token(absl::WebSafeBase64Escape(page.back()->id));

@@ -72,6 +72,13 @@ absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, client::Evaluate
     SG_ASSIGN_OR_RETURN(
         const SourceBoundaries boundaries,
         ParseSourceBoundaries(source.boundaries(), options.source_extents, "source.boundaries"));
+    if (source.connectivity_size() != source.num_matches()) {  // an older server sent none
+      return absl::FailedPreconditionError(
+          absl::StrCat("-o *.cgns: the server listed ", source.connectivity_size(),
+                       " of the grid's ", source.num_matches(),
+                       " matched boundary ranges; the file would lack connectivity "
+                       "(write .vtm or .x, or update the server)"));
+    }
     v1::StoredConnectivity stored;
     *stored.mutable_matches() = source.connectivity();
     SG_ASSIGN_OR_RETURN(
