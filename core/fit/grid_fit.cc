@@ -327,9 +327,12 @@ absl::StatusOr<GridFit> FitValidated(const MultiBlockGrid& grid, const Connectiv
       if (!d.empty()) folds.push_back(std::move(d));
     }
     if (!folds.empty()) {
+      const std::string repeated = RepeatedLines(grid);
       return absl::FailedPreconditionError(
           absl::StrCat("the fitted grid folds at refinement levels 0..", quality.max_level, ": ",
-                       absl::StrJoin(folds, "; "), RepeatedLines(grid), FoldAdvice(options),
+                       absl::StrJoin(folds, "; "),
+                       // Repeated lines fold any fit: no other fit to suggest.
+                       repeated.empty() ? FoldAdvice(options) : repeated,
                        ", or set allow_folds to accept the folded grid"));
     }
   }

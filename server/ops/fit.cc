@@ -1,5 +1,8 @@
 #include "server/ops/fit.h"
 
+#include <optional>
+#include <string>
+
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 
@@ -30,21 +33,27 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> FitAndPublish(
 // revision the deformations start from.
 absl::Status CheckFairable(const StoredGrid& grid, const GridRevision& revision) {
   if (revision.origin != RevisionOrigin::kDeform) return absl::OkStatus();
-  int64_t fitted = revision.parent;
-  for (int hops = 0; hops < 1000; ++hops) {  // walk the deformations back to their fit
-    const absl::StatusOr<std::shared_ptr<const GridRevision>> up = grid.ResolveRevision(fitted);
-    if (!up.ok() || (*up)->origin != RevisionOrigin::kDeform) break;
-    fitted = (*up)->parent;
+  // Walk the deformations back to their fit; retention may have dropped a link.
+  std::optional<int64_t> fitted;
+  int64_t next = revision.parent;
+  for (int hops = 0; hops < 1000 && !fitted; ++hops) {
+    const absl::StatusOr<std::shared_ptr<const GridRevision>> up = grid.ResolveRevision(next);
+    if (!up.ok()) break;
+    if ((*up)->origin != RevisionOrigin::kDeform) fitted = (*up)->number;
+    next = (*up)->parent;
   }
   return absl::FailedPreconditionError(absl::StrCat(
       "grids/", grid.id, " revision ", revision.number,
       " is deformed: FairGrid refits the grid's imported points, which do not carry the "
-      "deformation, so the faired grid would undo it; fair revision ",
-      fitted, " (the fit the deformations start from) and deform that"));
+      "deformation, so the faired grid would undo it; fair ",
+      fitted ? absl::StrCat("revision ", *fitted) : std::string("the fitted revision"),
+      " (the fit the deformations start from) and deform that"));
 }
 
+// Whether two fairings give the same fit (the weight is the lambda, or the upper end of the
+// search to tolerance).
 bool SameFairing(const FairingOptions& a, const FairingOptions& b) {
-  return a.mode == b.mode && (a.mode != FairingMode::kWeight || a.weight == b.weight);
+  return a.mode == b.mode && (a.mode == FairingMode::kOff || a.weight == b.weight);
 }
 
 // The options of refairing `parent` as `request` asks.
@@ -124,12 +133,15 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Fair(const OpsContext& conte
                       grid->ResolveRevision(request.revision));
   SG_RETURN_IF_ERROR(CheckFairable(*grid, *parent));
   SG_ASSIGN_OR_RETURN(const GridFitOptions options, FairOptions(*parent, request));
-  if (parent->origin == RevisionOrigin::kFair &&
+  // A revision fitted or faired with this very fairing: the refit is the same grid.
+  if (parent->fit_options.fairing.mode != FairingMode::kOff &&
       SameFairing(parent->fit_options.fairing, options.fairing)) {
     return absl::FailedPreconditionError(absl::StrCat(
         "grids/", request.grid_id, " revision ", parent->number,
-        " is faired already, as asked: fairing it again would store the same grid (fair revision ",
-        parent->parent, " with another fairing instead)"));
+        " is faired already, as asked: fairing it again would store the same grid",
+        parent->origin == RevisionOrigin::kFair
+            ? absl::StrCat(" (fair revision ", parent->parent, " with another fairing instead)")
+            : std::string(" (give another fairing)")));
   }
   return FitAndPublish(context, *grid, options, RevisionOrigin::kFair, parent->number, cancel);
 }
