@@ -44,9 +44,10 @@ constexpr int kStallCycles = 20;
 // 700-850 coarse sweeps. So when the largest move has not fallen to a new low for
 // kStallSweeps sweeps, or a move is not finite, the iteration starts again from the initial grid
 // with omega times kRelaxationBackoff, down to kMinRelaxation (stalled cycles first go on as
-// relaxation alone, as above); a stall there ends it, not converged (the 30P30N slat at 256 layers:
-// points in the cove collapse at any omega; it went on for 20,000 sweeps, 74 s). A converging run
-// makes a new low nearly every sweep (the slow far-field mode too).
+// relaxation alone, as above); a stall there ends it, not converged, with the iterate nearest
+// convergence (BestIterate; the 30P30N slat at 256 layers: points in the cove collapse at any
+// omega; it went on for 20,000 sweeps, 74 s, and its last iterate had folded cells). A converging
+// run makes a new low nearly every sweep (the slow far-field mode too).
 constexpr int kStallSweeps = 50;
 constexpr double kRelaxationBackoff = 0.75;
 constexpr double kMinRelaxation = 0.5;
@@ -434,6 +435,24 @@ class StallWatch {
   double lowest_ = std::numeric_limits<double>::infinity();
 };
 
+// The iterate nearest convergence so far (the smallest largest move of a sweep), which an
+// unconverged run returns: its last iterate may be one whose points jump or collapse.
+class BestIterate {
+ public:
+  void Offer(double largest, const StructuredBlock& grid) {
+    if (!(largest < largest_)) return;
+    largest_ = largest;
+    coords_.assign(grid.coords().begin(), grid.coords().end());
+  }
+  void RestoreInto(StructuredBlock& grid) const {
+    if (!coords_.empty()) std::copy(coords_.begin(), coords_.end(), grid.coords().begin());
+  }
+
+ private:
+  double largest_ = std::numeric_limits<double>::infinity();
+  std::vector<double> coords_;
+};
+
 // The next, smaller omega after a stall, or nullopt below kMinRelaxation.
 std::optional<double> BackedOff(double omega) {
   const double next = omega * kRelaxationBackoff;
@@ -475,6 +494,7 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
   const int first = std::clamp(held_layers, 1, nj - 1);
   LineRelaxation relaxation(result.grid, control, first, options.relaxation);
   StallWatch watch(kStallSweeps);
+  BestIterate best;
   for (result.sweeps = 0; result.sweeps < options.max_sweeps && relaxation.rows() > 0;) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     ++result.sweeps;
@@ -483,6 +503,7 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
       result.converged = true;
       break;
     }
+    best.Offer(largest, result.grid);
     if (!std::isfinite(largest) || watch.Stalled(largest)) {
       const std::optional<double> damped = BackedOff(relaxation.omega());
       if (!damped) {
@@ -497,6 +518,7 @@ absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
       ++result.restarts;
     }
   }
+  if (!result.converged) best.RestoreInto(result.grid);
   result.relaxation = relaxation.omega();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -643,6 +665,7 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
   Level& fine = multigrid.level(0);
   bool cycling = multigrid.num_levels() > 1;
   StallWatch watch(cycling ? kStallCycles : kStallSweeps);
+  BestIterate best;
   while (fine.sweeps < options.max_sweeps && fine.relax.rows() > 0) {
     SG_RETURN_IF_ERROR(PollCancel(options.cancel));
     double largest = multigrid.Sweep(0);
@@ -659,6 +682,7 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
         break;
       }
     }
+    best.Offer(largest, fine.grid);
     if (std::isfinite(largest) && !watch.Stalled(largest)) continue;
     // Stalled or diverged: start again from the initial grid (the iterate can be a worse start
     // than that), within the same sweep budget: cycles by relaxation alone (the cycles' fixed
@@ -681,6 +705,7 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
     watch.Reset();
     ++result.restarts;
   }
+  if (!result.converged) best.RestoreInto(fine.grid);
   result.relaxation = multigrid.omega();
   result.sweeps = fine.sweeps;
   for (int l = 1; l < multigrid.num_levels(); ++l) {
@@ -739,9 +764,14 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
     }
   }
   // The fine level starts from the omega the coarse level ended with: one that had to be
-  // lowered there would stall the fine cycles too.
+  // lowered there would stall the fine cycles too. An unconverged coarse level is no guess: the
+  // fine level starts from the algebraic grid with the caller's omega.
   EllipticOptions fine_options = options;
-  fine_options.relaxation = out.coarse.relaxation;
+  if (out.coarse.converged) {
+    fine_options.relaxation = out.coarse.relaxation;
+  } else {
+    guess = algebraic;
+  }
   SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, algebraic, out.held_layers, fine_options));
   if (compare) {
     SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,

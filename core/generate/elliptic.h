@@ -103,7 +103,7 @@ struct EllipticResult {
 
 // Smooths `initial` with `control` (same points), holding layers 0 .. held_layers - 1 and the
 // outer loop. Not converging (within max_sweeps, or stalled at the smallest omega: file comment) is
-// reported (converged = false), not an error.
+// reported (converged = false), not an error; the grid is then the iterate nearest convergence.
 // Errors: INVALID_ARGUMENT for bad options or a grid that is not a periodic planar O-grid of at
 // least 5 x 3 points; FAILED_PRECONDITION if the iteration diverges; CANCELLED.
 absl::StatusOr<EllipticResult> SmoothElliptic(const StructuredBlock& initial,
