@@ -271,15 +271,20 @@ TEST(EllipticTest, MultigridSolvesTheFineEquations) {
   }
 }
 
+// The default elliptic grid around the shared airfoil `name` with `layers` layers.
+ProfileGrid EllipticGrid(const std::string& name, int layers) {
+  ProfileGridOptions options;
+  options.method = LayerMethod::kElliptic;
+  options.layers = layers;
+  return GenerateProfileGrid(Coordinates(name), options).value();
+}
+
 // Over-relaxation (omega 1.3) kept the points by the RAE 2822's sharp trailing edge jumping by
 // 10-1000 times their spacing once the stack was deep: at 320 layers neither level converged in
 // 20,000 sweeps (180 s; 512 layers took 277 s). A stall now starts the level again with a
 // smaller omega, and the fine level starts from the coarse level's.
 TEST(EllipticTest, AStallLowersTheRelaxationFactor) {
-  ProfileGridOptions options;
-  options.method = LayerMethod::kElliptic;
-  options.layers = 320;
-  const ProfileGrid grid = GenerateProfileGrid(Coordinates("rae2822"), options).value();
+  const ProfileGrid grid = EllipticGrid("rae2822", 320);
   EXPECT_TRUE(grid.elliptic_converged);
   EXPECT_GE(grid.elliptic_restarts, 1);
   EXPECT_LT(grid.elliptic_relaxation, EllipticOptions().relaxation);
@@ -293,10 +298,7 @@ TEST(EllipticTest, AStallLowersTheRelaxationFactor) {
 // went on for 20,000 sweeps and now stops after some hundred, with the iterate nearest
 // convergence (its last iterate had 122 folded cells).
 TEST(EllipticTest, AStallAtTheSmallestFactorEndsItUnconverged) {
-  ProfileGridOptions options;
-  options.method = LayerMethod::kElliptic;
-  options.layers = 512;
-  const ProfileGrid grid = GenerateProfileGrid(Coordinates("30p30n/30p30n_slat"), options).value();
+  const ProfileGrid grid = EllipticGrid("30p30n/30p30n_slat", 512);
   EXPECT_FALSE(grid.elliptic_converged);
   EXPECT_LT(grid.fine_sweeps, 2000);  // measured 330
   EXPECT_LT(grid.elliptic_relaxation, 0.6);
