@@ -45,8 +45,9 @@ constexpr int kStallCycles = 20;
 // kStallSweeps sweeps, or a move is not finite, the iteration starts again from the initial grid
 // with omega times kRelaxationBackoff, down to kMinRelaxation (stalled cycles first go on as
 // relaxation alone, as above); a stall there ends it, not converged, with the iterate nearest
-// convergence (BestIterate; the 30P30N slat at 256 layers: points in the cove collapse at any
-// omega; it went on for 20,000 sweeps, 74 s, and its last iterate had folded cells). A converging
+// convergence (BestIterate; the 30P30N slat at 256 and 512 layers: points in the cove collapse
+// at any omega; it went on for 20,000 sweeps, 74 s at 256, and at 512 its last iterate had 122
+// folded cells). A converging
 // run makes a new low nearly every sweep (the slow far-field mode too).
 constexpr int kStallSweeps = 50;
 constexpr double kRelaxationBackoff = 0.75;
