@@ -47,8 +47,8 @@ constexpr int kStallCycles = 20;
 // relaxation alone, as above); a stall there ends it, not converged, with the iterate nearest
 // convergence (BestIterate; the 30P30N slat at 256 and 512 layers: points in the cove collapse
 // at any omega; it went on for 20,000 sweeps, 74 s at 256, and at 512 its last iterate had 122
-// folded cells). A converging
-// run makes a new low nearly every sweep (the slow far-field mode too).
+// folded cells). A converging run makes a new low nearly every sweep (the slow far-field mode
+// too).
 constexpr int kStallSweeps = 50;
 constexpr double kRelaxationBackoff = 0.75;
 constexpr double kMinRelaxation = 0.5;
