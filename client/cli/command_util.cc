@@ -232,21 +232,18 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
 
 absl::Status StoredNotAsAsked(const std::string& name, const v1::FitGridResponse& fit) {
   const v1::FitReport& report = fit.report();
+  std::string what;
   if (report.folded_cells() > 0) {
-    return WithExitCode(
-        absl::FailedPreconditionError(absl::StrCat(
-            name, " revision ", fit.revision(), " was stored with ", report.folded_cells(),
-            " folded sub-cells (--allow_folds); do not use it as a valid grid")),
-        kExitQualityNotMet);
+    what = absl::StrCat("was stored with ", report.folded_cells(),
+                        " folded sub-cells (--allow_folds); do not use it as a valid grid");
+  } else if (report.tolerances_given() && !report.tolerance_met()) {
+    what = absl::StrCat("was stored, but its tolerances are NOT met: ", report.unmet_reason());
+  } else {
+    return absl::OkStatus();
   }
-  if (report.tolerances_given() && !report.tolerance_met()) {
-    return WithExitCode(
-        absl::FailedPreconditionError(
-            absl::StrCat(name, " revision ", fit.revision(),
-                         " was stored, but its tolerances are NOT met: ", report.unmet_reason())),
-        kExitQualityNotMet);
-  }
-  return absl::OkStatus();
+  return WithExitCode(
+      absl::FailedPreconditionError(absl::StrCat(name, " revision ", fit.revision(), " ", what)),
+      kExitQualityNotMet);
 }
 
 }  // namespace splinegrid::cli

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/bspline/line_arc_length.h"
+#include "core/grid/structured_grid.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -76,7 +77,7 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
   for (double x : spline.control()) scale = std::max(scale, std::abs(x));
   const double negligible = 1e-12 * scale;
   // Points nearer than this can round to the same coordinates: a few ulps of the largest one.
-  const double separable = 8.0 * std::numeric_limits<double>::epsilon() * scale;
+  const double separable = kResolvableUlps * std::numeric_limits<double>::epsilon() * scale;
   for (int c = 0; c < n[e2]; ++c) {
     for (int a = 0; a < n[e1]; ++a) {
       SG_RETURN_IF_ERROR(PollCancel(cancel));

@@ -181,34 +181,30 @@ std::string RepeatedLines(const MultiBlockGrid& grid) {
     const StructuredBlock& block = grid.blocks[b];
     const Extents n = block.extents();
     const int s = block.spatial_dim();
-    auto same = [&](const Extents& p, const Extents& q) {
-      return std::equal(block.Point(p[0], p[1], p[2]), block.Point(p[0], p[1], p[2]) + s,
-                        block.Point(q[0], q[1], q[2]));
+    // Whether the cell at `cell` has no edge of length along d: the points at both ends of each
+    // of its edges along d (2 in a surface, 4 in a volume) coincide.
+    auto flat_along = [&](const Extents& cell, int d) {
+      const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+      for (int a = 0; a <= (n[e1] > 1); ++a) {
+        for (int c = 0; c <= (n[e2] > 1); ++c) {
+          Extents p = cell;
+          p[e1] += a;
+          p[e2] += c;
+          const double* x = block.Point(p[0], p[1], p[2]);
+          ++p[d];
+          if (!std::equal(x, x + s, block.Point(p[0], p[1], p[2]))) return false;
+        }
+      }
+      return true;
     };
     for (int k = 0; k < std::max(n[2] - 1, 1); ++k) {
       for (int j = 0; j < std::max(n[1] - 1, 1); ++j) {
         for (int i = 0; i < std::max(n[0] - 1, 1); ++i) {
-          const Extents cell = {i, j, k};
           bool flat = false;
-          for (int d = 0; d < 3 && !flat; ++d) {
-            if (n[d] < 2) continue;
-            flat = true;  // until an edge along d has length
-            for (int corner = 0; corner < 8 && flat; ++corner) {
-              Extents p = cell;
-              bool inside = true;
-              for (int e = 0; e < 3; ++e) {
-                if (e == d || !((corner >> e) & 1)) continue;
-                if (n[e] < 2) inside = false;
-                ++p[e];
-              }
-              if (!inside || ((corner >> d) & 1)) continue;
-              Extents q = p;
-              ++q[d];
-              flat = same(p, q);
-            }
+          for (int d = 0; d < 3 && !flat; ++d) flat = n[d] > 1 && flat_along({i, j, k}, d);
+          if (flat && count++ == 0) {
+            first = absl::StrCat("block ", b, " cell (", i, ", ", j, ", ", k, ")");
           }
-          if (!flat) continue;
-          if (count++ == 0) first = absl::StrCat("block ", b, " cell (", i, ", ", j, ", ", k, ")");
         }
       }
     }
@@ -246,15 +242,10 @@ std::string FoldAdvice(const GridFitOptions& options) {
 // Tolerances below kResolvableUlps units in the last place of the grid's largest coordinate
 // cannot be met or measured: a fit to 1e-300 was stored with every tolerance missed ("inf times
 // its tolerance"). INVALID_ARGUMENT naming the field (and the reference length it came from).
-constexpr double kResolvableUlps = 8.0;
-
 absl::Status CheckResolvable(const MultiBlockGrid& grid, const GridFitOptions& options,
                              const BoundaryTolerances& tolerances,
                              const ReferenceLength& reference) {
-  double largest = 0.0;
-  for (const StructuredBlock& block : grid.blocks) {
-    for (double v : block.coords()) largest = std::max(largest, std::abs(v));
-  }
+  const double largest = LargestCoordinate(grid);
   const double floor = kResolvableUlps * std::numeric_limits<double>::epsilon() * largest;
   const std::pair<const char*, double> kinds[] = {{"wall", tolerances.wall},
                                                   {"interface", tolerances.interface},

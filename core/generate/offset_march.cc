@@ -244,11 +244,16 @@ void ReduceConcaveCurvature(const std::vector<Point2>& p, const std::vector<bool
 
 }  // namespace
 
-absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
+absl::Status ValidateLayerCount(int layers) {
   if (layers < 1 || layers > kMaxLayers) {
     return absl::InvalidArgumentError(
         absl::StrCat("layers = ", layers, " is outside [1, ", kMaxLayers, "]"));
   }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateLayerStack(int layers, double first_height, double distance) {
+  SG_RETURN_IF_ERROR(ValidateLayerCount(layers));
   if (!(first_height > 0.0) || !std::isfinite(first_height)) {
     return absl::InvalidArgumentError(
         absl::StrCat("first_height = ", first_height, " is not a positive finite number"));

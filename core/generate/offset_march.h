@@ -84,6 +84,9 @@ inline constexpr int kMaxLayers = 100000;
 // (transfinite, elliptic) take any stack.
 inline constexpr double kMaxGrowthRatio = 10.0;
 
+// OK for 1 .. kMaxLayers layers; INVALID_ARGUMENT naming `layers` otherwise.
+absl::Status ValidateLayerCount(int layers);
+
 // OK for a stack of 1 .. kMaxLayers layers growing from first_height to add up to distance (both
 // positive, finite, distance >= layers * first_height); INVALID_ARGUMENT naming the field.
 absl::Status ValidateLayerStack(int layers, double first_height, double distance);

@@ -119,10 +119,7 @@ absl::Status ProfileGridOptions::Validate() const {
   } else {
     // The stack (distance >= layers x first_height) is checked once the unset length is known
     // from the profile's chord (GenerateProfileGrid).
-    if (layers < 1 || layers > kMaxLayers) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("layers = ", layers, " is outside [1, ", kMaxLayers, "]"));
-    }
+    SG_RETURN_IF_ERROR(ValidateLayerCount(layers));
     if (first_height) SG_RETURN_IF_ERROR(CheckFinitePositive(*first_height, "first_height"));
     if (distance) SG_RETURN_IF_ERROR(CheckFinitePositive(*distance, "distance"));
   }

@@ -24,6 +24,14 @@ StructuredBlock::StructuredBlock(const Extents& extents, int spatial_dim)
   coords_.assign(static_cast<size_t>(spatial_dim * NumPoints(extents)), 0.0);
 }
 
+double LargestCoordinate(const MultiBlockGrid& grid) {
+  double largest = 0.0;
+  for (const StructuredBlock& block : grid.blocks) {
+    for (double x : block.coords()) largest = std::max(largest, std::abs(x));
+  }
+  return largest;
+}
+
 absl::Status ValidateExtents(const Extents& extents, const std::string& what, int64_t max_points,
                              int max_extent) {
   static constexpr char kNames[] = "ijk";
@@ -134,8 +142,10 @@ absl::Status ValidateFittable(const StructuredBlock& block, const std::string& w
     hi[x % s] = std::max(hi[x % s], coords[x]);
   }
   double diagonal = 0.0, widest = 0.0;
-  for (int c = 0; c < s; ++c) diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-  for (int c = 0; c < s; ++c) widest = std::max(widest, hi[c] - lo[c]);
+  for (int c = 0; c < s; ++c) {
+    diagonal += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    widest = std::max(widest, hi[c] - lo[c]);
+  }
   diagonal = std::sqrt(diagonal);
   // Lengths whose squares underflow (the fit's normal equations and distances square them): a
   // grid in units of 1e-300 read as "all points equal".

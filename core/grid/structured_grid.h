@@ -70,6 +70,14 @@ struct MultiBlockGrid {
   std::vector<StructuredBlock> blocks;
 };
 
+// The largest |coordinate| of the grid's points (0 for a grid without points).
+double LargestCoordinate(const MultiBlockGrid& grid);
+
+// Lengths below this many units in the last place of a grid's largest coordinate round away:
+// two points closer than that can have the same coordinates, and a deviation that small can be
+// neither met nor measured.
+inline constexpr double kResolvableUlps = 8.0;
+
 // OK when every extent is in [1, max_extent] and the product is at most max_points;
 // otherwise INVALID_ARGUMENT naming `what` (e.g. "block 3") and the offending value.
 absl::Status ValidateExtents(const Extents& extents, const std::string& what,

@@ -1,10 +1,9 @@
 #include "server/ops/generated_grid.h"
 
-#include <algorithm>
-#include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/grid/structured_grid.h"
 #include "core/util/status_macros.h"
 #include "server/grid_id.h"
 #include "server/ops/fit.h"
@@ -13,13 +12,7 @@ namespace splinegrid::server::ops {
 namespace {
 
 // 1e-12 of the largest coordinate: what a derived connectivity's points may differ by.
-double RoundingTolerance(const MultiBlockGrid& grid) {
-  double largest = 0.0;
-  for (const StructuredBlock& block : grid.blocks) {
-    for (double x : block.coords()) largest = std::max(largest, std::abs(x));
-  }
-  return 1e-12 * largest;
-}
+double RoundingTolerance(const MultiBlockGrid& grid) { return 1e-12 * LargestCoordinate(grid); }
 
 }  // namespace
 
