@@ -175,6 +175,19 @@ std::vector<int64_t> DeformRevisionsBeyond(
   return dropped;
 }
 
+std::string NewIncarnation() {
+  std::random_device random;
+  const uint64_t bits = (uint64_t{random()} << 32) ^ random();
+  return absl::StrFormat("%016x", bits);
+}
+
+absl::Status ReplacedMeanwhile(const std::string& id) {
+  return absl::AbortedError(absl::StrCat(
+      "grids/", id,
+      " was deleted and created again while this call ran: its revision was made from the "
+      "earlier grid and is not stored; read the grid again and repeat the call"));
+}
+
 absl::Status CreateGrid(GridStore& store, const std::string& requested_id,
                         const std::shared_ptr<StoredGrid>& grid) {
   std::mt19937_64 random(std::random_device{}());

@@ -104,6 +104,11 @@ struct StoredGrid {
   // The principal whose token created the grid; empty when it was created without tokens (then
   // only an admin may delete it on a server with tokens).
   std::string owner;
+  // Which creation of the id this is: drawn by the store when the grid is created (NewIncarnation;
+  // the Redis store's generation) and kept by every later snapshot. A grid deleted and created
+  // again under the same id has another, so a revision made from the first is not published on
+  // the second (AddRevision). Empty on a grid not yet created.
+  std::string incarnation;
   absl::Time create_time;
   std::shared_ptr<const SourcePoints> source;
   std::vector<std::shared_ptr<const GridRevision>> revisions;  // ascending numbers
@@ -214,9 +219,12 @@ class GridStore {
   // Publishes `revision` (its number is assigned here: latest + 1) as the grid's newest, drops
   // deformed revisions beyond the retention limit, tells the grid's watchers and returns the new
   // snapshot; NOT_FOUND if the grid was deleted meanwhile, ABORTED if `expected_latest` is not 0
-  // and the grid's latest revision is another one (a concurrent writer got there first).
+  // and the grid's latest revision is another one (a concurrent writer got there first), or if
+  // `incarnation` is not empty and the grid is another creation of the id (the one the revision
+  // was made from was deleted and a new one created). Both checks are atomic with the publication.
   virtual absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
-      const std::string& id, GridRevision revision, int64_t expected_latest = 0) = 0;
+      const std::string& id, GridRevision revision, int64_t expected_latest = 0,
+      const std::string& incarnation = "") = 0;
 
   // Decides from a grid's owner whether it may be deleted (OK, or the error to return).
   using DeleteCheck = std::function<absl::Status(const std::string& owner)>;
@@ -265,6 +273,13 @@ class GridStore {
 // `max_deform_revisions`, which publishing the last one drops.
 std::vector<int64_t> DeformRevisionsBeyond(
     const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions);
+
+// A new incarnation (StoredGrid::incarnation): 64 random bits as 16 hex digits.
+std::string NewIncarnation();
+
+// ABORTED: grid `id` was deleted and created again while a call made a revision of the earlier
+// one.
+absl::Status ReplacedMeanwhile(const std::string& id);
 
 // Adds `grid` to `store` under `requested_id`, or, when that is empty, under a random id
 // "grid-xxxxxxxx" (retrying a few collisions); sets grid->id. ALREADY_EXISTS for a taken

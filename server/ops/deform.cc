@@ -31,9 +31,9 @@ std::string ShapeKey(const std::string& id, int64_t reference, const DeformOptio
   return absl::StrCat(DeformerKeyPrefix(id), reference, "#", OptionsKey(options), "#");
 }
 
-// The whole key: the shape key and the grid's creation (an id may be used again).
+// The whole key: the shape key and the grid's incarnation (an id may be used again).
 std::string DeformerKey(const StoredGrid& grid, int64_t reference, const DeformOptions& options) {
-  return absl::StrCat(ShapeKey(grid.id, reference, options), absl::ToUnixNanos(grid.create_time));
+  return absl::StrCat(ShapeKey(grid.id, reference, options), grid.incarnation);
 }
 
 absl::Status Validate(const DeformRequest& request) {
@@ -144,9 +144,9 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SG_ASSIGN_OR_RETURN(revision.memory,
                       context.budget.Reserve(RevisionBytes(revision), "the deformed revision"));
-  SG_ASSIGN_OR_RETURN(
-      const std::shared_ptr<const StoredGrid> stored,
-      context.store.AddRevision(request.grid_id, std::move(revision), request.base_revision));
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
+                      context.store.AddRevision(request.grid_id, std::move(revision),
+                                                request.base_revision, grid->incarnation));
   return stored->revisions.back();
 }
 

@@ -23,7 +23,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> FitAndPublish(
   SG_ASSIGN_OR_RETURN(GridRevision revision,
                       FitRevision(context, *grid.source, options, origin, parent, cancel));
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> stored,
-                      context.store.AddRevision(grid.id, std::move(revision)));
+                      context.store.AddRevision(grid.id, std::move(revision), 0, grid.incarnation));
   return stored->revisions.back();
 }
 

@@ -6,11 +6,21 @@
 #include "core/util/status_macros.h"
 
 namespace splinegrid::server {
+namespace {
+
+// `grid` as a new creation of its id: a copy (its parts are shared) with a new incarnation.
+std::shared_ptr<const StoredGrid> Incarnate(const StoredGrid& grid) {
+  auto created = std::make_shared<StoredGrid>(grid);
+  created->incarnation = NewIncarnation();
+  return created;
+}
+
+}  // namespace
 
 MemoryStore::MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log,
                          std::vector<std::shared_ptr<const StoredGrid>> loaded)
     : max_deform_revisions_(max_deform_revisions), log_(std::move(log)) {
-  for (auto& grid : loaded) grids_.emplace(grid->id, std::move(grid));
+  for (const auto& grid : loaded) grids_.emplace(grid->id, Incarnate(*grid));
 }
 
 std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
@@ -27,7 +37,7 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
       return absl::AlreadyExistsError(absl::StrCat("grids/", grid->id, " already exists"));
     }
     if (!log_) {
-      grids_.emplace(grid->id, std::move(grid));
+      grids_.emplace(grid->id, Incarnate(*grid));
       return absl::OkStatus();
     }
     creating_.insert(grid->id);
@@ -36,7 +46,7 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
   const absl::Status written = log_->WriteGrid(*grid);
   std::lock_guard<std::mutex> lock(mu_);
   creating_.erase(grid->id);
-  if (written.ok()) grids_.emplace(grid->id, std::move(grid));
+  if (written.ok()) grids_.emplace(grid->id, Incarnate(*grid));
   return written;
 }
 
@@ -48,7 +58,8 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::Get(const std::st
 }
 
 absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::AddRevision(
-    const std::string& id, GridRevision revision, int64_t expected_latest) {
+    const std::string& id, GridRevision revision, int64_t expected_latest,
+    const std::string& incarnation) {
   const std::shared_ptr<std::mutex> writer = WriterOf(id);
   std::lock_guard<std::mutex> write(*writer);
   auto published = std::make_shared<GridRevision>(std::move(revision));
@@ -57,6 +68,9 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::AddRevision(
     const auto it = grids_.find(id);
     if (it == grids_.end()) {
       return absl::NotFoundError(absl::StrCat("grids/", id, " was deleted"));
+    }
+    if (!incarnation.empty() && it->second->incarnation != incarnation) {
+      return ReplacedMeanwhile(id);
     }
     const auto& revisions = it->second->revisions;
     const int64_t latest = revisions.empty() ? 0 : revisions.back()->number;

@@ -45,7 +45,8 @@ class MemoryStore final : public GridStore {
   absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) override;
   bool ReadsAreLocal() const override { return true; }  // the dir: log is only written
   absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
-      const std::string& id, GridRevision revision, int64_t expected_latest = 0) override;
+      const std::string& id, GridRevision revision, int64_t expected_latest = 0,
+      const std::string& incarnation = "") override;
   absl::Status Delete(const std::string& id, const DeleteCheck& check = nullptr) override;
   absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
                                   size_t max_queued) override;

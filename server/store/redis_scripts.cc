@@ -33,6 +33,7 @@ const RedisScript& AddRevisionScript() {
   static const RedisScript* script = new RedisScript(R"lua(
 local gen = redis.call('HGET', KEYS[1], 'gen')
 if not gen then return {0} end
+if ARGV[8] ~= '' and ARGV[8] ~= gen then return {-2} end
 local latest = tonumber(redis.call('HGET', KEYS[1], 'latest'))
 local expected = tonumber(ARGV[2])
 if expected ~= 0 and expected ~= latest then return {-1, latest} end
@@ -54,8 +55,8 @@ end
 redis.call('XADD', g .. ':events', 'MAXLEN', '~', ARGV[7], '0-' .. ns, 's', ARGV[6])
 local nums = redis.call('ZRANGE', g .. ':nums', 0, -1)
 local known = {[ns] = true}
-if gen == ARGV[8] then
-  for i = 9, #ARGV do known[ARGV[i]] = true end
+if gen == ARGV[9] then
+  for i = 10, #ARGV do known[ARGV[i]] = true end
 end
 local values = {}
 for i, m in ipairs(nums) do

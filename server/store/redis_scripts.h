@@ -47,14 +47,15 @@ class RedisKeys {
 // written keys are incomplete, e.g. they expired: removed too).
 const RedisScript& CreateScript();
 
-// Publishes a revision: checks the base, assigns latest + 1, stores it, applies retention and
-// appends the event.
+// Publishes a revision: checks the generation and the base, assigns latest + 1, stores it,
+// applies retention and appends the event.
 // KEYS: grid. ARGV: the grid's Stem, expected_latest (0: any), the StoredRevision without its
 // number, "1" if deformed, max_deform_revisions, the event's summary, the stream's max length,
-// then as for GetScript the caller's cached generation and numbers.
-// Returns {0} (no such grid), {-1, latest} (stale base) or {1, number, gen, {numbers},
-// {values}}: the grid right after the change, as GetScript would return it (the new revision's
-// value "" too: the caller has it).
+// the expected generation ("": any), then as for GetScript the caller's cached generation and
+// numbers.
+// Returns {0} (no such grid), {-2} (another generation: the grid was deleted and created again),
+// {-1, latest} (stale base) or {1, number, gen, {numbers}, {values}}: the grid right after the
+// change, as GetScript would return it (the new revision's value "" too: the caller has it).
 const RedisScript& AddRevisionScript();
 
 // A grid's state for a reader that has some of it cached.

@@ -80,6 +80,7 @@ absl::StatusOr<RedisSnapshots::Fetched> RedisSnapshots::Assemble(
   snapshot->id = id;
   snapshot->display_name = shell->display_name;
   snapshot->owner = shell->owner;
+  snapshot->incarnation = gen;
   snapshot->create_time = shell->create_time;
   snapshot->source = shell->source;
   bool made_room = false;

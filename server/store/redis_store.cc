@@ -6,7 +6,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <random>
 #include <set>
 #include <thread>
 
@@ -36,13 +35,6 @@ std::string FormatBytes(int64_t bytes) {
   if (bytes >= (int64_t{1} << 30)) return absl::StrFormat("%.2f GiB", bytes / double(1 << 30));
   if (bytes >= (int64_t{1} << 20)) return absl::StrFormat("%.2f MiB", bytes / double(1 << 20));
   return absl::StrCat(bytes, " bytes");
-}
-
-// A new generation: 64 random bits as 16 hex digits.
-std::string NewGeneration() {
-  std::random_device random;
-  const uint64_t bits = (uint64_t{random()} << 32) ^ random();
-  return absl::StrFormat("%016x", bits);
 }
 
 absl::Status NotFound(const std::string& id, const char* how) {
@@ -130,9 +122,9 @@ class RedisStore final : public GridStore {
   }
   absl::StatusOr<std::shared_ptr<const StoredGrid>> GetHolding(
       const std::string& id, std::initializer_list<int64_t> numbers) override;
-  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(const std::string& id,
-                                                                GridRevision revision,
-                                                                int64_t expected_latest) override;
+  absl::StatusOr<std::shared_ptr<const StoredGrid>> AddRevision(
+      const std::string& id, GridRevision revision, int64_t expected_latest,
+      const std::string& incarnation) override;
   absl::Status Delete(const std::string& id, const DeleteCheck& check = nullptr) override;
   absl::StatusOr<Watch> Subscribe(const std::string& id, std::weak_ptr<GridWatcher> watcher,
                                   size_t max_queued) override;
@@ -227,7 +219,7 @@ absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
   if (exists.value().AsInt().value_or(0) != 0) {
     return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
   }
-  const std::string gen = NewGeneration();
+  const std::string gen = NewIncarnation();  // the generation
   const std::vector<std::string> gen_keys = {
       keys_.Gen(id, gen, "header"), keys_.Gen(id, gen, "source"), keys_.Gen(id, gen, "revs"),
       keys_.Gen(id, gen, "nums"), keys_.Gen(id, gen, "deforms")};
@@ -253,9 +245,12 @@ absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
       RedisReply committed,
       pool_.Run(CreateScript(), keys, {id, gen, latest, chunks, count, grid->owner}));
   switch (committed.value().AsInt().value_or(-2)) {
-    case 1:
-      snapshots_.Put(id, {gen, std::move(grid)});
+    case 1: {
+      auto created = std::make_shared<StoredGrid>(*grid);
+      created->incarnation = gen;
+      snapshots_.Put(id, {gen, std::move(created)});
       return absl::OkStatus();
+    }
     case 0:
       return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
     default:
@@ -290,8 +285,8 @@ absl::Status RedisStore::WriteGeneration(
     batch.clear();
     return absl::OkStatus();
   };
-  SG_RETURN_IF_ERROR(
-      ForEachSourceChunk(grid.source->grid(), kSourceChunkValues, [&](const v1::SourceChunk& chunk) {
+  SG_RETURN_IF_ERROR(ForEachSourceChunk(
+      grid.source->grid(), kSourceChunkValues, [&](const v1::SourceChunk& chunk) {
         batch.push_back(chunk.SerializeAsString());
         return std::ssize(batch) == kChunksPerRound ? flush() : absl::OkStatus();
       }));
@@ -317,9 +312,9 @@ absl::Status RedisStore::WriteGeneration(
   return lease->Pipeline(commands).status();
 }
 
-absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(const std::string& id,
-                                                                          GridRevision revision,
-                                                                          int64_t expected_latest) {
+absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(
+    const std::string& id, GridRevision revision, int64_t expected_latest,
+    const std::string& incarnation) {
   revision.number = 0;  // the script appends the number it assigns
   v1::StoredRevision stored;
   EncodeRevision(revision, &stored);
@@ -332,7 +327,8 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(const 
                                    revision.origin == RevisionOrigin::kDeform ? "1" : "0",
                                    absl::StrCat(options_.max_deform_revisions),
                                    EncodeEventSummary(RevisionSummary::Of(revision)),
-                                   absl::StrCat(kStreamMaxLen)};
+                                   absl::StrCat(kStreamMaxLen),
+                                   incarnation};
   RedisSnapshots::AppendKnown(cached, &args);
   const std::string grid_key = keys_.Grid(id);
   SG_ASSIGN_OR_RETURN(RedisReply reply,
@@ -342,6 +338,8 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(const 
   switch (result[0].AsInt().value_or(0)) {
     case 1:
       break;
+    case -2:
+      return ReplacedMeanwhile(id);
     case -1:
       return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,
                                              " is stale; the latest revision is ",

@@ -12,8 +12,9 @@
 //   grid:{id}:{gen}:nums        sorted set of the numbers in revs
 //   grid:{id}:{gen}:deforms     sorted set of the deformed ones (retention)
 //   grid:{id}:{gen}:events      stream: `0-N` per published revision N, `1-0` for the deletion
-// A generation is a random 64-bit id drawn by each Create, so a grid deleted and created again
-// under the same id shares no key with its predecessor, and a creation's keys are private.
+// A generation is a random 64-bit id drawn by each Create (the grid's incarnation), so a grid
+// deleted and created again under the same id shares no key with its predecessor, and a
+// creation's keys are private.
 //
 // Atomicity. Every change that must be atomic across replicas is one Lua script (EVALSHA),
 // which Redis runs without interleaving any other command:
@@ -23,8 +24,9 @@
 //    the index entry. So a half-written grid is never visible, two creations of one id give
 //    exactly one success (the other ALREADY_EXISTS), and a crashed writer's keys are private to
 //    its generation and expire by themselves: they never block a later Create.
-//  - AddRevision's script reads `latest`, checks the base (ABORTED if expected_latest is set
-//    and stale), assigns latest + 1, stores the revision, drops the oldest deformed revisions
+//  - AddRevision's script checks the generation (ABORTED if it is not the one the revision was
+//    made from), reads `latest`, checks the base (ABORTED if expected_latest is set and
+//    stale), assigns latest + 1, stores the revision, drops the oldest deformed revisions
 //    beyond max_deform_revisions (the same rule as DeformRevisionsBeyond) and appends the event,
 //    in one step: of two replicas deforming from the same base exactly one succeeds. `latest`
 //    only grows, so numbers are never reused, even after retention.

@@ -110,6 +110,52 @@ TEST_F(OpsTest, RefusedDeformsStoreNothing) {
   EXPECT_EQ(Latest(), latest);
 }
 
+// A revision is made from the grid a call read: if that grid is deleted and another one created
+// under its id while the call works, the revision is not the new grid's and is not stored there
+// (it was: a fit of the old points became revision 1 of a grid imported by someone else).
+TEST_F(OpsTest, ARevisionOfAGridDeletedAndCreatedAgainMeanwhileIsRefused) {
+  bool replaced = false;
+  const CancelCheck replace_the_grid = [&] {
+    if (!replaced) {
+      replaced = true;
+      EXPECT_TRUE(store_.Delete("naca").ok());
+      ops::ImportedSource source;
+      source.imported.grid = Naca();
+      source.imported.format = "plot3d";
+      EXPECT_TRUE(ops::StoreImported(ops_, {"naca", "", "someone-else"}, std::move(source)).ok());
+    }
+    return false;
+  };
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  const absl::Status fit = ops::Fit(ops_, "naca", options, replace_the_grid).status();
+  ASSERT_TRUE(replaced);
+  EXPECT_EQ(fit.code(), absl::StatusCode::kAborted) << fit;
+  EXPECT_THAT(fit.message(), HasSubstr("grids/naca was deleted and created again"));
+  const std::shared_ptr<const StoredGrid> now = store_.Get("naca").value();
+  EXPECT_EQ(now->owner, "someone-else");
+  EXPECT_TRUE(now->revisions.empty());
+}
+
+// Every creation of an id has its own incarnation, grids loaded from a log (dir: store) too, and
+// the store publishes a revision only on the incarnation it was made from.
+TEST_F(OpsTest, EveryCreationOfAnIdHasItsOwnIncarnation) {
+  const std::shared_ptr<const StoredGrid> first = store_.Get("naca").value();
+  EXPECT_EQ(first->incarnation.size(), 16u);
+  ASSERT_TRUE(store_.Delete("naca").ok());
+  AddNaca("naca", 0);
+  const std::shared_ptr<const StoredGrid> second = store_.Get("naca").value();
+  EXPECT_NE(second->incarnation, first->incarnation);
+  EXPECT_EQ(store_.AddRevision("naca", GridRevision{}, 0, first->incarnation).status().code(),
+            absl::StatusCode::kAborted);
+  EXPECT_TRUE(store_.AddRevision("naca", GridRevision{}, 0, second->incarnation).ok());
+
+  MemoryStore loaded(/*max_deform_revisions=*/4, nullptr, {second});
+  const std::shared_ptr<const StoredGrid> reloaded = loaded.Get("naca").value();
+  EXPECT_EQ(reloaded->incarnation.size(), 16u);
+  EXPECT_NE(reloaded->incarnation, second->incarnation);
+}
+
 // A kept deformer keeps its fold gate per check level, charged to the memory budget until the
 // deformer goes, unless the gate's reference is larger than the cap (level 4 of the 224 x 64
 // cells is 3.7M cells): then it is made for each call and charged while the call holds it. A

@@ -567,6 +567,25 @@ TEST_F(RedisStoreTest, AddRevisionToAMissingGridIsNotFound) {
               StatusIs(absl::StatusCode::kNotFound, "grids/g was deleted"));
 }
 
+// A revision made from a grid read through one replica is not published on a grid created again
+// under the same id through another meanwhile: the generation is checked in the script.
+TEST_F(RedisStoreTest, ARevisionOfAnEarlierCreationOfTheIdIsRefused) {
+  CreateFitted("g");
+  const std::shared_ptr<const StoredGrid> read = a_->Get("g").value();
+  EXPECT_EQ(read->incarnation.size(), 16u);
+  ASSERT_TRUE(b_->Delete("g").ok());
+  ASSERT_TRUE(b_->Create(MakeGrid("g")).ok());
+  const std::shared_ptr<const StoredGrid> again = b_->Get("g").value();
+  EXPECT_NE(again->incarnation, read->incarnation);
+  EXPECT_THAT(
+      a_->AddRevision("g", MakeRevision(RevisionOrigin::kFit), 0, read->incarnation).status(),
+      StatusIs(absl::StatusCode::kAborted, "grids/g was deleted and created again"));
+  EXPECT_TRUE(a_->Get("g").value()->revisions.empty());
+  // The new creation takes revisions made from it, on either replica.
+  EXPECT_TRUE(a_->AddRevision("g", MakeRevision(RevisionOrigin::kFit), 0, again->incarnation).ok());
+  EXPECT_EQ(b_->Get("g").value()->incarnation, again->incarnation);
+}
+
 TEST_F(RedisStoreTest, WatchSeesRevisionsFromTheOtherReplicaInOrderThenTheDeletion) {
   CreateFitted("g");
   GridStore::Watch on_a = a_->Subscribe("g", watcher_, 64).value();
