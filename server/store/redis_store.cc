@@ -339,6 +339,9 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> RedisStore::AddRevision(
     case 1:
       break;
     case -2:
+      // The revision was made from this process's snapshot of the earlier creation (possibly
+      // read within cached_read_window): drop it, so that the retry reads the grid from Redis.
+      snapshots_.Erase(id);
       return ReplacedMeanwhile(id);
     case -1:
       return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,

@@ -580,6 +580,9 @@ TEST_F(RedisStoreTest, ARevisionOfAnEarlierCreationOfTheIdIsRefused) {
   EXPECT_THAT(
       a_->AddRevision("g", MakeRevision(RevisionOrigin::kFit), 0, read->incarnation).status(),
       StatusIs(absl::StatusCode::kAborted, "grids/g was deleted and created again"));
+  // The refusal drops a's snapshot of the earlier creation: a read of a given revision (which
+  // may answer from a recent snapshot) sees the new creation at once.
+  EXPECT_EQ(a_->GetHolding("g", {1}).value()->incarnation, again->incarnation);
   EXPECT_TRUE(a_->Get("g").value()->revisions.empty());
   // The new creation takes revisions made from it, on either replica.
   EXPECT_TRUE(a_->AddRevision("g", MakeRevision(RevisionOrigin::kFit), 0, again->incarnation).ok());
