@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "Eigen/QR"
+#include "Eigen/SVD"
 
 namespace splinegrid {
 
@@ -92,6 +93,60 @@ CreaseDistances DistancesToCreases(const VertexGraph& graph, const std::vector<V
         queue.emplace(next, u);
       }
     }
+  }
+  return out;
+}
+
+CreaseSlides SlidesFromCorners(const VertexGraph& graph, const std::vector<Vec>& points,
+                               const ConcaveCreases& creases) {
+  const size_t n = creases.vertices.size();
+  CreaseSlides out{std::vector<double>(n, std::numeric_limits<double>::infinity()),
+                   std::vector<Vec>(n, Vec::Zero())};
+  // The faces' normals as rows: a corner has three singular values; a crease's direction is the
+  // right singular vector of its smallest.
+  const double min_spread = std::sin(2.0 * kCreaseDegrees * M_PI / 180.0);
+  std::vector<Vec> direction(n, Vec::Zero());
+  std::vector<int64_t> index(graph.num_vertices(), -1);  // vertex -> crease
+  using Entry = std::pair<double, int64_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  std::vector<int> corner_of(n, -1);
+  for (size_t c = 0; c < n; ++c) {
+    index[creases.vertices[c]] = static_cast<int64_t>(c);
+    Eigen::MatrixX3d normals(creases.faces[c].size(), 3);
+    for (size_t f = 0; f < creases.faces[c].size(); ++f) {
+      normals.row(f) = creases.faces[c][f].transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(normals, Eigen::ComputeFullV);
+    const auto& sigma = svd.singularValues();
+    if (sigma.size() == 3 && sigma[2] > min_spread * sigma[0]) {
+      out.distance[c] = 0.0;
+      corner_of[c] = static_cast<int>(c);
+      queue.emplace(0.0, static_cast<int64_t>(c));
+    } else {
+      direction[c] = svd.matrixV().col(2);
+    }
+  }
+  // Distances along the creases (edges between crease vertices) from the corners.
+  while (!queue.empty()) {
+    const auto [d, c] = queue.top();
+    queue.pop();
+    if (d > out.distance[c]) continue;
+    const int64_t v = creases.vertices[c];
+    for (int64_t e = graph.start[v]; e < graph.start[v + 1]; ++e) {
+      const int64_t u = index[graph.neighbour[e]];
+      if (u < 0) continue;
+      const double next = d + (points[graph.neighbour[e]] - points[v]).norm();
+      if (next < out.distance[u]) {
+        out.distance[u] = next;
+        corner_of[u] = corner_of[c];
+        queue.emplace(next, u);
+      }
+    }
+  }
+  for (size_t c = 0; c < n; ++c) {
+    if (corner_of[c] < 0 || corner_of[c] == static_cast<int>(c)) continue;
+    const Vec& t = direction[c];
+    out.slide[c] = creases.offset[corner_of[c]].dot(t) * t;
   }
   return out;
 }

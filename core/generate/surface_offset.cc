@@ -145,6 +145,7 @@ struct March {
   // The concave creases of the surface (concave_crease.h) and their points on it: the crease of
   // the layer at height H is at origin + H offset.
   ConcaveCreases creases;
+  CreaseSlides slides;  // of the creases near corners
   std::vector<Vec> crease_origin;
   std::vector<char> is_crease;  // per vertex
   int64_t num_vertices() const { return topology.num_vertices; }
@@ -528,6 +529,7 @@ struct CreaseBand {
   std::vector<int> crease;
   std::vector<int> face;
   std::vector<double> weight;
+  double reach = 0.0;  // R
 };
 
 // The band of the layer p at `height` (its normals `layer_normals`, unsmoothed): the reach is
@@ -542,9 +544,9 @@ CreaseBand BandOfCreases(const March& m, const Layer& p, const Layer& layer_norm
     for (const Vec& f : creases.faces[c]) along = std::max(along, (d - d.dot(f) * f).norm());
   }
   if (!(along > 0.0)) return {};
-  CreaseBand band{std::vector<int>(m.num_vertices(), -1), std::vector<int>(m.num_vertices(), -1),
-                  std::vector<double>(m.num_vertices(), 0.0)};
   const double reach = kCreaseReach * height * along;
+  CreaseBand band{std::vector<int>(m.num_vertices(), -1), std::vector<int>(m.num_vertices(), -1),
+                  std::vector<double>(m.num_vertices(), 0.0), reach};
   const CreaseDistances near = DistancesToCreases(m.graph, p, creases.vertices, reach);
   for (int64_t v = 0; v < m.num_vertices(); ++v) {
     const int c = near.nearest[v];
@@ -578,7 +580,10 @@ void BlendBandNormals(const March& m, const CreaseBand& band, Layer& normals) {
 void StepCreases(const March& m, const CreaseBand& band, const Layer& p, double height, Layer& q) {
   const ConcaveCreases& creases = m.creases;
   for (size_t c = 0; c < creases.vertices.size(); ++c) {
-    q[creases.vertices[c]] = m.crease_origin[c] + height * creases.offset[c];
+    const double slide =
+        band.reach > 0.0 ? CreaseShiftWeight(m.slides.distance[c] / band.reach) : 0.0;
+    q[creases.vertices[c]] =
+        m.crease_origin[c] + height * (creases.offset[c] + slide * m.slides.slide[c]);
   }
   for (size_t v = 0; v < band.crease.size(); ++v) {
     const int c = band.crease[v];
@@ -883,6 +888,7 @@ absl::StatusOr<SurfaceOffsetGrid> OffsetSurfaceGrid(const MultiBlockGrid& surfac
         m.is_crease[v] = 1;
         m.crease_origin.push_back(p[v]);
       }
+      m.slides = SlidesFromCorners(m.graph, p, m.creases);
       out.crease_vertices = static_cast<int64_t>(m.creases.vertices.size());
       if (out.crease_vertices > 0) m.stencil = BuildSmoothingStencil(m);
     }

@@ -57,8 +57,9 @@
 // (concave_crease.h): its points go straight to their layer's height above both faces (along
 // the bisector, by the miter), the faces' points near it move with it along their face and
 // march along the face's normal, the normal smoothing does not cross it, and its edges do not
-// limit the step. A corner where three concave creases meet (inside a box) is not treated and
-// folds (refused). On block edges the spline's
+// limit the step. Where three concave creases meet (the inside corner of a box) the corner goes
+// to its height above all three faces and the creases' points near it slide along their crease
+// away from it. On block edges the spline's
 // derivatives are one-sided (clamped knots), so no normal needs a neighbour outside its block.
 // Where an edge collapses to one point (a pole: X_v = 0 along u = 0, say) the normal X_u x X_v
 // vanishes; by l'Hopital X_v ~ u X_uv there, so the normal is that of X_u x X_uv (X_uv x X_v for
