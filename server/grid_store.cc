@@ -181,6 +181,12 @@ std::string NewIncarnation() {
   return absl::StrFormat("%016x", bits);
 }
 
+std::shared_ptr<const StoredGrid> WithIncarnation(const StoredGrid& grid, std::string incarnation) {
+  auto created = std::make_shared<StoredGrid>(grid);
+  created->incarnation = std::move(incarnation);
+  return created;
+}
+
 absl::Status ReplacedMeanwhile(const std::string& id) {
   return absl::AbortedError(absl::StrCat(
       "grids/", id,

@@ -277,6 +277,9 @@ std::vector<int64_t> DeformRevisionsBeyond(
 // A new incarnation (StoredGrid::incarnation): 64 random bits as 16 hex digits.
 std::string NewIncarnation();
 
+// `grid` as the store keeps a creation of it: a copy (its parts are shared) with `incarnation`.
+std::shared_ptr<const StoredGrid> WithIncarnation(const StoredGrid& grid, std::string incarnation);
+
 // ABORTED: grid `id` was deleted and created again while a call made a revision of the earlier
 // one.
 absl::Status ReplacedMeanwhile(const std::string& id);

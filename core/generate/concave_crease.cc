@@ -69,7 +69,8 @@ Vec CreaseOffset(const std::vector<Vec>& faces) {
 }
 
 CreaseDistances DistancesToCreases(const VertexGraph& graph, const std::vector<Vec>& points,
-                                   const std::vector<int64_t>& creases, double reach) {
+                                   const std::vector<int64_t>& creases, double reach,
+                                   const std::vector<char>* walkable) {
   const int64_t n = graph.num_vertices();
   CreaseDistances out{std::vector<double>(n, std::numeric_limits<double>::infinity()),
                       std::vector<int>(n, -1)};
@@ -86,6 +87,7 @@ CreaseDistances DistancesToCreases(const VertexGraph& graph, const std::vector<V
     if (d > out.distance[v]) continue;  // a stale entry
     for (int64_t e = graph.start[v]; e < graph.start[v + 1]; ++e) {
       const int64_t u = graph.neighbour[e];
+      if (walkable && !(*walkable)[u]) continue;
       const double next = d + (points[u] - points[v]).norm();
       if (next < out.distance[u] && next < reach) {
         out.distance[u] = next;
@@ -106,12 +108,11 @@ CreaseSlides SlidesFromCorners(const VertexGraph& graph, const std::vector<Vec>&
   // right singular vector of its smallest.
   const double min_spread = std::sin(2.0 * kCreaseDegrees * M_PI / 180.0);
   std::vector<Vec> direction(n, Vec::Zero());
-  std::vector<int64_t> index(graph.num_vertices(), -1);  // vertex -> crease
-  using Entry = std::pair<double, int64_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
-  std::vector<int> corner_of(n, -1);
+  std::vector<int64_t> corners;  // crease indices
+  std::vector<int64_t> corner_vertices;
+  std::vector<char> on_crease(graph.num_vertices(), 0);
   for (size_t c = 0; c < n; ++c) {
-    index[creases.vertices[c]] = static_cast<int64_t>(c);
+    on_crease[creases.vertices[c]] = 1;
     Eigen::MatrixX3d normals(creases.faces[c].size(), 3);
     for (size_t f = 0; f < creases.faces[c].size(); ++f) {
       normals.row(f) = creases.faces[c][f].transpose();
@@ -119,34 +120,22 @@ CreaseSlides SlidesFromCorners(const VertexGraph& graph, const std::vector<Vec>&
     const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(normals, Eigen::ComputeFullV);
     const auto& sigma = svd.singularValues();
     if (sigma.size() == 3 && sigma[2] > min_spread * sigma[0]) {
-      out.distance[c] = 0.0;
-      corner_of[c] = static_cast<int>(c);
-      queue.emplace(0.0, static_cast<int64_t>(c));
+      corners.push_back(static_cast<int64_t>(c));
+      corner_vertices.push_back(creases.vertices[c]);
     } else {
       direction[c] = svd.matrixV().col(2);
     }
   }
-  // Distances along the creases (edges between crease vertices) from the corners.
-  while (!queue.empty()) {
-    const auto [d, c] = queue.top();
-    queue.pop();
-    if (d > out.distance[c]) continue;
-    const int64_t v = creases.vertices[c];
-    for (int64_t e = graph.start[v]; e < graph.start[v + 1]; ++e) {
-      const int64_t u = index[graph.neighbour[e]];
-      if (u < 0) continue;
-      const double next = d + (points[graph.neighbour[e]] - points[v]).norm();
-      if (next < out.distance[u]) {
-        out.distance[u] = next;
-        corner_of[u] = corner_of[c];
-        queue.emplace(next, u);
-      }
-    }
-  }
+  if (corners.empty()) return out;
+  // Distances along the creases (through crease vertices only) from the corners.
+  const CreaseDistances near = DistancesToCreases(
+      graph, points, corner_vertices, std::numeric_limits<double>::infinity(), &on_crease);
   for (size_t c = 0; c < n; ++c) {
-    if (corner_of[c] < 0 || corner_of[c] == static_cast<int>(c)) continue;
-    const Vec& t = direction[c];
-    out.slide[c] = creases.offset[corner_of[c]].dot(t) * t;
+    const int nearest = near.nearest[creases.vertices[c]];
+    if (nearest < 0) continue;
+    out.distance[c] = near.distance[creases.vertices[c]];
+    const Vec& t = direction[c];  // zero at a corner: no slide
+    out.slide[c] = creases.offset[corners[nearest]].dot(t) * t;
   }
   return out;
 }

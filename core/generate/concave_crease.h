@@ -96,15 +96,16 @@ ConcaveCreases FindConcaveCreases(const VertexGraph& graph,
 Eigen::Vector3d CreaseOffset(const std::vector<Eigen::Vector3d>& faces);
 
 // For every vertex within `reach` of a crease vertex (shortest path along the graph's edges,
-// lengths from `points`): the distance and the index of the nearest crease in `creases`;
-// elsewhere infinity and -1.
+// lengths from `points`; with `walkable`, only through vertices marked there): the distance and
+// the index of the nearest crease in `creases`; elsewhere infinity and -1.
 struct CreaseDistances {
   std::vector<double> distance;
   std::vector<int> nearest;
 };
 CreaseDistances DistancesToCreases(const VertexGraph& graph,
                                    const std::vector<Eigen::Vector3d>& points,
-                                   const std::vector<int64_t>& creases, double reach);
+                                   const std::vector<int64_t>& creases, double reach,
+                                   const std::vector<char>* walkable = nullptr);
 
 // Corners where three or more creases' faces span space (the inside corner of a box), and how
 // the crease points near them slide along their crease (file comment): per crease (an index into

@@ -6,21 +6,11 @@
 #include "core/util/status_macros.h"
 
 namespace splinegrid::server {
-namespace {
-
-// `grid` as a new creation of its id: a copy (its parts are shared) with a new incarnation.
-std::shared_ptr<const StoredGrid> Incarnate(const StoredGrid& grid) {
-  auto created = std::make_shared<StoredGrid>(grid);
-  created->incarnation = NewIncarnation();
-  return created;
-}
-
-}  // namespace
-
 MemoryStore::MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log,
                          std::vector<std::shared_ptr<const StoredGrid>> loaded)
     : max_deform_revisions_(max_deform_revisions), log_(std::move(log)) {
-  for (const auto& grid : loaded) grids_.emplace(grid->id, Incarnate(*grid));
+  for (const auto& grid : loaded)
+    grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
 }
 
 std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
@@ -37,7 +27,7 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
       return absl::AlreadyExistsError(absl::StrCat("grids/", grid->id, " already exists"));
     }
     if (!log_) {
-      grids_.emplace(grid->id, Incarnate(*grid));
+      grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
       return absl::OkStatus();
     }
     creating_.insert(grid->id);
@@ -46,7 +36,7 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
   const absl::Status written = log_->WriteGrid(*grid);
   std::lock_guard<std::mutex> lock(mu_);
   creating_.erase(grid->id);
-  if (written.ok()) grids_.emplace(grid->id, Incarnate(*grid));
+  if (written.ok()) grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
   return written;
 }
 

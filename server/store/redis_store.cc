@@ -245,12 +245,9 @@ absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
       RedisReply committed,
       pool_.Run(CreateScript(), keys, {id, gen, latest, chunks, count, grid->owner}));
   switch (committed.value().AsInt().value_or(-2)) {
-    case 1: {
-      auto created = std::make_shared<StoredGrid>(*grid);
-      created->incarnation = gen;
-      snapshots_.Put(id, {gen, std::move(created)});
+    case 1:
+      snapshots_.Put(id, {gen, WithIncarnation(*grid, gen)});
       return absl::OkStatus();
-    }
     case 0:
       return absl::AlreadyExistsError(absl::StrCat("grids/", id, " already exists"));
     default:
