@@ -8,7 +8,15 @@
 #   3. then redis-server gets SIGTERM (it fsyncs the AOF and exits), SIGKILL after 10 s.
 # A pid file whose process is gone, or is no longer the program start.sh started, is removed
 # without signalling anything. Redis data in RUN_DIR/redis is kept.
+#
+# Then it checks the ports start.sh recorded in RUN_DIR/ports. A port that still has a listener
+# (a process restarted by hand without its RUN_DIR/cmd script, another topology on the same
+# ports, an nginx worker left by a SIGKILLed master) is reported on stderr with the process
+# listening there, and stop.sh exits 1. It never signals a process that is not in its pid files.
 set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+# shellcheck source=deploy/local/common.sh
+. "$here/common.sh"
 RUN_DIR=${RUN_DIR:-/tmp/splinegrid-local}
 SHUTDOWN_GRACE=${SHUTDOWN_GRACE:-8s}
 grace=${SHUTDOWN_GRACE%s}; [[ $grace =~ ^[0-9]+$ ]] || grace=10
@@ -65,5 +73,26 @@ if pid=$(live_pid "$RUN_DIR/redis.pid" redis-server) && [[ -n $pid ]]; then
   wait_or_kill 10 "$pid" || status=1
 fi
 rm -f "$RUN_DIR/redis.pid"
-echo "stop.sh: stopped in $(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s$( ((status)) && echo ', some processes needed SIGKILL')"
+
+# Anything still listening on the topology's ports was not stopped here.
+leftover=()
+if [[ -s $RUN_DIR/ports ]]; then
+  while read -r name port; do
+    [[ $port =~ ^[0-9]+$ ]] || continue
+    # (a listener of a process that has just exited may take a moment to close)
+    for ((try = 0; try < 10; try++)); do port_listening "$port" || continue 2; sleep 0.2; done
+    echo "stop.sh: port $port ($name) still has a listener, which stop.sh did not stop" \
+         "(it signals only the pids in $RUN_DIR/*.pid): $(port_users "$port")" >&2
+    leftover+=("$port")
+  done <"$RUN_DIR/ports"
+else
+  echo "stop.sh: no $RUN_DIR/ports (written by start.sh), so the ports were not checked" >&2
+fi
+took=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+if ((${#leftover[@]})); then
+  echo "stop.sh: NOT stopped: port(s) ${leftover[*]} of RUN_DIR=$RUN_DIR still listening (see above);" \
+       "stop that process yourself if it belongs to this topology" >&2
+  exit 1
+fi
+echo "stop.sh: stopped in $took s$( ((status)) && echo ', some processes needed SIGKILL')"
 exit $status
