@@ -71,6 +71,12 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
       revisions.begin(), revisions.end(), number,
       [](const std::shared_ptr<const GridRevision>& r, int64_t n) { return r->number < n; });
   if (it != revisions.end() && (*it)->number == number) return *it;
+  if (std::binary_search(damaged_revisions.begin(), damaged_revisions.end(), number)) {
+    return absl::DataLossError(absl::StrCat(
+        "grids/", id, " revision ", number,
+        " was damaged on disk: the server set it aside at a start (its log names the file in "
+        "the store's corrupt/ directory)"));
+  }
   const int64_t latest = revisions.back()->number;
   if (number < latest) {
     return absl::NotFoundError(absl::StrCat(

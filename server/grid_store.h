@@ -112,12 +112,16 @@ struct StoredGrid {
   absl::Time create_time;
   std::shared_ptr<const SourcePoints> source;
   std::vector<std::shared_ptr<const GridRevision>> revisions;  // ascending numbers
+  // Revisions a dir: store found damaged on disk and set aside (corrupt/): asking for one is
+  // DATA_LOSS saying so, not "dropped by retention".
+  std::vector<int64_t> damaged_revisions;  // ascending
 
   // The revision `number` of the request's field `field` (0: the latest), or with `step` the
   // latest deformed revision of that time step. Every handler resolves revisions here, so the
   // errors are the same for every call: INVALID_ARGUMENT naming the field for a negative number
   // or for both a number and a step; NOT_FOUND for a number or step the grid does not have
-  // (saying so when retention dropped it); FAILED_PRECONDITION when it has no revision yet.
+  // (saying so when retention dropped it); DATA_LOSS for a damaged revision;
+  // FAILED_PRECONDITION when it has no revision yet.
   absl::StatusOr<std::shared_ptr<const GridRevision>> ResolveRevision(
       int64_t number, std::optional<int64_t> step = std::nullopt,
       const char* field = "revision") const;

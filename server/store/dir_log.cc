@@ -14,6 +14,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/io/file_util.h"
 #include "core/io/record_file.h"
 #include "core/util/status_macros.h"
 #include "server/store/grid_archive.h"
@@ -26,11 +27,12 @@ namespace fs = std::filesystem;
 
 constexpr char kGridFile[] = "grid.records";
 
-absl::Status ErrnoStatus(const std::string& what) {
-  return absl::InternalError(absl::StrCat(what, ": ", std::strerror(errno)));
-}
+absl::Status ErrnoStatus(const std::string& what) { return ErrnoToStatusWithMessage(errno, what); }
 
 absl::Status FsStatus(const std::error_code& error, const std::string& what) {
+  if (error.category() == std::generic_category() || error.category() == std::system_category()) {
+    return ErrnoToStatusWithMessage(error.value(), what);
+  }
   return absl::InternalError(absl::StrCat(what, ": ", error.message()));
 }
 
@@ -39,8 +41,11 @@ absl::Status SyncDirectory(const fs::path& dir) {
   const int fd = open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0) return ErrnoStatus(absl::StrCat("cannot open ", dir.string()));
   const int synced = fsync(fd);
+  const int error = errno;
   close(fd);
-  if (synced != 0) return ErrnoStatus(absl::StrCat("cannot fsync ", dir.string()));
+  if (synced != 0) {
+    return ErrnoToStatusWithMessage(error, absl::StrCat("cannot fsync ", dir.string()));
+  }
   return absl::OkStatus();
 }
 
@@ -49,6 +54,17 @@ std::string RevisionFile(int64_t number) { return absl::StrFormat("r%012d.record
 // The revision number of a file name "r{number}.records", or -1.
 int64_t RevisionNumberOf(const std::string& name) {
   constexpr std::string_view kSuffix = ".records";
+  if (name.size() <= 1 + kSuffix.size() || name[0] != 'r' || !name.ends_with(kSuffix)) return -1;
+  int64_t number = 0;
+  if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - kSuffix.size()), &number)) return -1;
+  return number > 0 ? number : -1;
+}
+
+// The marker left in a grid's directory for a revision file that was set aside as damaged
+// ("r{number}.damaged", holding why), and the number of such a name (or -1).
+std::string DamagedMarker(int64_t number) { return absl::StrFormat("r%012d.damaged", number); }
+int64_t DamagedNumberOf(const std::string& name) {
+  constexpr std::string_view kSuffix = ".damaged";
   if (name.size() <= 1 + kSuffix.size() || name[0] != 'r' || !name.ends_with(kSuffix)) return -1;
   int64_t number = 0;
   if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - kSuffix.size()), &number)) return -1;
@@ -120,6 +136,16 @@ class DirLog final : public DurableLog {
     }
   }
 
+  absl::Status Probe() override {
+    const fs::path grids = root_ / "grids";
+    // A name starting with '.': a start removes it if this does not finish.
+    SG_RETURN_IF_ERROR(WriteRecordFile(grids, ".probe", {"probe"}));
+    if (std::remove((grids / ".probe").c_str()) != 0) {
+      return ErrnoStatus(absl::StrCat("cannot remove ", (grids / ".probe").string()));
+    }
+    return SyncDirectory(grids);
+  }
+
   absl::Status DeleteGrid(const std::string& id) override {
     const fs::path trash = root_ / "trash" / absl::StrCat(id, "-", absl::ToUnixNanos(absl::Now()));
     if (std::rename((root_ / "grids" / id).c_str(), trash.c_str()) != 0) {
@@ -180,12 +206,15 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const
     }
   }
   std::vector<std::pair<int64_t, fs::path>> files;
+  std::vector<int64_t> damaged;  // set aside, at this start or an earlier one
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
     if (name.ends_with(".tmp")) {
       fs::remove(entry.path());  // an unacknowledged write
     } else if (const int64_t number = RevisionNumberOf(name); number > 0) {
       files.emplace_back(number, entry.path());
+    } else if (const int64_t marked = DamagedNumberOf(name); marked > 0) {
+      damaged.push_back(marked);
     }
   }
   std::sort(files.begin(), files.end());
@@ -202,15 +231,28 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const
         return absl::InvalidArgumentError("it holds no revision record");
       }
       if (record.revision().number() != number) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "it holds revision ", record.revision().number(), ", not ", number));
+        return absl::InvalidArgumentError(
+            absl::StrCat("it holds revision ", record.revision().number(), ", not ", number));
       }
       return assembler.AddRevision(record.revision());
     }();
     if (loaded.code() == absl::StatusCode::kResourceExhausted) return loaded;
-    if (!loaded.ok()) SetAside(root, path, loaded);
+    if (!loaded.ok()) {
+      // A marker in its place, so that asking for it says what happened, after later starts too.
+      const absl::Status marked =
+          WriteRecordFile(dir, DamagedMarker(number), {std::string(loaded.message())});
+      if (!marked.ok()) {
+        std::fprintf(stderr, "splinegrid: store: cannot mark %s as damaged: %s\n",
+                     path.string().c_str(), std::string(marked.message()).c_str());
+      }
+      SetAside(root, path, loaded);
+      damaged.push_back(number);
+    }
   }
   SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid, assembler.Finish(/*check_counts=*/false));
+  std::sort(damaged.begin(), damaged.end());
+  damaged.erase(std::unique(damaged.begin(), damaged.end()), damaged.end());
+  grid->damaged_revisions = std::move(damaged);
   // Retention may not have finished removing files before a crash: apply it again.
   const std::vector<int64_t> dropped = DeformRevisionsBeyond(grid->revisions, max_deform_revisions);
   for (int64_t number : dropped) {
@@ -256,8 +298,8 @@ absl::StatusOr<std::unique_ptr<MemoryStore>> OpenDirStore(const std::string& pat
       loaded.push_back(*std::move(grid));
     } else if (grid.status().code() == absl::StatusCode::kResourceExhausted) {
       close(lock_fd);
-      return absl::ResourceExhaustedError(absl::StrCat(
-          "--store=dir:", path, ": loading grids/", name, ": ", grid.status().message()));
+      return absl::ResourceExhaustedError(absl::StrCat("--store=dir:", path, ": loading grids/",
+                                                       name, ": ", grid.status().message()));
     } else {
       SetAside(root, entry.path(), grid.status());
     }

@@ -4,6 +4,7 @@
 // Layout under PATH (every file a record file, core/io/record_file.h):
 //   grids/{id}/grid.records          the header and the source points (archive records)
 //   grids/{id}/r{number}.records     one StoredRevision each (number zero-padded to 12 digits)
+//   grids/{id}/r{number}.damaged     a revision file a start found damaged and set aside (why)
 //   corrupt/                         what a start found damaged, moved aside (and logged)
 // Each file is written as `name.tmp`, fsynced, renamed over `name` and its directory fsynced
 // (rename is atomic, so a reader sees the old state or the new, never half). A new grid is

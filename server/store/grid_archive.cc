@@ -1,5 +1,8 @@
 #include "server/store/grid_archive.h"
 
+#include <algorithm>
+
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/util/quote.h"
 #include "core/util/status_macros.h"
@@ -16,6 +19,7 @@ v1::ArchiveHeader EncodeGridHeader(const StoredGrid& grid, int64_t num_revisions
   header.set_id(grid.id);
   header.set_display_name(grid.display_name);
   header.set_owner(grid.owner);
+  header.set_incarnation(grid.incarnation);
   EncodeStoredTime(grid.create_time, header.mutable_create_time());
   const SourcePoints& source = *grid.source;
   header.set_source_format(source.format);
@@ -93,6 +97,14 @@ absl::Status GridAssembler::AddHeader(const v1::ArchiveHeader& header) {
   if (header.owner().size() > 1024) {
     return absl::InvalidArgumentError("header.owner is longer than 1024 bytes");
   }
+  if (const std::string& incarnation = header.incarnation();
+      incarnation.size() > 64 || !std::all_of(incarnation.begin(), incarnation.end(), [](char c) {
+        return absl::ascii_isdigit(c) || (c >= 'a' && c <= 'f');
+      })) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("header.incarnation = ", QuoteClientString(incarnation),
+                     " is not up to 64 lowercase hexadecimal digits"));
+  }
   if (header.num_source_chunks() < 0 || header.num_revisions() < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "header.num_source_chunks = ", header.num_source_chunks(),
@@ -106,6 +118,7 @@ absl::Status GridAssembler::AddHeader(const v1::ArchiveHeader& header) {
   grid_->id = id;
   grid_->display_name = header.display_name();
   grid_->owner = header.owner();
+  grid_->incarnation = header.incarnation();
   grid_->create_time = create_time;
   header_ = header;
   return absl::OkStatus();

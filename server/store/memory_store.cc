@@ -1,6 +1,8 @@
 #include "server/store/memory_store.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <string_view>
 
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
@@ -9,8 +11,11 @@ namespace splinegrid::server {
 MemoryStore::MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log,
                          std::vector<std::shared_ptr<const StoredGrid>> loaded)
     : max_deform_revisions_(max_deform_revisions), log_(std::move(log)) {
-  for (const auto& grid : loaded)
-    grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
+  // A loaded grid keeps its creation's incarnation (older store files have none).
+  for (auto& grid : loaded) {
+    if (grid->incarnation.empty()) grid = WithIncarnation(*grid, NewIncarnation());
+    grids_.emplace(grid->id, std::move(grid));
+  }
 }
 
 std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
@@ -33,11 +38,14 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
     creating_.insert(grid->id);
   }
   // The source points may take a while to write: outside the lock, the id held by creating_.
-  const absl::Status written = log_->WriteGrid(*grid);
+  // The incarnation is written with them, so that a restart keeps it.
+  std::shared_ptr<const StoredGrid> created = WithIncarnation(*grid, NewIncarnation());
+  const absl::Status written = log_->WriteGrid(*created);
   std::lock_guard<std::mutex> lock(mu_);
-  creating_.erase(grid->id);
-  if (written.ok()) grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
-  return written;
+  creating_.erase(created->id);
+  if (!written.ok()) return LogWriteFailed(written, absl::StrCat("grids/", created->id));
+  grids_.emplace(created->id, std::move(created));
+  return absl::OkStatus();
 }
 
 absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::Get(const std::string& id) {
@@ -68,11 +76,15 @@ absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::AddRevision(
       return absl::AbortedError(absl::StrCat("grids/", id, ": base_revision ", expected_latest,
                                              " is stale; the latest revision is ", latest));
     }
-    published->number = latest + 1;
+    // Past a damaged revision too: its number stays taken (a client may have been given it).
+    const auto& damaged = it->second->damaged_revisions;
+    published->number = std::max(latest, damaged.empty() ? 0 : damaged.back()) + 1;
   }
   // Only this writer changes the grid's revisions, so the number stays free while it is written.
   if (log_) {
-    if (absl::Status written = log_->WriteRevision(id, *published); !written.ok()) return written;
+    if (absl::Status written = log_->WriteRevision(id, *published); !written.ok()) {
+      return LogWriteFailed(written, absl::StrCat("grids/", id, " revision ", published->number));
+    }
   }
   std::shared_ptr<const StoredGrid> replaced;  // released after the lock, with what it dropped
   std::shared_ptr<const StoredGrid> result;
@@ -115,7 +127,10 @@ absl::Status MemoryStore::Delete(const std::string& id, const DeleteCheck& check
   // Under the grid's writer lock: no one deletes or creates it meanwhile.
   if (check) SG_RETURN_IF_ERROR(check(owner));
   if (log_) {
-    if (absl::Status deleted = log_->DeleteGrid(id); !deleted.ok()) return deleted;
+    if (absl::Status deleted = log_->DeleteGrid(id); !deleted.ok()) {
+      return LogWriteFailed(deleted, absl::StrCat("grids/", id),
+                            "it was not deleted and is still served");
+    }
   }
   std::shared_ptr<const StoredGrid> removed;  // released after the lock
   SubscriptionHub::Woken ended;
@@ -171,6 +186,40 @@ absl::StatusOr<GridStore::Counts> MemoryStore::Count() {
     *counts.revisions += static_cast<int64_t>(grid->revisions.size());
   }
   return counts;
+}
+
+absl::Status MemoryStore::LogWriteFailed(const absl::Status& error, const std::string& what,
+                                         const char* outcome) const {
+  std::fprintf(stderr, "splinegrid: store: %s failed: %s\n", what.c_str(),
+               std::string(error.message()).c_str());
+  {
+    std::lock_guard<std::mutex> lock(log_health_mu_);
+    log_failure_ = absl::UnavailableError(absl::StrCat("cannot write: ", error.message()));
+    last_probe_ = absl::Now();
+  }
+  // The file system's own words (after the path the message names first): the caller gets no
+  // server paths.
+  const absl::string_view message = error.message();
+  const size_t colon = message.rfind(": ");
+  const absl::string_view cause =
+      colon == std::string_view::npos ? message : message.substr(colon + 2);
+  const absl::StatusCode code = error.code() == absl::StatusCode::kResourceExhausted
+                                    ? absl::StatusCode::kResourceExhausted
+                                    : absl::StatusCode::kUnavailable;
+  return absl::Status(code, absl::StrCat(what, ": the server's store could not be written (", cause,
+                                         "); ", outcome));
+}
+
+absl::Status MemoryStore::Available() const {
+  if (!log_) return absl::OkStatus();
+  std::lock_guard<std::mutex> lock(log_health_mu_);
+  if (log_failure_.ok() || absl::Now() - last_probe_ < absl::Seconds(1)) return log_failure_;
+  last_probe_ = absl::Now();
+  const absl::Status probe = log_->Probe();
+  log_failure_ = probe.ok()
+                     ? absl::OkStatus()
+                     : absl::UnavailableError(absl::StrCat("cannot write: ", probe.message()));
+  return log_failure_;
 }
 
 }  // namespace splinegrid::server

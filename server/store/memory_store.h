@@ -32,6 +32,9 @@ class DurableLog {
   // when the log is loaded.
   virtual void DropRevisions(const std::string& id, const std::vector<int64_t>& numbers) = 0;
   virtual absl::Status DeleteGrid(const std::string& id) = 0;
+  // Writes, syncs and removes a small file where grids are written: whether writes get
+  // through now (after one failed).
+  virtual absl::Status Probe() = 0;
 };
 
 class MemoryStore final : public GridStore {
@@ -56,10 +59,20 @@ class MemoryStore final : public GridStore {
                                                                       int limit,
                                                                       bool* more) override;
   absl::StatusOr<Counts> Count() override;
+  // With a log: UNAVAILABLE from a failed write of it until a probe write gets through (tried
+  // at most once a second, here).
+  absl::Status Available() const override;
 
  private:
   // The mutex that serialises the writers of grid `id`.
   std::shared_ptr<std::mutex> WriterOf(const std::string& id);
+  // A write of the log failed (`error`, naming the file): noted for Available() and logged;
+  // what the caller gets: RESOURCE_EXHAUSTED for a full disk or quota, UNAVAILABLE for any
+  // other fault of the store (a read-only or failing disk, lost permissions), never an error
+  // that would be about the caller's request (PERMISSION_DENIED, NOT_FOUND, ...).
+  // `what` failed; `outcome` says what that left ("nothing was stored").
+  absl::Status LogWriteFailed(const absl::Status& error, const std::string& what,
+                              const char* outcome = "nothing was stored") const;
 
   const int max_deform_revisions_;
   const std::unique_ptr<DurableLog> log_;
@@ -68,6 +81,10 @@ class MemoryStore final : public GridStore {
   std::set<std::string> creating_;  // ids whose Create is writing to the log
   std::map<std::string, std::shared_ptr<std::mutex>> writers_;
   SubscriptionHub hub_;
+  // The log's health: OK, or why its last write (or probe) failed.
+  mutable std::mutex log_health_mu_;
+  mutable absl::Status log_failure_;
+  mutable absl::Time last_probe_ = absl::InfinitePast();
 };
 
 }  // namespace splinegrid::server

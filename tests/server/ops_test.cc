@@ -137,8 +137,8 @@ TEST_F(OpsTest, ARevisionOfAGridDeletedAndCreatedAgainMeanwhileIsRefused) {
   EXPECT_TRUE(now->revisions.empty());
 }
 
-// Every creation of an id has its own incarnation, grids loaded from a log (dir: store) too, and
-// the store publishes a revision only on the incarnation it was made from.
+// Every creation of an id has its own incarnation, which a grid loaded from a log (dir: store)
+// keeps, and the store publishes a revision only on the incarnation it was made from.
 TEST_F(OpsTest, EveryCreationOfAnIdHasItsOwnIncarnation) {
   const std::shared_ptr<const StoredGrid> first = store_.Get("naca").value();
   EXPECT_EQ(first->incarnation.size(), 16u);
@@ -150,10 +150,16 @@ TEST_F(OpsTest, EveryCreationOfAnIdHasItsOwnIncarnation) {
             absl::StatusCode::kAborted);
   EXPECT_TRUE(store_.AddRevision("naca", GridRevision{}, 0, second->incarnation).ok());
 
-  MemoryStore loaded(/*max_deform_revisions=*/4, nullptr, {second});
-  const std::shared_ptr<const StoredGrid> reloaded = loaded.Get("naca").value();
-  EXPECT_EQ(reloaded->incarnation.size(), 16u);
-  EXPECT_NE(reloaded->incarnation, second->incarnation);
+  // A grid loaded from a log keeps its creation's incarnation (a watch resumed across a
+  // restart still watches it); one written before incarnations were kept gets a new one.
+  auto older = std::make_shared<StoredGrid>(*second);
+  older->id = "older";
+  older->incarnation.clear();
+  MemoryStore loaded(/*max_deform_revisions=*/4, nullptr, {second, older});
+  EXPECT_EQ(loaded.Get("naca").value()->incarnation, second->incarnation);
+  const std::string drawn = loaded.Get("older").value()->incarnation;
+  EXPECT_EQ(drawn.size(), 16u);
+  EXPECT_NE(drawn, second->incarnation);
 }
 
 // A kept deformer keeps its fold gate per check level, charged to the memory budget until the

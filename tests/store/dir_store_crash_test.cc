@@ -204,8 +204,25 @@ TEST_F(DirStoreCrashTest, DamagedFilesAreSkippedWithAMessage) {
   const std::string log = server_->ReadLog();
   EXPECT_THAT(log, ::testing::HasSubstr("r000000000002.records is damaged"));
   EXPECT_THAT(log, ::testing::HasSubstr("other is damaged"));
-  // A new fit takes revision 2's place on disk; the grid keeps working.
-  EXPECT_TRUE(client->Fit("pitch", spec).ok());
+  // Asking for revision 2 says what happened to it (not "dropped by retention").
+  const auto damaged = [&] {
+    const absl::Status status = client->Get("pitch", 2).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << status;
+    EXPECT_THAT(status.message(), ::testing::HasSubstr("revision 2 was damaged on disk"));
+  };
+  damaged();
+  // The grid keeps working; a new fit does not take the damaged revision's number (a client may
+  // have been given it), and both stay so across another restart.
+  const absl::StatusOr<v1::FitGridResponse> refit = client->Fit("pitch", spec);
+  ASSERT_TRUE(refit.ok()) << refit.status();
+  EXPECT_EQ(refit->revision(), 3);
+  EXPECT_EQ(server_->Stop(SIGTERM), 0);
+  client = Start();
+  damaged();
+  const absl::StatusOr<v1::Grid> again = client->Get("pitch");
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(again->latest_revision(), 3);
+  EXPECT_EQ(again->revisions_size(), 2);
   EXPECT_EQ(server_->Stop(SIGTERM), 0);
 }
 
