@@ -109,34 +109,43 @@ absl::StatusOr<ArchiveSummary> Client::ExportGrid(const std::string& name, const
   v1::ExportGridRequest request;
   request.set_name(GridName(name));
   const std::string temp = absl::StrCat(path, ".partial-", getpid());
-  SG_ASSIGN_OR_RETURN(RecordWriter writer, RecordWriter::Create(temp));
-  ArchiveShape shape([&](const std::string& what) {
+  const auto data_loss = [&](const std::string& what) {
     return absl::DataLossError(absl::StrCat("the export of ", request.name(), ": ", what));
-  });
-  int64_t bytes = static_cast<int64_t>(kRecordFileMagic.size());
+  };
+  // Every attempt writes the file from its start (a retried export repeats the stream).
+  std::optional<RecordWriter> writer;
+  std::optional<ArchiveShape> shape;
+  int64_t bytes = 0;
   absl::Status local;  // a write failure or a malformed stream (the call is cancelled)
-  absl::Status status =
-      Call(GridId(request.name()), [&](grpc::ClientContext* context, bool* responded) {
-        auto reader = stub_->ExportGrid(context, request);
-        v1::ExportGridResponse message;
-        std::string payload;
-        while (local.ok() && reader->Read(&message)) {
-          *responded = true;
-          local = shape.Add(message.record());
-          if (local.ok()) {
-            message.record().SerializeToString(&payload);
-            local = writer.Append(payload);
-            bytes += 8 + static_cast<int64_t>(payload.size());
-            if (progress) progress(bytes, 0);
-          }
-          if (!local.ok()) context->TryCancel();
-        }
-        return reader->Finish();
-      });
+  absl::Status status = Call(GridId(request.name()), [&](grpc::ClientContext* context) {
+    writer.reset();
+    shape.emplace(data_loss);
+    bytes = static_cast<int64_t>(kRecordFileMagic.size());
+    absl::StatusOr<RecordWriter> created = RecordWriter::Create(temp);
+    local = created.status();
+    if (!local.ok()) return grpc::Status::OK;  // `local` says why
+    writer.emplace(*std::move(created));
+    auto reader = stub_->ExportGrid(context, request);
+    v1::ExportGridResponse message;
+    std::string payload;
+    while (local.ok() && reader->Read(&message)) {
+      local = shape->Add(message.record());
+      if (local.ok()) {
+        message.record().SerializeToString(&payload);
+        local = writer->Append(payload);
+        bytes += 8 + static_cast<int64_t>(payload.size());
+        if (progress) progress(bytes, 0);
+      }
+      if (!local.ok()) context->TryCancel();
+    }
+    return reader->Finish();
+  });
   if (status.ok()) status = local;
-  if (status.ok()) status = shape.Complete();
-  const absl::Status closed = writer.Close(/*sync=*/status.ok());
-  if (status.ok()) status = closed;
+  if (status.ok()) status = shape->Complete();
+  if (writer.has_value()) {
+    const absl::Status closed = writer->Close(/*sync=*/status.ok());
+    if (status.ok()) status = closed;
+  }
   if (status.ok()) {
     std::error_code error;
     std::filesystem::rename(temp, path, error);
@@ -150,7 +159,7 @@ absl::StatusOr<ArchiveSummary> Client::ExportGrid(const std::string& name, const
     return status;
   }
   SyncDirectory(std::filesystem::path(path).parent_path());
-  return shape.Summary(bytes);
+  return shape->Summary(bytes);
 }
 
 absl::StatusOr<v1::Grid> Client::ImportArchive(const std::string& path, const std::string& new_id,
@@ -176,7 +185,7 @@ absl::StatusOr<v1::Grid> Client::ImportArchive(const std::string& path, const st
 
   v1::Grid grid;
   absl::Status local;  // a damaged file (the call is cancelled: nothing is stored)
-  const absl::Status status = Call(grid_id, [&](grpc::ClientContext* context, bool*) {
+  const absl::Status status = Call(grid_id, [&](grpc::ClientContext* context) {
     auto writer = stub_->ImportArchive(context, &grid);
     v1::ImportArchiveRequest request;
     request.set_grid_id(GridId(new_id));

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"
@@ -99,6 +101,12 @@ class EvaluationAssembler {
 };
 
 }  // namespace
+
+bool BrokeOff(const grpc::Status& status) {
+  return status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+         (status.error_code() == grpc::StatusCode::INTERNAL &&
+          absl::StrContains(status.error_message(), "RST_STREAM"));
+}
 
 absl::Status FromGrpc(const grpc::Status& status) {
   if (status.ok()) return absl::OkStatus();
@@ -201,26 +209,22 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
   Backoff backoff(options_.retry);
   for (int attempts = 1;; ++attempts) {
     auto context = NewContext(deadline, grid, options_.token);
-    bool responded = false;
-    const grpc::Status status = attempt(context.get(), &responded);
+    const grpc::Status status = attempt(context.get());
     std::optional<absl::Duration> wait;
-    if (status.error_code() == grpc::StatusCode::UNAVAILABLE && !responded) {
-      wait = backoff.Next(deadline);
-    }
+    if (BrokeOff(status)) wait = backoff.Next(deadline);
     if (!wait) {
       absl::Status result = FromGrpc(status);
       if (!result.ok() && attempts > 1) {
-        result = absl::Status(result.code(),
-                              absl::StrCat(result.message(), " [attempt ", attempts,
-                                           "; the earlier ones failed with UNAVAILABLE]"));
+        result = absl::Status(result.code(), absl::StrCat(result.message(), " [attempt ", attempts,
+                                                          "; the earlier ones broke off]"));
       }
       // A TLS server closes a plaintext connection at once; say what that usually means.
       if (absl::IsUnavailable(result) && !options_.use_tls &&
           absl::StrContains(result.message(), "Socket closed")) {
-        result = absl::Status(
-            result.code(), absl::StrCat(result.message(),
-                                        " (the server closed the connection: if it uses TLS, "
-                                        "give its CA: --tls_ca, ClientOptions.tls_root_certs)"));
+        result = absl::Status(result.code(),
+                              absl::StrCat(result.message(),
+                                           " (the server closed the connection: if it uses TLS, "
+                                           "give its CA: --tls_ca, ClientOptions.tls_root_certs)"));
       }
       return result;
     }
@@ -275,7 +279,7 @@ absl::StatusOr<v1::Grid> Client::UploadFile(const v1::ImportHeader& header,
   *head.mutable_header() = header;
   const int64_t size = static_cast<int64_t>(bytes.size());
   v1::Grid grid;
-  SG_RETURN_IF_ERROR(Call(GridId(header.grid_id()), [&](grpc::ClientContext* context, bool*) {
+  SG_RETURN_IF_ERROR(Call(GridId(header.grid_id()), [&](grpc::ClientContext* context) {
     auto writer = stub_->ImportGrid(context, &grid);
     bool open = writer->Write(head);
     v1::ImportGridRequest request;
@@ -309,7 +313,7 @@ absl::StatusOr<v1::Grid> Client::ImportPoints(const MultiBlockGrid& source,
     total += static_cast<int64_t>(block.coords().size() * sizeof(double));
   }
   v1::Grid grid;
-  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context, bool*) {
+  SG_RETURN_IF_ERROR(Call(GridId(grid_id), [&](grpc::ClientContext* context) {
     auto writer = stub_->ImportGrid(context, &grid);
     bool open = writer->Write(head);
     int64_t done = 0;
@@ -376,13 +380,15 @@ void WatchCancel::Attach(grpc::ClientContext* context) {
   if (context_ != nullptr && cancelled_) context_->TryCancel();
 }
 
-RevisionStream::RevisionStream(std::function<Call()> open, const RetryPolicy& retry,
-                               std::shared_ptr<grpc::Channel> channel,
+RevisionStream::RevisionStream(std::function<Call(int64_t)> open, int64_t after_revision,
+                               const RetryPolicy& retry, std::shared_ptr<grpc::Channel> channel,
                                std::shared_ptr<WatchCancel> cancel)
     : open_(std::move(open)),
+      retry_(retry),
       backoff_(retry),
       channel_(std::move(channel)),
-      cancel_(std::move(cancel)) {
+      cancel_(std::move(cancel)),
+      after_(after_revision) {
   Open();
 }
 
@@ -390,30 +396,76 @@ RevisionStream::~RevisionStream() { (void)Finish(); }
 
 void RevisionStream::Open() {
   cancel_->Attach(nullptr);  // before the previous attempt's context goes
-  call_ = open_();
+  call_ = open_(after_);
   cancel_->Attach(call_.context.get());
+}
+
+bool RevisionStream::SameCreation() {
+  const std::multimap<grpc::string_ref, grpc::string_ref>& metadata =
+      call_.context->GetServerInitialMetadata();
+  const auto value = [&](const char* key) -> std::optional<std::string> {
+    const auto it = metadata.find(key);
+    if (it == metadata.end()) return std::nullopt;
+    return std::string(it->second.data(), it->second.size());
+  };
+  if (after_ == -1) {
+    int64_t begins_after = 0;
+    if (const std::optional<std::string> after = value(kWatchAfterHeader);
+        after.has_value() && absl::SimpleAtoi(*after, &begins_after) && begins_after >= 0) {
+      after_ = begins_after;
+    }
+  }
+  const std::optional<std::string> incarnation = value(kIncarnationHeader);
+  if (!incarnation.has_value() || incarnation->empty()) return true;
+  if (incarnation_.empty()) incarnation_ = *incarnation;
+  return *incarnation == incarnation_;
+}
+
+bool RevisionStream::Resume() {
+  if (cancel_->cancelled() || !BrokeOff(*finished_)) return false;
+  // A call that was up (its initial metadata arrived) gets the retries afresh.
+  if (!call_.context->GetServerInitialMetadata().empty()) backoff_ = Backoff(retry_);
+  const std::optional<absl::Duration> wait = backoff_.Next(absl::InfiniteFuture());
+  if (!wait) return false;
+  if (PauseBeforeRetry(*channel_, *wait, [&] { return cancel_->cancelled(); })) {
+    finished_ = grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
+    return false;
+  }
+  finished_.reset();
+  ended_ = false;
+  resumed_ = true;
+  Open();
+  return true;
 }
 
 bool RevisionStream::Next(v1::WatchGridResponse* message) {
   while (!ended_) {
-    if (call_.reader->Read(message)) {
-      received_ = true;
+    const bool read = call_.reader->Read(message);
+    ended_ = !read;
+    if (!SameCreation()) {
+      // The watched grid was deleted while the call was resumed, and the id created again.
+      if (read) {
+        call_.context->TryCancel();
+        v1::WatchGridResponse ignored;
+        while (call_.reader->Read(&ignored)) {
+        }
+        ended_ = true;
+      }
+      (void)call_.reader->Finish();
+      finished_ = grpc::Status::OK;
+      return false;
+    }
+    if (read) {
+      after_ = message->revision().revision();
       return true;
     }
-    ended_ = true;
-    if (received_) break;
-    // Nothing arrived yet: a call that failed with UNAVAILABLE is opened again.
     finished_ = call_.reader->Finish();
-    if (finished_->error_code() != grpc::StatusCode::UNAVAILABLE || cancel_->cancelled()) break;
-    const std::optional<absl::Duration> wait = backoff_.Next(absl::InfiniteFuture());
-    if (!wait) break;
-    if (PauseBeforeRetry(*channel_, *wait, [&] { return cancel_->cancelled(); })) {
-      finished_ = grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
-      break;
+    // A resumed call that finds no grid: it was deleted meanwhile, which ends the watch.
+    if (resumed_ && finished_->error_code() == grpc::StatusCode::NOT_FOUND) {
+      finished_ = grpc::Status::OK;
+      return false;
     }
-    finished_.reset();
-    ended_ = false;
-    Open();
+    if (!Resume()) break;
   }
   return false;
 }
@@ -487,18 +539,16 @@ absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
   request.set_name(GridName(request.name()));
   std::optional<EvaluationAssembler> assembler;
   absl::Status malformed;  // the stream did not fit together (the call was cancelled)
-  const absl::Status status =
-      Call(GridId(request.name()), [&](grpc::ClientContext* context, bool* responded) {
-        assembler.emplace(progress);
-        auto reader = stub_->EvaluateGrid(context, request);
-        v1::EvaluateGridResponse message;
-        while (malformed.ok() && reader->Read(&message)) {
-          *responded = true;
-          malformed = assembler->Add(message);
-          if (!malformed.ok()) context->TryCancel();
-        }
-        return reader->Finish();
-      });
+  const absl::Status status = Call(GridId(request.name()), [&](grpc::ClientContext* context) {
+    assembler.emplace(progress);
+    auto reader = stub_->EvaluateGrid(context, request);
+    v1::EvaluateGridResponse message;
+    while (malformed.ok() && reader->Read(&message)) {
+      malformed = assembler->Add(message);
+      if (!malformed.ok()) context->TryCancel();
+    }
+    return reader->Finish();
+  });
   SG_RETURN_IF_ERROR(malformed);
   SG_RETURN_IF_ERROR(status);
   return std::move(*assembler).Finish();
@@ -512,14 +562,17 @@ std::unique_ptr<RevisionStream> Client::Watch(const std::string& name, int64_t a
   if (cancel == nullptr) cancel = std::make_shared<WatchCancel>();
   // The stream may outlive this client: it keeps a stub of its own (sharing the channel).
   std::shared_ptr<v1::SplineGrid::Stub> stub = v1::SplineGrid::NewStub(channel_);
-  auto open = [stub, request, token = options_.token] {
+  auto open = [stub, request, token = options_.token](int64_t after) {
     RevisionStream::Call call;
     // No deadline: a watch lasts.
     call.context = NewContext(absl::InfiniteFuture(), GridId(request.name()), token);
-    call.reader = stub->WatchGrid(call.context.get(), request);
+    v1::WatchGridRequest resumed = request;
+    resumed.set_after_revision(after);
+    call.reader = stub->WatchGrid(call.context.get(), resumed);
     return call;
   };
-  return std::make_unique<RevisionStream>(open, options_.retry, channel_, std::move(cancel));
+  return std::make_unique<RevisionStream>(open, after_revision, options_.retry, channel_,
+                                          std::move(cancel));
 }
 
 absl::Status Client::Watch(const std::string& name, int64_t after_revision,

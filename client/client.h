@@ -23,15 +23,20 @@ namespace splinegrid::client {
 // names one (and with imports and GenerateGrid when the new id is given): a balancer in front
 // of several replicas hashes on it, so the calls about one grid go to one replica.
 inline constexpr char kGridRoutingHeader[] = "x-splinegrid-grid";
+// WatchGrid's initial metadata: where the stream begins and which creation of the id it
+// watches (the proto's WatchGrid), for resuming it.
+inline constexpr char kWatchAfterHeader[] = "x-splinegrid-watch-after";
+inline constexpr char kIncarnationHeader[] = "x-splinegrid-incarnation";
 
 struct ClientOptions {
   // Deadline of every call, measured from its start; retries run within it.
   absl::Duration timeout = absl::Seconds(120);
-  // Calls that fail with UNAVAILABLE (a replica died, a balancer had no upstream, the server is
-  // restarting) are made again: every unary call, and streaming calls that fail before their
-  // first response (EvaluateGrid, ExportGrid, WatchGrid; uploads, whose only response comes at
-  // the end, are sent again whole). Health checks are not retried (a probe answers for now).
-  // The channel of Connect() also reconnects at this pace (initial/max backoff).
+  // Calls that break off (BrokeOff: UNAVAILABLE because a replica died, a balancer had no
+  // upstream or the server is restarting; INTERNAL "RST_STREAM" from a balancer whose upstream
+  // died mid-stream) are made again: every call from its start (EvaluateGrid and ExportGrid
+  // drop what had arrived, uploads are sent again whole), WatchGrid resumed after the last
+  // revision received (RevisionStream). Health checks are not retried (a probe answers for
+  // now). The channel of Connect() also reconnects at this pace (initial/max backoff).
   //
   // An attempt whose answer was lost may still have been carried out, so a retried call that
   // stores something can meet its own earlier attempt: DeformGrid with a base_revision answers
@@ -121,17 +126,25 @@ class WatchCancel {
 //
 // Next() blocks until the server sends the next revision. Cancel() (or cancel()->Cancel()) may
 // be called from any other thread while Next() blocks; the stream must outlive those calls.
-// Destroying an unfinished stream cancels the call. A call that fails with UNAVAILABLE before
-// its first message is opened again under the client's RetryPolicy (inside Next()).
+// Destroying an unfinished stream cancels the call.
+//
+// A call that breaks off (BrokeOff: the replica died or stopped, a balancer reset the stream)
+// is resumed inside Next(), under the client's RetryPolicy, after the last revision received
+// (or where the first call began, which the server states in its initial metadata): no
+// revision is missed or repeated. The retries start afresh once a resumed call is up. When the
+// resumed call finds the grid deleted, or another creation under its id, the stream ends as a
+// deletion ends it (OK).
 class RevisionStream {
  public:
   struct Call {
     std::unique_ptr<grpc::ClientContext> context;
     std::unique_ptr<grpc::ClientReader<v1::WatchGridResponse>> reader;
   };
-  // `open` starts the call on `channel` (again on a retry).
-  RevisionStream(std::function<Call()> open, const RetryPolicy& retry,
-                 std::shared_ptr<grpc::Channel> channel, std::shared_ptr<WatchCancel> cancel);
+  // `open(after)` starts the call for the revisions after `after` on `channel`; the first with
+  // `after_revision` (0: every stored one, -1: only new ones).
+  RevisionStream(std::function<Call(int64_t after)> open, int64_t after_revision,
+                 const RetryPolicy& retry, std::shared_ptr<grpc::Channel> channel,
+                 std::shared_ptr<WatchCancel> cancel);
   ~RevisionStream();
   RevisionStream(const RevisionStream&) = delete;
   RevisionStream& operator=(const RevisionStream&) = delete;
@@ -143,20 +156,30 @@ class RevisionStream {
   void Cancel() { cancel_->Cancel(); }
   const std::shared_ptr<WatchCancel>& cancel() const { return cancel_; }
   // The call's status once Next() has returned false (cancels the call first otherwise): OK
-  // when the server ended the stream (the grid was deleted, or the server is stopping),
-  // CANCELLED after Cancel(), the error otherwise (NOT_FOUND for an unknown grid, ...).
+  // when the grid was deleted (or replaced by another creation under its id), CANCELLED after
+  // Cancel(), the error otherwise (NOT_FOUND for an unknown grid, UNAVAILABLE when the
+  // retries gave up, RESOURCE_EXHAUSTED when the client fell too far behind, ...).
   absl::Status Finish();
 
  private:
-  // Starts the call (again).
+  // Starts the call (again) for the revisions after after_.
   void Open();
+  // Takes in the current call's initial metadata, if it has arrived: where the first call
+  // began (for -1) and which creation of the id is watched. False when the call watches
+  // another creation than the stream did.
+  bool SameCreation();
+  // Whether the ended call (finished_) is resumed; waits before it.
+  bool Resume();
 
-  std::function<Call()> open_;
+  std::function<Call(int64_t)> open_;
+  RetryPolicy retry_;
   Backoff backoff_;
   std::shared_ptr<grpc::Channel> channel_;
   Call call_;
   std::shared_ptr<WatchCancel> cancel_;
-  bool received_ = false;  // a message arrived: no more retries
+  int64_t after_;            // the last revision received, or where the stream began
+  std::string incarnation_;  // the creation watched, once a call has said
+  bool resumed_ = false;     // the current call resumes an earlier one
   bool ended_ = false;
   std::optional<grpc::Status> finished_;  // the reader's Finish(), once called
   std::optional<absl::Status> status_;
@@ -164,6 +187,12 @@ class RevisionStream {
 
 // grpc::Status -> absl::Status.
 absl::Status FromGrpc(const grpc::Status& status);
+
+// Whether a call ended because it broke off rather than being answered: UNAVAILABLE (the
+// server went away or is stopping, a balancer had no upstream), or INTERNAL "RST_STREAM" (a
+// balancer reset a half-sent stream when its upstream died: nginx does, and gRPC reports it as
+// INTERNAL "Received RST_STREAM with error code 2").
+bool BrokeOff(const grpc::Status& status);
 
 // Waits `wait` before the next attempt of a call on `channel`, watching the channel meanwhile:
 // gRPC takes in the outcome of a reconnection only while something waits on the channel
@@ -260,9 +289,9 @@ class Client {
   v1::SplineGrid::Stub& stub() { return *stub_; }
 
  private:
-  // One attempt of a call on `context`: its status; `*responded` set once a response has
-  // arrived (a streaming call is not retried past that).
-  using Attempt = std::function<grpc::Status(grpc::ClientContext* context, bool* responded)>;
+  // One attempt of a call on `context`: its status. An attempt starts from scratch (a stream's
+  // partial results are dropped), so every call may be repeated when it broke off.
+  using Attempt = std::function<grpc::Status(grpc::ClientContext* context)>;
 
   // A context with `deadline` (InfiniteFuture: none), for a non-empty `grid` of printable
   // ASCII (anything else is no grid id the server accepts) the routing header naming it, and
@@ -271,9 +300,9 @@ class Client {
                                                          const std::string& grid,
                                                          const std::string& token);
   // Runs `attempt` on a fresh context (deadline options_.timeout from now, shared by all
-  // attempts; routing header `grid`) until it does not fail with UNAVAILABLE, has responded,
-  // or options_.retry gives up; the last attempt's status (annotated with the attempt count
-  // when there were retries).
+  // attempts; routing header `grid`) until it does not break off (BrokeOff) or options_.retry
+  // gives up; the last attempt's status (annotated with the attempt count when there were
+  // retries).
   absl::Status Call(const std::string& grid, const Attempt& attempt) const;
 
   // Puts one piece of a file into an upload request (its plot3d_chunk or cgns_chunk).
@@ -304,11 +333,10 @@ class Client {
                                                                               Response*),
                                  const Request& request) const {
     Response response;
-    const absl::Status status =
-        Call(RoutingGrid(request), [&](grpc::ClientContext* context, bool*) {
-          response.Clear();
-          return (stub_.get()->*method)(context, request, &response);
-        });
+    const absl::Status status = Call(RoutingGrid(request), [&](grpc::ClientContext* context) {
+      response.Clear();
+      return (stub_.get()->*method)(context, request, &response);
+    });
     if (!status.ok()) return status;
     return response;
   }

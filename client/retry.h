@@ -1,7 +1,7 @@
-// Retrying calls that fail with UNAVAILABLE: a replica died, a balancer had no upstream for a
-// moment, or the server is restarting. The waits between attempts grow exponentially with
-// jitter (the scheme of gRPC's connection backoff, A6 retry design) and never run past the
-// call's deadline.
+// Retrying calls that break off (client.h BrokeOff): a replica died, a balancer had no upstream
+// for a moment or reset a stream, or the server is restarting. The waits between attempts grow
+// exponentially with jitter (the scheme of gRPC's connection backoff, A6 retry design) and never
+// run past the call's deadline.
 #ifndef SPLINEGRID_CLIENT_RETRY_H_
 #define SPLINEGRID_CLIENT_RETRY_H_
 
@@ -12,11 +12,11 @@
 
 namespace splinegrid::client {
 
-// When and how often a call that failed with UNAVAILABLE is made again. The n-th retry waits
+// When and how often a call that broke off is made again. The n-th retry waits
 // min(initial_backoff * multiplier^(n-1), max_backoff), scaled by a random factor uniform in
 // [1 - jitter, 1 + jitter]; a wait that would end at or past the call's deadline is not taken
 // (the call returns its last error). The defaults wait about 50, 100, 200, 400 ms: a call gives
-// up after ~0.75 s of UNAVAILABLE.
+// up after ~0.75 s of failed attempts.
 struct RetryPolicy {
   // Attempts of one call in all, the first included; 1 (or less) turns retrying off.
   int max_attempts = 5;

@@ -15,8 +15,10 @@
 //  - RESOURCE_EXHAUSTED when the client falls more than max_watch_lag revisions behind.
 // The initial metadata goes out as soon as the subscription is in place, so a client can wait
 // for it (ClientReader::WaitForInitialMetadata) to know that it will see every revision
-// published from then on. No reaction blocks: each takes the reactor's mutex for a moment and
-// calls gRPC outside it; at most one operation (metadata or a write) is in flight.
+// published from then on; it says where the stream begins and which creation of the id it
+// watches (x-splinegrid-watch-after, x-splinegrid-incarnation), for a client that resumes. No
+// reaction blocks: each takes the reactor's mutex for a moment and calls gRPC outside it; at most
+// one operation (metadata or a write) is in flight.
 //
 // Lifetime: the reactor is owned by a shared_ptr that it releases in OnDone; the store reaches it
 // only through a weak_ptr, and a wake-up holds a shared_ptr while it runs, so a wake-up racing
@@ -33,6 +35,9 @@
 
 namespace splinegrid::server {
 namespace {
+
+constexpr char kWatchAfterHeader[] = "x-splinegrid-watch-after";
+constexpr char kIncarnationHeader[] = "x-splinegrid-incarnation";
 
 class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, public GridWatcher {
  public:
@@ -103,6 +108,9 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
         ops::RevisionFeed::Open(state_->Ops(), std::move(id), request_->after_revision(),
                                 std::weak_ptr<GridWatcher>(self_),
                                 static_cast<size_t>(state_->options.max_watch_lag)));
+    // Where this stream begins, for a client that resumes it elsewhere (the proto's WatchGrid).
+    context_->AddInitialMetadata(kWatchAfterHeader, absl::StrCat(feed->begins_after()));
+    context_->AddInitialMetadata(kIncarnationHeader, feed->incarnation());
     std::lock_guard<std::mutex> lock(mu_);
     feed_ = std::move(feed);
     return absl::OkStatus();

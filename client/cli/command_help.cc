@@ -57,7 +57,8 @@ std::string OverviewHelp(absl::string_view version) {
   }
   absl::StrAppend(&out, "\n",
                   Wrap("Client commands (all but serve and airfoil) talk to --server host:port "
-                       "(default localhost:50051) and take --json, --timeout, and for a secured "
+                       "(default $SPLINEGRID_SERVER, else localhost:50051) and take --json, "
+                       "--timeout, and for a secured "
                        "server --token (or $SPLINEGRID_TOKEN), --tls_ca, --tls_cert, --tls_key "
                        "and --tls_server_name. Exit status: 0 success, 1 a failed call, 2 a "
                        "usage error, 3 a revision stored whose quality is not met "

@@ -81,10 +81,18 @@ absl::StatusOr<std::vector<v1::FaceKind>> ParseFaceFlag(const std::string& text)
 
 absl::Status Usage(const std::string& message) { return absl::InvalidArgumentError(message); }
 
+std::string ServerAddress() {
+  if (std::string address = absl::GetFlag(FLAGS_server); !address.empty()) return address;
+  if (const char* env = std::getenv("SPLINEGRID_SERVER"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return "localhost:50051";
+}
+
 std::unique_ptr<client::Client> Connect() {
   client::ClientOptions options = ConnectionOptions();
   options.timeout = absl::GetFlag(FLAGS_timeout);
-  return client::Client::Connect(absl::GetFlag(FLAGS_server), options);
+  return client::Client::Connect(ServerAddress(), options);
 }
 
 void Print(const std::string& human, const google::protobuf::Message& message) {

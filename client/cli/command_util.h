@@ -23,7 +23,12 @@ namespace splinegrid::cli {
 // INVALID_ARGUMENT with `message` (exit status 2).
 absl::Status Usage(const std::string& message);
 
-// A client for --server with --timeout and the token and TLS settings of PrepareConnection.
+// The server to talk to: --server, else $SPLINEGRID_SERVER (what deploy/local/start.sh
+// prints), else localhost:50051.
+std::string ServerAddress();
+
+// A client for ServerAddress() with --timeout and the token and TLS settings of
+// PrepareConnection.
 std::unique_ptr<client::Client> Connect();
 
 // Prints `human`, or with --json `message` as JSON, to stdout.

@@ -3,7 +3,9 @@
 #include "absl/flags/flag.h"
 #include "server/server_options.h"
 
-ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server to talk to (host:port)");
+ABSL_FLAG(std::string, server, "",
+          "splinegrid server to talk to, host:port (default: $SPLINEGRID_SERVER, else "
+          "localhost:50051)");
 ABSL_FLAG(bool, json, false, "print results as JSON");
 ABSL_FLAG(absl::Duration, timeout, absl::Minutes(10), "deadline of each call");
 

@@ -15,10 +15,11 @@
 // a step (a fold it found itself) or a step failed, 2 for bad flags, 3 when the setup (import,
 // fit) failed.
 //
-// Surviving a replica's death: every call is retried on UNAVAILABLE with backoff (--attempts,
-// the client's RetryPolicy). A DeformGrid attempt whose answer was lost may still have been
-// stored; its retry then meets base_revision and answers ABORTED. So when a deform fails with
-// anything but a fold (FAILED_PRECONDITION) or a bad request, the client asks GetGrid(step=n)
+// Surviving a replica's death: every call that breaks off (UNAVAILABLE, or INTERNAL
+// "RST_STREAM" from a balancer) is made again with backoff (--attempts, the client's
+// RetryPolicy; an evaluation from its start). A DeformGrid attempt whose answer was lost may still
+// have been stored; its retry then meets base_revision and answers ABORTED. So when a deform fails
+// with anything but a fold (FAILED_PRECONDITION) or a bad request, the client asks GetGrid(step=n)
 // whether that step's revision landed and, if so, takes it as acknowledged. --acked FILE
 // records one line "step revision" per acknowledged step (flushed at once), so every
 // acknowledged revision can be checked afterwards.
@@ -163,24 +164,6 @@ absl::StatusOr<std::optional<v1::Revision>> RevisionOfStep(client::Client& clien
   return grid->revision();
 }
 
-// EvaluateGrid, asked for again when the stream broke off after its first chunk (which the
-// client does not retry): a replica that dies mid-reply shows as UNAVAILABLE, or, through a
-// balancer that resets the half-sent stream, as INTERNAL "RST_STREAM". Evaluation only reads,
-// so repeating it is safe; a few attempts with growing waits cover the balancer's failover.
-absl::StatusOr<client::EvaluatedGrid> Evaluate(client::Client& client,
-                                               const v1::EvaluateGridRequest& request) {
-  absl::StatusOr<client::EvaluatedGrid> grid = client.Evaluate(request);
-  for (int attempt = 1; attempt < 5; ++attempt) {
-    const bool broken = absl::IsUnavailable(grid.status()) ||
-                        (absl::IsInternal(grid.status()) &&
-                         absl::StrContains(grid.status().message(), "RST_STREAM"));
-    if (!broken) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50 << attempt));
-    grid = client.Evaluate(request);
-  }
-  return grid;
-}
-
 // One step's DeformGrid (retried on UNAVAILABLE by the client) and, when it fails without a
 // verdict, whether one of its attempts was stored anyway:
 //   - OK: acknowledged;
@@ -313,7 +296,7 @@ int Run() {
   evaluate.set_name(name);
   evaluate.set_refinement_level(level);
   evaluate.set_revision(fit->revision());
-  absl::StatusOr<client::EvaluatedGrid> start = Evaluate(*client, evaluate);
+  absl::StatusOr<client::EvaluatedGrid> start = client->Evaluate(evaluate);
   if (!start.ok()) {
     std::fprintf(stderr, "evaluate: %s\n", start.status().ToString().c_str());
     return 3;
@@ -368,7 +351,7 @@ int Run() {
 
     const auto evaluate_start = std::chrono::steady_clock::now();
     evaluate.set_revision(outcome.revision);
-    absl::StatusOr<client::EvaluatedGrid> grid = Evaluate(*client, evaluate);
+    absl::StatusOr<client::EvaluatedGrid> grid = client->Evaluate(evaluate);
     evaluate_ms.push_back(MillisecondsSince(evaluate_start));
     if (!grid.ok()) {
       std::printf("step %d: evaluate: %s\n", n, grid.status().ToString().c_str());

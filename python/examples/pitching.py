@@ -17,8 +17,9 @@ Prints latency percentiles (p50, p90, p99, max) of the deform call, the evaluate
 whole step, and the number of folded cells. Exits 1 if a cell folded, the server refused a
 step (a fold it found itself) or a step failed, 3 when the setup (import, fit) failed.
 
-Surviving a replica's death: every call is retried on UNAVAILABLE with backoff (--attempts,
-the client's RetryPolicy). A DeformGrid attempt whose answer was lost may still have been
+Surviving a replica's death: every call that breaks off (UNAVAILABLE, or INTERNAL "RST_STREAM"
+from a balancer) is made again with backoff (--attempts, the client's RetryPolicy; an
+evaluation from its start). A DeformGrid attempt whose answer was lost may still have been
 stored; its retry then meets base_revision and answers ABORTED. So when a deform fails with
 anything but a fold (FAILED_PRECONDITION) or a bad request, the client asks
 ``get(name, step=n)`` whether that step's revision landed and, if so, takes it as
@@ -117,23 +118,6 @@ def revision_of_step(client: Client, name: str, step: int):
     return revision
 
 
-def evaluate(client: Client, name: str, level: int, revision: int):
-    """The revision at ``level``, asked for again when the stream broke off after its first
-    chunk (which the client does not retry): a replica that dies mid-reply shows as
-    UNAVAILABLE, or, through a balancer that resets the half-sent stream, as INTERNAL
-    "RST_STREAM". Evaluation only reads, so repeating it is safe; a few attempts with growing
-    waits cover the balancer's failover."""
-    for attempt in range(1, 6):
-        try:
-            return client.evaluate(name, level=level, revision=revision)
-        except SplinegridError as error:
-            broken = (error.code == "UNAVAILABLE"
-                      or (error.code == "INTERNAL" and "RST_STREAM" in error.message))
-            if not broken or attempt == 5:
-                raise
-        time.sleep(0.05 * 2 ** attempt)
-
-
 def deform_step(client: Client, name: str, acked_step: int, late: list,
                 **deform) -> DeformOutcome:
     """One step's deform (retried on UNAVAILABLE by the client) and, when it fails without a
@@ -229,7 +213,7 @@ def main() -> int:
             return 3
         try:
             fit = client.fit(name, boundary_tolerances={})  # 0.15e-3 wall, 2e-3, 8e-3 outer
-            start = evaluate(client, name, args.level, fit.revision)
+            start = client.evaluate(name, level=args.level, revision=fit.revision)
         except SplinegridError as error:
             print(f"fit: {error}", file=sys.stderr)
             client.delete(name)
@@ -288,7 +272,7 @@ def main() -> int:
             if outcome.answered:
                 server_ms.append(1e3 * outcome.report.seconds)
             try:
-                grid = evaluate(client, name, args.level, outcome.revision)
+                grid = client.evaluate(name, level=args.level, revision=outcome.revision)
             except SplinegridError as error:
                 print(f"step {n}: evaluate: {error}")
                 failed += 1

@@ -114,23 +114,25 @@ class _ArchiveCalls(_Calls):
         request = service_pb2.ExportGridRequest(name=grid_name(name))
         path = os.fspath(path)
         temp = f"{path}.partial-{os.getpid()}"
-        try:
+        def attempt(a: _Attempt) -> _ArchiveShape:
+            # Every attempt writes the file from its start (a retried export repeats the
+            # stream).
+            shape = _ArchiveShape(lambda what: _data_loss(
+                f"the export of {request.name}: {what}"))
             with records.RecordWriter(temp) as writer:
-                def attempt(a: _Attempt) -> _ArchiveShape:
-                    shape = _ArchiveShape(lambda what: _data_loss(
-                        f"the export of {request.name}: {what}"))
-                    call = self._export_grid(request, timeout=a.timeout, metadata=a.metadata)
-                    try:
-                        for payload in a.marking(call):
-                            shape.add(payload)
-                            writer.append(payload)
-                    except BaseException:
-                        call.cancel()
-                        raise
-                    shape.complete()
-                    return shape
+                call = self._export_grid(request, timeout=a.timeout, metadata=a.metadata)
+                try:
+                    for payload in call:
+                        shape.add(payload)
+                        writer.append(payload)
+                except BaseException:
+                    call.cancel()
+                    raise
+                shape.complete()
+            return shape
 
-                shape = self._call(attempt, _routing_grid(request))
+        try:
+            shape = self._call(attempt, _routing_grid(request))
             os.replace(temp, path)
         except BaseException:
             with contextlib.suppress(OSError):

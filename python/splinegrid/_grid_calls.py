@@ -3,7 +3,7 @@ page), delete, and watch (the revisions as they are stored)."""
 
 from __future__ import annotations
 
-from typing import Iterable, Literal, Optional, Union, overload
+from typing import Any, Iterable, Literal, Optional, Union, overload
 
 from splinegrid._args import _integer, _set_step, grid_name
 from splinegrid._calls import _Calls
@@ -45,8 +45,9 @@ class _GridCalls(_Calls):
 
         The revisions after ``after_revision`` that are stored already come first (0: all of
         them, -1: none), then each new one (a fit, a fairing, a deformation) as it is stored.
-        The call has no deadline: it lasts until the grid is deleted, the server stops, or the
-        watch is closed or cancelled::
+        The call has no deadline: it lasts until the grid is deleted, or the watch is closed or
+        cancelled; when it breaks off (the replica died or stopped) it is resumed after the
+        last revision received::
 
             with client.watch("naca") as revisions:
                 for info in revisions:
@@ -54,8 +55,13 @@ class _GridCalls(_Calls):
         """
         request = _watch_request(name, after_revision)
         metadata = self._metadata(_routing_grid(request))
-        return RevisionWatch(lambda: self.stub.WatchGrid(request, metadata=metadata),
-                             request.name, self.retry, self._pause_before_retry)
+
+        def open_call(after: int) -> Any:
+            resumed = service_pb2.WatchGridRequest(name=request.name, after_revision=after)
+            return self.stub.WatchGrid(resumed, metadata=metadata)
+
+        return RevisionWatch(open_call, request.name, request.after_revision, self.retry,
+                             self._pause_before_retry)
 
     @overload
     def get(self, name: str, revision: int = 0, full: Literal[False] = False,

@@ -3,7 +3,7 @@ serialization, credentials files, and the hand-encoded grpc.health.v1 messages."
 
 from __future__ import annotations
 
-from typing import Iterable, Iterator, Optional, TypeVar, Union
+from typing import Optional, TypeVar, Union
 
 from google.protobuf.message import Message
 
@@ -18,21 +18,15 @@ _HEALTH_STATUS = ("UNKNOWN", "SERVING", "NOT_SERVING", "SERVICE_UNKNOWN")
 
 
 class _Attempt:
-    """One try of a call: its ``timeout`` (what is left of the call's deadline), its
-    ``metadata``, and whether a response has arrived (``responded``; see ``marking``)."""
+    """One try of a call: its ``timeout`` (what is left of the call's deadline) and its
+    ``metadata``. An attempt starts from scratch (a stream's partial results are dropped), so
+    every call may be repeated when it broke off."""
 
-    __slots__ = ("timeout", "metadata", "responded")
+    __slots__ = ("timeout", "metadata")
 
     def __init__(self, timeout: float, metadata: Optional[Metadata]) -> None:
         self.timeout = timeout
         self.metadata = metadata
-        self.responded = False
-
-    def marking(self, messages: Iterable[_T]) -> Iterator[_T]:
-        """``messages`` passed through, setting ``responded`` at the first."""
-        for message in messages:
-            self.responded = True
-            yield message
 
 
 def _routing_grid(request: Union[bytes, Message]) -> str:

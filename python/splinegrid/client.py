@@ -19,11 +19,12 @@ Deadlines
     retries run within it.
 
 Retries
-    A call that fails with UNAVAILABLE (a replica died, a balancer had no upstream, the server
-    is restarting) is made again after a growing, jittered wait (:class:`RetryPolicy`): every
-    unary call, and streaming calls that fail before their first response (``evaluate``,
-    ``export_grid``, ``watch``; uploads, whose only response comes at the end, are sent again
-    whole). ``health`` is not retried. An attempt whose answer was lost may still have been
+    A call that breaks off (UNAVAILABLE: a replica died, a balancer had no upstream, the server
+    is restarting; INTERNAL "RST_STREAM": a balancer whose upstream died mid-stream reset it)
+    is made again after a growing, jittered wait (:class:`RetryPolicy`): every call from its
+    start (``evaluate`` and ``export_grid`` drop what had arrived, uploads are sent again
+    whole), and ``watch`` resumed after the last revision received (:class:`RevisionWatch`).
+    ``health`` is not retried. An attempt whose answer was lost may still have been
     carried out, so a retried call that stores something can meet its own earlier attempt:
     ``deform`` with a ``base_revision`` answers ABORTED (ask ``get(name, step=...)`` whether
     the step landed, as ``examples/pitching.py`` does); ``deform`` without one, ``fit`` and
@@ -90,7 +91,7 @@ from splinegrid._transport import (GRID_ROUTING_HEADER, SERVICE, _as, _Attempt,
 from splinegrid._upload_calls import _UploadCalls
 from splinegrid._upload_calls import UPLOAD_CHUNK_BYTES as UPLOAD_CHUNK_BYTES
 from splinegrid.filekind import FileKind, detect_file_kind
-from splinegrid.errors import SplinegridError, _code, _translated_errors
+from splinegrid.errors import SplinegridError, _broke_off, _translated_errors
 from splinegrid.retry import RetryPolicy
 from splinegrid.v1 import grid_pb2
 from splinegrid.v1 import splinegrid_service_pb2_grpc as service_grpc
@@ -106,7 +107,8 @@ _T = TypeVar("_T")
 
 class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls, _DeformCalls,
              _EvaluationCalls):
-    """A connection to a splinegrid server (a plaintext or TLS channel to ``target``).
+    """A connection to a splinegrid server (a plaintext or TLS channel to ``target``; default:
+    the environment variable ``SPLINEGRID_SERVER``, else ``localhost:50051``).
 
     Use it as a context manager, or call :meth:`close`. ``timeout`` is the deadline of every
     call in seconds; ``retry`` says how calls failing with UNAVAILABLE are retried within it
@@ -122,13 +124,15 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
     is the name the server's certificate must carry when it is not the target's host.
     """
 
-    def __init__(self, target: str = "localhost:50051", timeout: float = 120.0,
+    def __init__(self, target: Optional[str] = None, timeout: float = 120.0,
                  retry: Optional[RetryPolicy] = None, *, token: Optional[str] = None,
                  tls: bool = False, tls_ca: Optional[str] = None,
                  tls_cert: Optional[str] = None, tls_key: Optional[str] = None,
                  tls_server_name: Optional[str] = None) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout = {timeout}; must be positive")
+        if target is None:
+            target = os.environ.get("SPLINEGRID_SERVER") or "localhost:50051"
         if token is None:
             token = os.environ.get("SPLINEGRID_TOKEN", "")
         if token and not (token.isascii() and token.isprintable() and " " not in token):
@@ -198,11 +202,10 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
     # Calls: deadline, routing header, retries, error translation
 
     def _call(self, attempt: Callable[[_Attempt], _T], grid: str = "") -> _T:
-        """Runs ``attempt`` (one try of a call, given its timeout and metadata) until it does not
-        fail with UNAVAILABLE, it has responded (``_Attempt.responded``: a stream is not
-        retried past its first message), or ``self.retry`` gives up; all attempts share the
-        deadline ``self.timeout`` from now. grpc.RpcError -> SplinegridError (chained; the
-        message says the attempt when there were retries)."""
+        """Runs ``attempt`` (one try of a call, given its timeout and metadata, from scratch)
+        until it does not break off (``errors._broke_off``) or ``self.retry`` gives up; all
+        attempts share the deadline ``self.timeout`` from now. grpc.RpcError ->
+        SplinegridError (chained; the message says the attempt when there were retries)."""
         deadline = time.monotonic() + self.timeout
         metadata = self._metadata(grid)
         waits = self.retry.waits()
@@ -216,14 +219,14 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                 raise
             except grpc.RpcError as error:
                 wait = None
-                if _code(error) == grpc.StatusCode.UNAVAILABLE and not state.responded:
+                if _broke_off(error):
                     wait = next(waits, None)
                 if wait is None or time.monotonic() + wait >= deadline:
                     translated = SplinegridError.from_rpc_error(error)
                     if attempts > 1:
                         translated = SplinegridError(
                             translated.code, f"{translated.message} [attempt {attempts}; the "
-                            "earlier ones failed with UNAVAILABLE]")
+                            "earlier ones broke off]")
                     if (translated.code == "UNAVAILABLE" and not self._tls
                             and "Socket closed" in translated.message):
                         # A TLS server closes a plaintext connection at once.

@@ -32,6 +32,18 @@ def _code(error: grpc.RpcError) -> grpc.StatusCode:
     return error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
 
 
+def _broke_off(error: grpc.RpcError) -> bool:
+    """Whether a call ended because it broke off rather than being answered: UNAVAILABLE (the
+    server went away or is stopping, a balancer had no upstream), or INTERNAL "RST_STREAM" (a
+    balancer reset a half-sent stream when its upstream died: nginx does, and gRPC reports it
+    as INTERNAL "Received RST_STREAM with error code 2"). The C++ client's ``BrokeOff``."""
+    code = _code(error)
+    if code == grpc.StatusCode.UNAVAILABLE:
+        return True
+    details = error.details() if hasattr(error, "details") else ""
+    return code == grpc.StatusCode.INTERNAL and "RST_STREAM" in (details or "")
+
+
 @contextlib.contextmanager
 def _translated_errors() -> Iterator[None]:
     """grpc.RpcError -> SplinegridError (chained)."""

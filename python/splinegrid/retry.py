@@ -1,4 +1,5 @@
-"""When and how often a call that failed with UNAVAILABLE is made again."""
+"""When and how often a call that broke off (UNAVAILABLE, a balancer's RST_STREAM) is made
+again."""
 
 from __future__ import annotations
 
@@ -11,12 +12,12 @@ from typing import Iterator
 
 
 class RetryPolicy:
-    """When and how often a call that failed with UNAVAILABLE is made again (the C++ client's
+    """When and how often a call that broke off is made again (the C++ client's
     ``RetryPolicy``). The n-th retry waits ``min(initial_backoff * multiplier**(n-1),
     max_backoff)`` seconds, scaled by a random factor uniform in ``[1 - jitter, 1 + jitter]``;
     a wait that would end at or past the call's deadline is not taken (the call raises its last
     error). The defaults wait about 0.05, 0.1, 0.2, 0.4 s: a call gives up after ~0.75 s of
-    UNAVAILABLE."""
+    failed attempts."""
 
     max_attempts: int = 5          # attempts in all, the first included; 1 turns retrying off
     initial_backoff: float = 0.05  # seconds before the first retry

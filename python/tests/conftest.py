@@ -22,8 +22,8 @@ DATA = pathlib.Path(os.environ.get("SPLINEGRID_SHARED_DATA", REPO.parent / "shar
 
 
 def server_binary() -> pathlib.Path:
-    """``SPLINEGRID_SERVER`` (set by the CTest registration), else ``REPO/build/splinegrid``."""
-    return pathlib.Path(os.environ.get("SPLINEGRID_SERVER", REPO / "build" / "splinegrid"))
+    """``SPLINEGRID_BINARY`` (set by the CTest registration), else ``REPO/build/splinegrid``."""
+    return pathlib.Path(os.environ.get("SPLINEGRID_BINARY", REPO / "build" / "splinegrid"))
 
 
 @contextlib.contextmanager
@@ -55,7 +55,7 @@ def server():
     always passes it."""
     binary = server_binary()
     if not binary.is_file():
-        pytest.skip(f"{binary} is not built (set SPLINEGRID_SERVER)")
+        pytest.skip(f"{binary} is not built (set SPLINEGRID_BINARY)")
     port = _free_port()
     process = subprocess.Popen([str(binary), "serve", f"--address=127.0.0.1:{port}",
                                 "--drain_notice=0s", "--shutdown_grace=1s"],

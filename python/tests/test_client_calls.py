@@ -1,6 +1,7 @@
-"""The Python client's calls against an in-process fake SplineGrid server: retries of
-UNAVAILABLE (unary, before a stream's first message, within the deadline), the routing header,
-and export/import of archives (framing, a damaged file cancels the upload)."""
+"""The Python client's calls against an in-process fake SplineGrid server: retries of calls
+that broke off (UNAVAILABLE, a balancer's RST_STREAM; unary, streams from their start, within
+the deadline), watches resumed where they broke off, the routing header, and export/import of
+archives (framing, a damaged file cancels the upload)."""
 
 import threading
 import time
@@ -29,6 +30,7 @@ class FakeSplineGrid(service_grpc.SplineGridServicer):
         self.imported = None     # (grid_id, [record bytes]) of the last complete ImportArchive
         self.import_ended = threading.Event()
         self.import_outcome = None
+        self.resets = 2          # EvaluateGrid of grids/reset: reset after its first message
 
     def _enter(self, method, context):
         self.calls[method] = self.calls.get(method, 0) + 1
@@ -66,6 +68,11 @@ class FakeSplineGrid(service_grpc.SplineGridServicer):
                 block=0, extents=grid_pb2.Extents(i=2, j=1, k=1))]))
         if request.name == "grids/broken":
             context.abort(grpc.StatusCode.UNAVAILABLE, "broken off")
+        if request.name == "grids/reset" and self.resets > 0:
+            self.resets -= 1
+            context.abort(grpc.StatusCode.INTERNAL, "Received RST_STREAM with error code 2")
+        if request.name == "grids/bug":
+            context.abort(grpc.StatusCode.INTERNAL, "a server bug")
         yield service_pb2.EvaluateGridResponse(chunk=service_pb2.EvaluationChunk(
             block=0, field=service_pb2.FIELD_POINTS, offset=0, values=[0, 0, 1, 0]))
 
@@ -137,7 +144,7 @@ def test_retries_stop_after_max_attempts_with_the_last_error(fake):
         with pytest.raises(SplinegridError) as error:
             client.deform("naca", rotate_degrees=1.0)
     assert error.value.code == "UNAVAILABLE"
-    assert "no upstream [attempt 4; the earlier ones failed with UNAVAILABLE]" in str(error.value)
+    assert "no upstream [attempt 4; the earlier ones broke off]" in str(error.value)
     assert fake.calls["DeformGrid"] == 4
 
 
@@ -174,16 +181,27 @@ def test_uploads_are_sent_again_whole_and_route_by_the_requested_id(fake):
     assert fake.routing["ImportGrid"] == ["new", "new", None]
 
 
-def test_a_stream_is_retried_only_before_its_first_message(fake):
+def test_a_broken_stream_is_asked_for_again_from_its_start(fake):
     fake.failures["EvaluateGrid"] = 2
     with connect(fake) as client:
         grid = client.evaluate("naca")
         assert grid.revision == 2 and grid[0].points.shape == (1, 1, 2, 2)
         assert fake.calls["EvaluateGrid"] == 3
-        with pytest.raises(SplinegridError, match="UNAVAILABLE: broken off$"):
+        # Reset by a balancer after the first message, twice: the third attempt is whole.
+        grid = client.evaluate("reset")
+        assert grid[0].points.shape == (1, 1, 2, 2)
+        assert fake.calls["EvaluateGrid"] == 6
+        # Broken off after the first message every time: the retries give up.
+        with pytest.raises(SplinegridError, match=r"UNAVAILABLE: broken off \[attempt 4; the "
+                           r"earlier ones broke off\]$"):
             client.evaluate("broken")
-    assert fake.calls["EvaluateGrid"] == 4
-    assert fake.routing["EvaluateGrid"] == ["naca"] * 3 + ["broken"]
+        assert fake.calls["EvaluateGrid"] == 10
+        # Any other INTERNAL is an answer, not a break.
+        with pytest.raises(SplinegridError, match="INTERNAL: a server bug$"):
+            client.evaluate("bug")
+    assert fake.calls["EvaluateGrid"] == 11
+    assert fake.routing["EvaluateGrid"] == (["naca"] * 3 + ["reset"] * 3 + ["broken"] * 4
+                                            + ["bug"])
 
 
 def test_a_watch_is_opened_again_before_its_first_revision(fake):
@@ -193,6 +211,114 @@ def test_a_watch_is_opened_again_before_its_first_revision(fake):
             assert [info.revision for info in revisions] == [1, 2]
     assert fake.calls["WatchGrid"] == 3
     assert fake.routing["WatchGrid"] == ["naca"] * 3
+
+
+class BreakingWatch(service_grpc.SplineGridServicer):
+    """WatchGrid of a grid whose latest revision is ``latest`` (creation ``incarnation``):
+    sends the initial metadata, then per call the revisions after the request's, until the
+    call's entry in ``breaks`` (a count of revisions, then an abort with ``break_code``) or
+    the end (``None``: the stream ends, as at a deletion). Records each request's
+    after_revision."""
+
+    def __init__(self, latest, breaks, incarnations=("00aa",),
+                 break_code=grpc.StatusCode.UNAVAILABLE, break_message="replica gone"):
+        self.latest = latest
+        self.breaks = list(breaks)
+        self.incarnations = list(incarnations)
+        self.break_code, self.break_message = break_code, break_message
+        self.afters = []
+
+    def WatchGrid(self, request, context):
+        call = len(self.afters)
+        self.afters.append(request.after_revision)
+        after = self.latest if request.after_revision == -1 else request.after_revision
+        incarnation = self.incarnations[min(call, len(self.incarnations) - 1)]
+        context.send_initial_metadata((("x-splinegrid-watch-after", str(after)),
+                                       ("x-splinegrid-incarnation", incarnation)))
+        sent = 0
+        limit = self.breaks[call] if call < len(self.breaks) else None
+        for revision in range(after + 1, self.latest + 1):
+            if limit is not None and sent == limit:
+                break
+            yield service_pb2.WatchGridResponse(revision=grid_pb2.RevisionInfo(
+                revision=revision))
+            sent += 1
+        if limit is not None:
+            context.abort(self.break_code, self.break_message)
+
+
+def watch_through(servicer, after_revision, **watch_args):
+    """The revisions a watch of ``servicer`` yields (FAST retries) and how it ended."""
+    server = grpc.server(futures.ThreadPoolExecutor(max_workers=2))
+    service_grpc.add_SplineGridServicer_to_server(servicer, server)
+    port = server.add_insecure_port("127.0.0.1:0")
+    server.start()
+    try:
+        with Client(f"127.0.0.1:{port}", retry=FAST) as client:
+            seen = []
+            try:
+                with client.watch("naca", after_revision) as revisions:
+                    for info in revisions:
+                        seen.append(info.revision)
+            except SplinegridError as error:
+                return seen, error
+            return seen, None
+    finally:
+        server.stop(None)
+
+
+def test_a_broken_watch_resumes_after_the_last_revision_it_received():
+    # Breaks after 2 revisions, then after 0, then after 1, then runs to the end: every break
+    # is followed by a call that was up, so the retries start afresh each time.
+    servicer = BreakingWatch(latest=6, breaks=[2, 0, 1, 0, 0, 0, None])
+    seen, error = watch_through(servicer, 0)
+    assert error is None
+    assert seen == [1, 2, 3, 4, 5, 6]
+    assert servicer.afters == [0, 2, 2, 3, 3, 3, 3]
+
+
+def test_a_watch_of_new_revisions_resumes_where_it_began():
+    # after_revision -1 when revision 6 is the latest; the first call breaks before any new
+    # one: the second asks for those after 6 (not -1, which would skip what came meanwhile).
+    servicer = BreakingWatch(latest=6, breaks=[0, None])
+    seen, error = watch_through(servicer, -1)
+    assert error is None and seen == []
+    assert servicer.afters == [-1, 6]
+
+
+def test_a_balancer_reset_is_resumed_and_other_errors_end_the_watch():
+    servicer = BreakingWatch(latest=3, breaks=[1, None], break_code=grpc.StatusCode.INTERNAL,
+                             break_message="Received RST_STREAM with error code 2")
+    assert watch_through(servicer, 0) == ([1, 2, 3], None)
+    servicer = BreakingWatch(latest=3, breaks=[1, None], break_code=grpc.StatusCode.INTERNAL,
+                             break_message="a server bug")
+    seen, error = watch_through(servicer, 0)
+    assert seen == [1] and error.code == "INTERNAL" and servicer.afters == [0]
+
+
+def test_a_watch_whose_grid_was_created_again_ends_when_it_resumes():
+    servicer = BreakingWatch(latest=4, breaks=[2, None], incarnations=("00aa", "00bb"))
+    seen, error = watch_through(servicer, 0)
+    assert error is None
+    assert seen == [1, 2]  # not 3 and 4: they are another grid's
+    assert servicer.afters == [0, 2]
+
+
+class GoneAfterFirstCall(BreakingWatch):
+    """Breaks the first call after one revision; every later call fails before its metadata."""
+
+    def WatchGrid(self, request, context):
+        if self.afters:
+            self.afters.append(request.after_revision)
+            context.abort(grpc.StatusCode.UNAVAILABLE, "down")
+        yield from super().WatchGrid(request, context)
+
+
+def test_a_watch_gives_up_when_the_server_stays_away():
+    servicer = GoneAfterFirstCall(latest=3, breaks=[1])
+    seen, error = watch_through(servicer, 0)
+    assert seen == [1] and error.code == "UNAVAILABLE" and error.message == "down"
+    assert servicer.afters == [0, 1, 1, 1]  # FAST: 4 attempts in all after the break
 
 
 def archive(num_chunks=2, num_revisions=1):

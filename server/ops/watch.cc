@@ -31,6 +31,8 @@ absl::StatusOr<std::unique_ptr<RevisionFeed>> RevisionFeed::Open(const OpsContex
   } else {
     feed->last_taken_ = stored.empty() ? 0 : stored.back()->number;
   }
+  feed->begins_after_ = feed->last_taken_;
+  feed->incarnation_ = watch.snapshot->incarnation;
   return feed;
 }
 

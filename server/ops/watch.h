@@ -36,6 +36,11 @@ class RevisionFeed {
   // the deletion was taken); RESOURCE_EXHAUSTED when more than max_lag revisions waited
   // (naming the revision to watch again after); UNAVAILABLE when the server shuts down.
   bool ended() const { return ended_; }
+  // Where the feed began: revisions after this one are sent (the request's after_revision, or
+  // for -1 the latest stored when it was opened).
+  int64_t begins_after() const { return begins_after_; }
+  // The creation of the grid id that is watched (StoredGrid::incarnation).
+  const std::string& incarnation() const { return incarnation_; }
   const absl::Status& end_status() const { return end_status_; }
 
   // Stops the subscription (the feed ends); a no-op the second time. Takes the store's lock.
@@ -52,6 +57,8 @@ class RevisionFeed {
   std::shared_ptr<GridSubscription> subscription_;
   std::deque<RevisionSummary> backlog_;  // the stored revisions not yet taken
   int64_t last_taken_ = 0;               // (or where the feed began)
+  int64_t begins_after_ = 0;
+  std::string incarnation_;
   bool ended_ = false;
   absl::Status end_status_;
 };

@@ -181,7 +181,8 @@ TEST(CommandHelp, ListsTheCommandsFlagsWithHelpAndDefaults) {
   EXPECT_THAT(fit, HasSubstr("usage: splinegrid fit FILE"));
   EXPECT_THAT(fit, HasSubstr("--tol VALUE  (default: 0)"));
   EXPECT_THAT(fit, HasSubstr("largest allowed deviation"));
-  EXPECT_THAT(fit, HasSubstr("--server VALUE  (default: \"localhost:50051\")"));
+  EXPECT_THAT(fit, HasSubstr("--server VALUE  (default: \"\")"));
+  EXPECT_THAT(fit, HasSubstr("$SPLINEGRID_SERVER, else"));
   EXPECT_THAT(fit, Not(HasSubstr("--rotate")));
   const std::string airfoil = CommandHelp(*FindCommand("airfoil"));
   EXPECT_THAT(airfoil, Not(HasSubstr("--server VALUE")));  // local: refused, not listed

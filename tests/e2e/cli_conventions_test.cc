@@ -75,7 +75,9 @@ TEST(CliConventions, CommandHelpListsItsFlagsWithHelpAndDefaults) {
     EXPECT_THAT(help.out, HasSubstr("--tol VALUE  (default: 0)")) << form;
     EXPECT_THAT(help.out, HasSubstr("fit: largest allowed deviation")) << form;
     EXPECT_THAT(help.out, HasSubstr("--kinds  (default: false)")) << form;
-    EXPECT_THAT(help.out, HasSubstr("--server VALUE  (default: \"localhost:50051\")")) << form;
+    EXPECT_THAT(help.out, HasSubstr("--server VALUE  (default: \"\")")) << form;
+    EXPECT_THAT(help.out, HasSubstr("(default: $SPLINEGRID_SERVER, else\n      localhost:50051)"))
+        << form;
     EXPECT_THAT(help.out, Not(HasSubstr("--rotate"))) << form;  // deform's
   }
   const Result serve = Stdout("help serve");
@@ -90,7 +92,8 @@ TEST(CliConventions, CommandHelpListsItsFlagsWithHelpAndDefaults) {
 TEST(CliConventions, VersionIsTheProjectVersion) {
   const std::string cmake = ReadFile(SPLINEGRID_SOURCE_DIR "/CMakeLists.txt");
   std::smatch match;
-  ASSERT_TRUE(std::regex_search(cmake, match, std::regex(R"(project\(splinegrid VERSION ([0-9.]+))")));
+  ASSERT_TRUE(
+      std::regex_search(cmake, match, std::regex(R"(project\(splinegrid VERSION ([0-9.]+))")));
   const Result version = Stdout("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_EQ(version.out, absl::StrCat("splinegrid ", match[1].str(), "\n"));
@@ -119,10 +122,11 @@ TEST(CliConventions, AMistypedFlagOrCommandGetsASuggestion) {
 // The complete command lines of the READMEs' code blocks, as words after `build/splinegrid`.
 std::vector<std::vector<std::string>> ReadmeCommandLines() {
   std::vector<std::vector<std::string>> lines;
-  for (const char* file : {"/README.md", "/python/README.md", "/deploy/README.md",
-                           "/docker/README.md", "/docs/formats.md", "/docs/c-api.md",
-                           "/docs/operations.md"}) {
-    for (absl::string_view line : absl::StrSplit(ReadFile(SPLINEGRID_SOURCE_DIR + std::string(file)), '\n')) {
+  for (const char* file :
+       {"/README.md", "/python/README.md", "/deploy/README.md", "/docker/README.md",
+        "/docs/formats.md", "/docs/c-api.md", "/docs/operations.md"}) {
+    for (absl::string_view line :
+         absl::StrSplit(ReadFile(SPLINEGRID_SOURCE_DIR + std::string(file)), '\n')) {
       line = absl::StripAsciiWhitespace(line);
       if (!absl::ConsumePrefix(&line, "build/splinegrid ")) continue;
       line = line.substr(0, line.find('#'));  // a comment
@@ -137,11 +141,11 @@ std::vector<std::vector<std::string>> ReadmeCommandLines() {
   return lines;
 }
 
-// Each line runs against a closed port (client commands; airfoil works locally) in a scratch directory beside a link
-// to ../shared, so nothing is written into the tree: the line must get past the command-line
-// check and Abseil's parsing. Client commands then fail to connect (exit 1); serve is stopped
-// by an out-of-range --threads appended, which only its own flag check reports (exit 2 with
-// "splinegrid serve: ...", not the check's "splinegrid: ...").
+// Each line runs against a closed port (client commands; airfoil works locally) in a scratch
+// directory beside a link to ../shared, so nothing is written into the tree: the line must get past
+// the command-line check and Abseil's parsing. Client commands then fail to connect (exit 1); serve
+// is stopped by an out-of-range --threads appended, which only its own flag check reports (exit 2
+// with "splinegrid serve: ...", not the check's "splinegrid: ...").
 TEST(CliConventions, EveryReadmeCommandLineParses) {
   const std::vector<std::vector<std::string>> lines = ReadmeCommandLines();
   ASSERT_GT(lines.size(), 15u);
@@ -188,6 +192,26 @@ TEST(CliConventions, TheLocalAirfoilRefusesConnectionFlags) {
   const Result local = Both(absl::StrCat("airfoil ", profile, " 2>&1"));
   EXPECT_EQ(local.exit_code, 0) << local.out;
   EXPECT_THAT(Stdout("help airfoil").out, Not(HasSubstr("--server VALUE")));
+}
+
+// The server of client commands: --server, else $SPLINEGRID_SERVER (what
+// deploy/local/start.sh prints), else localhost:50051. Port 1 on loopback has no listener: the
+// failed call names the address it tried.
+TEST(CliConventions, ClientCommandsTalkToSplinegridServerUnlessGivenServer) {
+  const auto list = [](const std::string& environment, const std::string& flags) {
+    Result result;
+    result.exit_code = RunShell(
+        absl::StrCat(environment, " timeout 60 ", kBinary, " list --timeout=2s ", flags, " 2>&1"),
+        &result.out);
+    return result;
+  };
+  const Result from_env = list("SPLINEGRID_SERVER=127.0.0.1:1", "");
+  EXPECT_EQ(from_env.exit_code, 1) << from_env.out;
+  EXPECT_THAT(from_env.out, HasSubstr("127.0.0.1:1")) << from_env.out;
+  const Result from_flag = list("SPLINEGRID_SERVER=127.0.0.1:1", "--server=127.0.0.1:2");
+  EXPECT_EQ(from_flag.exit_code, 1) << from_flag.out;
+  EXPECT_THAT(from_flag.out, HasSubstr("127.0.0.1:2")) << from_flag.out;
+  EXPECT_THAT(from_flag.out, Not(HasSubstr("127.0.0.1:1"))) << from_flag.out;
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
-// The C++ client's calls against a fake SplineGrid server on a loopback port: retries of
-// UNAVAILABLE (unary, before a stream's first message, within the deadline, across a server
-// that starts late), the routing header, and export/import of archives (framing, a damaged
-// file cancels the upload, nothing is left of a failed export).
+// The C++ client's calls against a fake SplineGrid server on a loopback port: retries of calls
+// that broke off (UNAVAILABLE, a balancer's RST_STREAM; unary, streams from their start, within
+// the deadline, across a server that starts late), the routing header, and export/import of
+// archives (framing, a damaged file cancels the upload, nothing is left of a failed export).
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -32,6 +33,8 @@ class FakeSplineGrid final : public v1::SplineGrid::Service {
  public:
   std::map<std::string, int> failures;
   std::vector<v1::ArchiveRecord> archive;  // what ExportGrid sends
+  // EvaluateGrid of grids/reset: reset (as a balancer does) after the first message, this often.
+  std::atomic<int> resets_{2};
 
   int calls(const std::string& method) {
     std::lock_guard<std::mutex> lock(mu_);
@@ -96,6 +99,12 @@ class FakeSplineGrid final : public v1::SplineGrid::Service {
     writer->Write(message);
     if (request->name() == "grids/broken") {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE, "broken off");
+    }
+    if (request->name() == "grids/reset" && resets_.fetch_sub(1) > 0) {
+      return grpc::Status(grpc::StatusCode::INTERNAL, "Received RST_STREAM with error code 2");
+    }
+    if (request->name() == "grids/bug") {
+      return grpc::Status(grpc::StatusCode::INTERNAL, "a server bug");
     }
     message.Clear();
     v1::EvaluationChunk* chunk = message.mutable_chunk();
@@ -239,7 +248,7 @@ TEST_F(ClientCallsTest, RetriesStopAfterMaxAttemptsWithTheLastError) {
   const absl::StatusOr<v1::Grid> grid = Connect()->Get("naca");
   EXPECT_TRUE(absl::IsUnavailable(grid.status())) << grid.status();
   EXPECT_THAT(grid.status().message(),
-              HasSubstr("no upstream [attempt 4; the earlier ones failed with UNAVAILABLE]"));
+              HasSubstr("no upstream [attempt 4; the earlier ones broke off]"));
   EXPECT_EQ(fake_.calls("GetGrid"), 4);
 }
 
@@ -276,7 +285,7 @@ TEST_F(ClientCallsTest, UploadsAreSentAgainWholeAndRouteByTheRequestedId) {
   EXPECT_THAT(fake_.routing("ImportGrid"), ElementsAre("new", "new", "(none)"));
 }
 
-TEST_F(ClientCallsTest, AStreamIsRetriedOnlyBeforeItsFirstMessage) {
+TEST_F(ClientCallsTest, ABrokenStreamIsAskedForAgainFromItsStart) {
   fake_.failures["EvaluateGrid"] = 2;
   auto client = Connect();
   v1::EvaluateGridRequest request;
@@ -285,11 +294,23 @@ TEST_F(ClientCallsTest, AStreamIsRetriedOnlyBeforeItsFirstMessage) {
   ASSERT_TRUE(grid.ok()) << grid.status();
   EXPECT_EQ(grid->revision, 2);
   EXPECT_EQ(fake_.calls("EvaluateGrid"), 3);
+  // Reset by a balancer after the first message, twice: the third attempt is whole.
+  request.set_name("reset");
+  const absl::StatusOr<client::EvaluatedGrid> reset = client->Evaluate(request);
+  ASSERT_TRUE(reset.ok()) << reset.status();
+  EXPECT_EQ(reset->blocks.at(0).points.num_points(), 2);
+  EXPECT_EQ(fake_.calls("EvaluateGrid"), 6);
+  // Broken off after the first message every time: the retries give up.
   request.set_name("broken");
   const absl::Status broken = client->Evaluate(request).status();
   EXPECT_TRUE(absl::IsUnavailable(broken)) << broken;
-  EXPECT_EQ(broken.message(), "broken off");
-  EXPECT_THAT(fake_.routing("EvaluateGrid"), ElementsAre("naca", "naca", "naca", "broken"));
+  EXPECT_EQ(broken.message(), "broken off [attempt 4; the earlier ones broke off]");
+  // Any other INTERNAL is an answer, not a break.
+  request.set_name("bug");
+  const absl::Status bug = client->Evaluate(request).status();
+  EXPECT_TRUE(absl::IsInternal(bug)) << bug;
+  EXPECT_EQ(bug.message(), "a server bug");
+  EXPECT_EQ(fake_.calls("EvaluateGrid"), 11);
 }
 
 TEST_F(ClientCallsTest, AWatchIsOpenedAgainBeforeItsFirstRevision) {
