@@ -460,8 +460,10 @@ bool RevisionStream::Next(v1::WatchGridResponse* message) {
       return true;
     }
     finished_ = call_.reader->Finish();
-    // A resumed call that finds no grid: it was deleted meanwhile, which ends the watch.
-    if (resumed_ && finished_->error_code() == grpc::StatusCode::NOT_FOUND) {
+    // A resumed call that finds no grid which an earlier call did find: it was deleted
+    // meanwhile, which ends the watch.
+    if (resumed_ && !incarnation_.empty() &&
+        finished_->error_code() == grpc::StatusCode::NOT_FOUND) {
       finished_ = grpc::Status::OK;
       return false;
     }
@@ -541,6 +543,7 @@ absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
   absl::Status malformed;  // the stream did not fit together (the call was cancelled)
   const absl::Status status = Call(GridId(request.name()), [&](grpc::ClientContext* context) {
     assembler.emplace(progress);
+    malformed = absl::OkStatus();
     auto reader = stub_->EvaluateGrid(context, request);
     v1::EvaluateGridResponse message;
     while (malformed.ok() && reader->Read(&message)) {

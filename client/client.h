@@ -131,7 +131,9 @@ class WatchCancel {
 // A call that breaks off (BrokeOff: the replica died or stopped, a balancer reset the stream)
 // is resumed inside Next(), under the client's RetryPolicy, after the last revision received
 // (or where the first call began, which the server states in its initial metadata): no
-// revision is missed or repeated. The retries start afresh once a resumed call is up. When the
+// revision is missed or repeated (of those the server still keeps: more than --keep_revisions
+// deformed revisions stored while the watch was away lose their oldest, as for any late
+// reader). The retries start afresh once a resumed call is up. When the
 // resumed call finds the grid deleted, or another creation under its id, the stream ends as a
 // deletion ends it (OK).
 class RevisionStream {
@@ -241,8 +243,8 @@ class Client {
   absl::StatusOr<v1::GenerateGridResponse> Generate(const v1::GenerateGridRequest& request);
   // Watches a grid's revisions (WatchGrid): those after `after_revision` (0: every stored one
   // first, -1: only new ones), then each new one as it is stored. The call has no deadline; it
-  // lasts until the grid is deleted, the server stops or the call is cancelled (`cancel`, or
-  // the stream's Cancel(), from any thread).
+  // lasts until the grid is deleted or the call is cancelled (`cancel`, or the stream's
+  // Cancel(), from any thread); a call that breaks off is resumed (RevisionStream).
   std::unique_ptr<RevisionStream> Watch(const std::string& name, int64_t after_revision,
                                         std::shared_ptr<WatchCancel> cancel = nullptr);
   // The same with a callback per revision, on the calling thread; returning false stops the

@@ -45,10 +45,9 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   }
   if (options.drain_notice < absl::ZeroDuration() ||
       options.shutdown_grace < absl::ZeroDuration()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("drain_notice = ", absl::FormatDuration(options.drain_notice),
-                     " and shutdown_grace = ", absl::FormatDuration(options.shutdown_grace),
-                     " must not be negative"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "drain_notice = ", absl::FormatDuration(options.drain_notice), " and shutdown_grace = ",
+        absl::FormatDuration(options.shutdown_grace), " must not be negative"));
   }
   absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
       MakeServerCredentials(options);
@@ -102,7 +101,11 @@ void Server::FollowStoreHealth() {
   std::unique_lock<std::mutex> lock(health_mu_);
   while (!health_cv_.wait_for(lock, std::chrono::milliseconds(250), [this] { return stopping_; })) {
     if (drain_begun_) continue;  // NOT_SERVING until the end
+    // Without the lock: a dir: store may probe its disk here, which must not hold up Shutdown.
+    lock.unlock();
     const absl::Status available = state_->store->Available();
+    lock.lock();
+    if (stopping_ || drain_begun_) continue;
     if (available.ok() == serving) continue;
     serving = available.ok();
     SetServing(serving);
@@ -202,9 +205,8 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
   std::unique_ptr<MetricsEndpoint> metrics;
   if (!options.metrics_address.empty()) {
     const ServiceState* state = &(*server)->state();
-    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> started =
-        MetricsEndpoint::Start(options.metrics_address, options.metrics_insecure,
-                               [state] { return MetricsText(*state); });
+    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> started = MetricsEndpoint::Start(
+        options.metrics_address, options.metrics_insecure, [state] { return MetricsText(*state); });
     if (!started.ok()) {
       (*server)->Shutdown();
       return started.status();

@@ -50,8 +50,8 @@ absl::Status Watch(const Args& args) {
   if (!status.ok()) return status;
   std::fprintf(stderr, "splinegrid watch: %s: %s\n", name.c_str(),
                cancel->cancelled() ? "interrupted"
-                                   : "the stream ended (the grid was deleted or the server "
-                                     "stopped)");
+                                   : "the stream ended (the grid was deleted, or deleted "
+                                     "and created again)");
   return absl::OkStatus();
 }
 

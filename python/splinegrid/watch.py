@@ -33,9 +33,10 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
     A call that breaks off (the replica died or stopped, a balancer reset the stream) is
     resumed inside ``next()``, under ``retry``, after the last revision received (or where the
     first call began, which the server states in its initial metadata): no revision is missed
-    or repeated. The retries start afresh once a resumed call is up. When the resumed call
-    finds the grid deleted, or another creation under its id, the iteration ends as a deletion
-    ends it.
+    or repeated (of those the server still keeps: more than ``--keep_revisions`` deformed
+    revisions stored while the watch was away lose their oldest). The retries start afresh once
+    a resumed call is up. When the resumed call finds the grid deleted, or another creation
+    under its id, the iteration ends as a deletion ends it.
     """
 
     def __init__(self, open_call: Callable[[int], Any], name: str, after_revision: int = 0,
@@ -96,7 +97,7 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
                 self._done = True
                 raise
             except grpc.RpcError as error:
-                if not self._same_creation() or (self._resumed and
+                if not self._same_creation() or (self._resumed and self._incarnation and
                                                  _code(error) == grpc.StatusCode.NOT_FOUND):
                     # The grid was deleted (and maybe created again) while the call resumed.
                     self._done = True

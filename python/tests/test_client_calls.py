@@ -78,6 +78,8 @@ class FakeSplineGrid(service_grpc.SplineGridServicer):
 
     def WatchGrid(self, request, context):
         self._enter("WatchGrid", context)
+        if request.name == "grids/missing":
+            context.abort(grpc.StatusCode.NOT_FOUND, "grids/missing not found")
         for revision in (1, 2):
             yield service_pb2.WatchGridResponse(revision=grid_pb2.RevisionInfo(revision=revision))
 
@@ -211,6 +213,15 @@ def test_a_watch_is_opened_again_before_its_first_revision(fake):
             assert [info.revision for info in revisions] == [1, 2]
     assert fake.calls["WatchGrid"] == 3
     assert fake.routing["WatchGrid"] == ["naca"] * 3
+
+
+def test_a_watch_of_an_unknown_grid_is_not_found_also_after_a_retry(fake):
+    # The retry is not a resumption: no call ever found the grid, so NOT_FOUND is no deletion.
+    fake.failures["WatchGrid"] = 1
+    with connect(fake) as client:
+        with pytest.raises(SplinegridError, match="NOT_FOUND: grids/missing not found"):
+            list(client.watch("missing"))
+    assert fake.calls["WatchGrid"] == 2
 
 
 class BreakingWatch(service_grpc.SplineGridServicer):

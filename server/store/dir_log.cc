@@ -76,13 +76,17 @@ int64_t DamagedNumberOf(const std::string& name) {
 absl::Status WriteRecordFile(const fs::path& dir, const std::string& name,
                              const std::vector<std::string>& payloads) {
   const fs::path tmp = dir / (name + ".tmp");
-  SG_ASSIGN_OR_RETURN(RecordWriter writer, RecordWriter::Create(tmp.string()));
-  for (const std::string& payload : payloads) SG_RETURN_IF_ERROR(writer.Append(payload));
-  SG_RETURN_IF_ERROR(writer.Close(/*sync=*/true));
-  if (std::rename(tmp.c_str(), (dir / name).c_str()) != 0) {
-    return ErrnoStatus(absl::StrCat("cannot rename ", tmp.string()));
-  }
-  return absl::OkStatus();
+  absl::Status written = [&]() -> absl::Status {
+    SG_ASSIGN_OR_RETURN(RecordWriter writer, RecordWriter::Create(tmp.string()));
+    for (const std::string& payload : payloads) SG_RETURN_IF_ERROR(writer.Append(payload));
+    SG_RETURN_IF_ERROR(writer.Close(/*sync=*/true));
+    if (std::rename(tmp.c_str(), (dir / name).c_str()) != 0) {
+      return ErrnoStatus(absl::StrCat("cannot rename ", tmp.string()));
+    }
+    return absl::OkStatus();
+  }();
+  if (!written.ok()) std::remove(tmp.c_str());  // a full disk gets its space back at once
+  return written;
 }
 
 std::string Serialize(const v1::ArchiveRecord& record) { return record.SerializeAsString(); }
@@ -93,33 +97,13 @@ class DirLog final : public DurableLog {
   ~DirLog() override { close(lock_fd_); }
 
   absl::Status WriteGrid(const StoredGrid& grid) override {
-    const fs::path grids = root_ / "grids";
-    const fs::path staging = grids / absl::StrCat(".", grid.id, ".new");
-    std::error_code error;
-    fs::remove_all(staging, error);
-    if (!fs::create_directory(staging, error)) {
-      return FsStatus(error, absl::StrCat("cannot create ", staging.string()));
+    const fs::path staging = root_ / "grids" / absl::StrCat(".", grid.id, ".new");
+    const absl::Status written = WriteStaged(grid, staging);
+    if (!written.ok()) {
+      std::error_code error;
+      fs::remove_all(staging, error);  // a full disk gets its space back at once
     }
-    std::vector<std::string> payloads;
-    v1::ArchiveRecord record;
-    *record.mutable_header() = EncodeGridHeader(grid, 0);
-    payloads.push_back(Serialize(record));
-    SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid(), kSourceChunkValues,
-                                          [&](const v1::SourceChunk& chunk) {
-                                            v1::ArchiveRecord r;
-                                            *r.mutable_source() = chunk;
-                                            payloads.push_back(Serialize(r));
-                                            return absl::OkStatus();
-                                          }));
-    SG_RETURN_IF_ERROR(WriteRecordFile(staging, kGridFile, payloads));
-    for (const auto& revision : grid.revisions) {
-      SG_RETURN_IF_ERROR(WriteRevisionFile(staging, *revision));
-    }
-    SG_RETURN_IF_ERROR(SyncDirectory(staging));
-    if (std::rename(staging.c_str(), (grids / grid.id).c_str()) != 0) {
-      return ErrnoStatus(absl::StrCat("cannot rename ", staging.string(), " to ", grid.id));
-    }
-    return SyncDirectory(grids);
+    return written;
   }
 
   absl::Status WriteRevision(const std::string& id, const GridRevision& revision) override {
@@ -158,6 +142,36 @@ class DirLog final : public DurableLog {
   }
 
  private:
+  // WriteGrid through `staging` (grids/.{id}.new), renamed to grids/{id} when complete.
+  absl::Status WriteStaged(const StoredGrid& grid, const fs::path& staging) {
+    const fs::path grids = root_ / "grids";
+    std::error_code error;
+    fs::remove_all(staging, error);
+    if (!fs::create_directory(staging, error)) {
+      return FsStatus(error, absl::StrCat("cannot create ", staging.string()));
+    }
+    std::vector<std::string> payloads;
+    v1::ArchiveRecord record;
+    *record.mutable_header() = EncodeGridHeader(grid, 0);
+    payloads.push_back(Serialize(record));
+    SG_RETURN_IF_ERROR(ForEachSourceChunk(grid.source->grid(), kSourceChunkValues,
+                                          [&](const v1::SourceChunk& chunk) {
+                                            v1::ArchiveRecord r;
+                                            *r.mutable_source() = chunk;
+                                            payloads.push_back(Serialize(r));
+                                            return absl::OkStatus();
+                                          }));
+    SG_RETURN_IF_ERROR(WriteRecordFile(staging, kGridFile, payloads));
+    for (const auto& revision : grid.revisions) {
+      SG_RETURN_IF_ERROR(WriteRevisionFile(staging, *revision));
+    }
+    SG_RETURN_IF_ERROR(SyncDirectory(staging));
+    if (std::rename(staging.c_str(), (grids / grid.id).c_str()) != 0) {
+      return ErrnoStatus(absl::StrCat("cannot rename ", staging.string(), " to ", grid.id));
+    }
+    return SyncDirectory(grids);
+  }
+
   static absl::Status WriteRevisionFile(const fs::path& dir, const GridRevision& revision) {
     v1::ArchiveRecord record;
     EncodeRevision(revision, record.mutable_revision());
@@ -167,6 +181,17 @@ class DirLog final : public DurableLog {
   const fs::path root_;
   const int lock_fd_;  // flock'ed: one server per directory
 };
+
+// The incarnation of a grid written before the store kept incarnations: the same at every start
+// (a watch resumed across a restart still knows the grid), different for another creation of
+// the id (another create_time). FNV-1a, 64 bits, of "id/create_time in ns".
+std::string StableIncarnation(const StoredGrid& grid) {
+  uint64_t hash = 14695981039346656037ull;
+  for (const char c : absl::StrCat(grid.id, "/", absl::ToUnixNanos(grid.create_time))) {
+    hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  }
+  return absl::StrFormat("%016x", hash);
+}
 
 // Moves a damaged file or grid directory to corrupt/ and says so.
 void SetAside(const fs::path& root, const fs::path& path, const absl::Status& why) {
@@ -250,6 +275,7 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const
     }
   }
   SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid, assembler.Finish(/*check_counts=*/false));
+  if (grid->incarnation.empty()) grid->incarnation = StableIncarnation(*grid);
   std::sort(damaged.begin(), damaged.end());
   damaged.erase(std::unique(damaged.begin(), damaged.end()), damaged.end());
   grid->damaged_revisions = std::move(damaged);

@@ -41,11 +41,16 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
   // The incarnation is written with them, so that a restart keeps it.
   std::shared_ptr<const StoredGrid> created = WithIncarnation(*grid, NewIncarnation());
   const absl::Status written = log_->WriteGrid(*created);
-  std::lock_guard<std::mutex> lock(mu_);
-  creating_.erase(created->id);
-  if (!written.ok()) return LogWriteFailed(written, absl::StrCat("grids/", created->id));
-  grids_.emplace(created->id, std::move(created));
-  return absl::OkStatus();
+  const std::string id = created->id;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    creating_.erase(id);
+    if (written.ok()) {
+      grids_.emplace(id, std::move(created));
+      return absl::OkStatus();
+    }
+  }
+  return LogWriteFailed(written, absl::StrCat("grids/", id));
 }
 
 absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::Get(const std::string& id) {
@@ -196,6 +201,7 @@ absl::Status MemoryStore::LogWriteFailed(const absl::Status& error, const std::s
     std::lock_guard<std::mutex> lock(log_health_mu_);
     log_failure_ = absl::UnavailableError(absl::StrCat("cannot write: ", error.message()));
     last_probe_ = absl::Now();
+    ++failures_;
   }
   // The file system's own words (after the path the message names first): the caller gets no
   // server paths.
@@ -212,13 +218,25 @@ absl::Status MemoryStore::LogWriteFailed(const absl::Status& error, const std::s
 
 absl::Status MemoryStore::Available() const {
   if (!log_) return absl::OkStatus();
-  std::lock_guard<std::mutex> lock(log_health_mu_);
-  if (log_failure_.ok() || absl::Now() - last_probe_ < absl::Seconds(1)) return log_failure_;
-  last_probe_ = absl::Now();
+  int64_t failures = 0;
+  {
+    std::lock_guard<std::mutex> lock(log_health_mu_);
+    if (log_failure_.ok() || probing_ || absl::Now() - last_probe_ < absl::Seconds(1)) {
+      return log_failure_;
+    }
+    last_probe_ = absl::Now();
+    probing_ = true;
+    failures = failures_;
+  }
+  // Outside the lock: a slow disk holds up only this caller (the health thread).
   const absl::Status probe = log_->Probe();
-  log_failure_ = probe.ok()
-                     ? absl::OkStatus()
-                     : absl::UnavailableError(absl::StrCat("cannot write: ", probe.message()));
+  std::lock_guard<std::mutex> lock(log_health_mu_);
+  probing_ = false;
+  if (failures_ == failures) {  // no write failed meanwhile (that failure would stand)
+    log_failure_ = probe.ok()
+                       ? absl::OkStatus()
+                       : absl::UnavailableError(absl::StrCat("cannot write: ", probe.message()));
+  }
   return log_failure_;
 }
 

@@ -85,6 +85,8 @@ class MemoryStore final : public GridStore {
   mutable std::mutex log_health_mu_;
   mutable absl::Status log_failure_;
   mutable absl::Time last_probe_ = absl::InfinitePast();
+  mutable bool probing_ = false;  // a probe runs (outside the lock)
+  mutable int64_t failures_ = 0;  // failed writes so far
 };
 
 }  // namespace splinegrid::server

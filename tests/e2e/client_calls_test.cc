@@ -114,9 +114,12 @@ class FakeSplineGrid final : public v1::SplineGrid::Service {
     return grpc::Status::OK;
   }
 
-  grpc::Status WatchGrid(grpc::ServerContext* context, const v1::WatchGridRequest*,
+  grpc::Status WatchGrid(grpc::ServerContext* context, const v1::WatchGridRequest* request,
                          grpc::ServerWriter<v1::WatchGridResponse>* writer) override {
     if (auto failed = Enter("WatchGrid", context)) return *failed;
+    if (request->name() == "grids/missing") {
+      return grpc::Status(grpc::StatusCode::NOT_FOUND, "grids/missing not found");
+    }
     for (int revision : {1, 2}) {
       v1::WatchGridResponse message;
       message.mutable_revision()->set_revision(revision);
@@ -311,6 +314,15 @@ TEST_F(ClientCallsTest, ABrokenStreamIsAskedForAgainFromItsStart) {
   EXPECT_TRUE(absl::IsInternal(bug)) << bug;
   EXPECT_EQ(bug.message(), "a server bug");
   EXPECT_EQ(fake_.calls("EvaluateGrid"), 11);
+}
+
+// The retry is not a resumption: no call ever found the grid, so NOT_FOUND is no deletion.
+TEST_F(ClientCallsTest, AWatchOfAnUnknownGridIsNotFoundAlsoAfterARetry) {
+  fake_.failures["WatchGrid"] = 1;
+  const absl::Status status =
+      Connect()->Watch("missing", 0, [](const v1::WatchGridResponse&) { return true; });
+  EXPECT_TRUE(absl::IsNotFound(status)) << status;
+  EXPECT_EQ(fake_.calls("WatchGrid"), 2);
 }
 
 TEST_F(ClientCallsTest, AWatchIsOpenedAgainBeforeItsFirstRevision) {
