@@ -51,25 +51,19 @@ absl::Status SyncDirectory(const fs::path& dir) {
 
 std::string RevisionFile(int64_t number) { return absl::StrFormat("r%012d.records", number); }
 
-// The revision number of a file name "r{number}.records", or -1.
-int64_t RevisionNumberOf(const std::string& name) {
-  constexpr std::string_view kSuffix = ".records";
-  if (name.size() <= 1 + kSuffix.size() || name[0] != 'r' || !name.ends_with(kSuffix)) return -1;
+// The revision number of a file name "r{number}{suffix}", or -1.
+int64_t NumberOf(const std::string& name, std::string_view suffix) {
+  if (name.size() <= 1 + suffix.size() || name[0] != 'r' || !name.ends_with(suffix)) return -1;
   int64_t number = 0;
-  if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - kSuffix.size()), &number)) return -1;
+  if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - suffix.size()), &number)) return -1;
   return number > 0 ? number : -1;
 }
+int64_t RevisionNumberOf(const std::string& name) { return NumberOf(name, ".records"); }
 
 // The marker left in a grid's directory for a revision file that was set aside as damaged
 // ("r{number}.damaged", holding why), and the number of such a name (or -1).
 std::string DamagedMarker(int64_t number) { return absl::StrFormat("r%012d.damaged", number); }
-int64_t DamagedNumberOf(const std::string& name) {
-  constexpr std::string_view kSuffix = ".damaged";
-  if (name.size() <= 1 + kSuffix.size() || name[0] != 'r' || !name.ends_with(kSuffix)) return -1;
-  int64_t number = 0;
-  if (!absl::SimpleAtoi(name.substr(1, name.size() - 1 - kSuffix.size()), &number)) return -1;
-  return number > 0 ? number : -1;
-}
+int64_t DamagedNumberOf(const std::string& name) { return NumberOf(name, ".damaged"); }
 
 // Writes `payloads` as the record file `dir/name` through a temporary file: durable and
 // atomic. The directory itself is not synced (the caller does, once per change).
