@@ -433,7 +433,6 @@ bool RevisionStream::Resume() {
   }
   finished_.reset();
   ended_ = false;
-  resumed_ = true;
   Open();
   return true;
 }
@@ -460,10 +459,9 @@ bool RevisionStream::Next(v1::WatchGridResponse* message) {
       return true;
     }
     finished_ = call_.reader->Finish();
-    // A resumed call that finds no grid which an earlier call did find: it was deleted
-    // meanwhile, which ends the watch.
-    if (resumed_ && !incarnation_.empty() &&
-        finished_->error_code() == grpc::StatusCode::NOT_FOUND) {
+    // A call that finds no grid which an earlier call did find (only a resumed call can: the
+    // server ends a found grid's watch OK): it was deleted meanwhile, which ends the watch.
+    if (!incarnation_.empty() && finished_->error_code() == grpc::StatusCode::NOT_FOUND) {
       finished_ = grpc::Status::OK;
       return false;
     }

@@ -181,7 +181,6 @@ class RevisionStream {
   std::shared_ptr<WatchCancel> cancel_;
   int64_t after_;            // the last revision received, or where the stream began
   std::string incarnation_;  // the creation watched, once a call has said
-  bool resumed_ = false;     // the current call resumes an earlier one
   bool ended_ = false;
   std::optional<grpc::Status> finished_;  // the reader's Finish(), once called
   std::optional<absl::Status> status_;

@@ -48,7 +48,6 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
         self._waits = self._retry.waits()
         self._after = after_revision  # the last revision received, or where the watch began
         self._incarnation = ""        # the creation watched, once a call has said
-        self._resumed = False         # the current call resumes an earlier one
         self.name = name
         self._cancelled = threading.Event()
         self._done = False
@@ -80,7 +79,6 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
         wait = next(self._waits, None)
         if wait is None or self._pause(wait, self._cancelled):
             return False
-        self._resumed = True
         self._call = self._open(self._after)
         if self._cancelled.is_set():  # cancel() raced with the reopening
             self._call.cancel()
@@ -97,9 +95,10 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
                 self._done = True
                 raise
             except grpc.RpcError as error:
-                if not self._same_creation() or (self._resumed and self._incarnation and
+                if not self._same_creation() or (self._incarnation and
                                                  _code(error) == grpc.StatusCode.NOT_FOUND):
-                    # The grid was deleted (and maybe created again) while the call resumed.
+                    # The grid was deleted (and maybe created again) while the call resumed:
+                    # a NOT_FOUND after a call had found it (the server ends that call OK).
                     self._done = True
                     raise StopIteration from None
                 if self._resume(error):

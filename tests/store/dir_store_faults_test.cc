@@ -5,7 +5,6 @@
 // but no server path, stores nothing and leaves what was stored readable; health turns NOT_SERVING
 // and back to SERVING once writes get through again, without a restart. Skipped where mount
 // namespaces are not allowed (the test says so).
-#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
