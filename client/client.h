@@ -131,11 +131,11 @@ class WatchCancel {
 // A call that breaks off (BrokeOff: the replica died or stopped, a balancer reset the stream)
 // is resumed inside Next(), under the client's RetryPolicy, after the last revision received
 // (or where the first call began, which the server states in its initial metadata): no
-// revision is missed or repeated (of those the server still keeps: more than --keep_revisions
-// deformed revisions stored while the watch was away lose their oldest, as for any late
-// reader). The retries start afresh once a resumed call is up. When the
-// resumed call finds the grid deleted, or another creation under its id, the stream ends as a
-// deletion ends it (OK).
+// revision is missed or repeated. When retention dropped revisions it had not received (more
+// than --keep_revisions deformed ones stored while it was away), the server refuses the resumed
+// call with OUT_OF_RANGE, which ends the stream. The retries start afresh once a resumed call is
+// up. When the resumed call finds the grid deleted, or another creation under its id, the stream
+// ends as a deletion ends it (OK).
 class RevisionStream {
  public:
   struct Call {

@@ -33,8 +33,9 @@ class RevisionWatch(collections.abc.Generator["grid_pb2.RevisionInfo", object, N
     A call that breaks off (the replica died or stopped, a balancer reset the stream) is
     resumed inside ``next()``, under ``retry``, after the last revision received (or where the
     first call began, which the server states in its initial metadata): no revision is missed
-    or repeated (of those the server still keeps: more than ``--keep_revisions`` deformed
-    revisions stored while the watch was away lose their oldest). The retries start afresh once
+    or repeated. When retention dropped revisions it had not received (more than
+    ``--keep_revisions`` deformed ones stored while it was away), the server refuses the resumed
+    call with OUT_OF_RANGE, which the iteration raises. The retries start afresh once
     a resumed call is up. When the resumed call finds the grid deleted, or another creation
     under its id, the iteration ends as a deletion ends it.
     """

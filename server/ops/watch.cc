@@ -1,9 +1,48 @@
 #include "server/ops/watch.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid::server::ops {
+
+namespace {
+
+int64_t NumberOf(int64_t number) { return number; }
+int64_t NumberOf(const std::shared_ptr<const GridRevision>& revision) { return revision->number; }
+
+// A watch that asks for the revisions after `after_revision` must not silently miss some:
+// OUT_OF_RANGE when retention dropped one of them (a client resuming after a long absence, or
+// asking for an old number). Damaged revisions are never sent and are not counted.
+absl::Status CheckNoneDropped(const StoredGrid& grid, int64_t after_revision) {
+  if (grid.revisions.empty()) return absl::OkStatus();
+  const auto& kept = grid.revisions;
+  const auto& damaged = grid.damaged_revisions;  // never sent, so not missed
+  const int64_t latest = kept.back()->number;
+  auto by_number = [](const auto& a, const auto& b) { return NumberOf(a) < NumberOf(b); };
+  const auto kept_after = std::upper_bound(kept.begin(), kept.end(), after_revision, by_number);
+  const auto damaged_after = std::upper_bound(damaged.begin(), damaged.end(), after_revision);
+  const auto damaged_end = std::upper_bound(damaged_after, damaged.end(), latest);
+  const int64_t dropped =
+      latest - after_revision - (kept.end() - kept_after) - (damaged_end - damaged_after);
+  if (dropped <= 0) return absl::OkStatus();
+  // The newest number that is neither kept nor damaged: a walk down past at most the kept and
+  // damaged numbers above it.
+  int64_t newest_dropped = latest;
+  while (std::binary_search(kept_after, kept.end(), newest_dropped, by_number) ||
+         std::binary_search(damaged_after, damaged_end, newest_dropped)) {
+    --newest_dropped;
+  }
+  return absl::OutOfRangeError(absl::StrCat(
+      "after_revision = ", after_revision, ": grids/", grid.id, " no longer keeps ", dropped,
+      " of the revisions after it (dropped by retention, which keeps the fit, faired revisions "
+      "and the newest deformed ones; the newest dropped is ",
+      newest_dropped, "); watch with after_revision = ", newest_dropped,
+      " for those after it, or 0 for every revision kept"));
+}
+
+}  // namespace
 
 absl::StatusOr<std::unique_ptr<RevisionFeed>> RevisionFeed::Open(const OpsContext& context,
                                                                  std::string grid_id,
@@ -21,6 +60,9 @@ absl::StatusOr<std::unique_ptr<RevisionFeed>> RevisionFeed::Open(const OpsContex
       new RevisionFeed(context.store, std::move(grid_id), after_revision, max_lag));
   feed->subscription_ = std::move(watch.subscription);
   const auto& stored = watch.snapshot->revisions;
+  if (after_revision > 0) {
+    SG_RETURN_IF_ERROR(CheckNoneDropped(*watch.snapshot, after_revision));
+  }
   if (after_revision >= 0) {
     feed->last_taken_ = after_revision;
     for (const auto& revision : stored) {

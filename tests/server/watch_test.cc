@@ -13,8 +13,8 @@ namespace splinegrid::testing {
 namespace {
 
 using server::GridStore;
-using server::MemoryStore;
 using server::GridSubscription;
+using server::MemoryStore;
 using End = GridSubscription::End;
 
 // ---- GridStore subscriptions ----
@@ -234,6 +234,31 @@ TEST_F(WatchTest, ASlowClientIsEndedWithResourceExhausted) {
   const absl::Status status = End(*watch);
   EXPECT_EQ(status.code(), absl::StatusCode::kResourceExhausted) << status;
   EXPECT_THAT(status.message(), ::testing::HasSubstr("more than 2 revisions behind"));
+}
+
+TEST_F(WatchTest, AWatchThatWouldMissRevisionsRetentionDroppedIsRefused) {
+  options_.max_deform_revisions = 3;
+  StartServer();
+  ImportAndFit();
+  for (int step = 1; step <= 6; ++step) DeformStep(step);  // keeps 1, 5, 6, 7
+  const absl::Status gap = End(*Open("grids/naca", 1, false));
+  EXPECT_EQ(gap.code(), absl::StatusCode::kOutOfRange) << gap;
+  EXPECT_THAT(gap.message(), ::testing::HasSubstr("after_revision = 1: grids/naca no longer "
+                                                  "keeps 3 of the revisions after it"));
+  EXPECT_THAT(gap.message(), ::testing::HasSubstr("watch with after_revision = 4"));
+  // What the message proposes, and every kept revision, are served.
+  std::unique_ptr<Watch> rest = Open("grids/naca", 4);
+  EXPECT_THAT(Read(*rest, 3), ::testing::ElementsAre(5, 6, 7));
+  std::unique_ptr<Watch> all = Open("grids/naca", 0);
+  EXPECT_THAT(Read(*all, 4), ::testing::ElementsAre(1, 5, 6, 7));
+  // A gap between kept revisions counts too: 5 is dropped, 6 and 7 are still kept.
+  DeformStep(7);
+  const absl::Status middle = End(*Open("grids/naca", 4, false));
+  EXPECT_EQ(middle.code(), absl::StatusCode::kOutOfRange) << middle;
+  EXPECT_THAT(middle.message(), ::testing::HasSubstr("no longer keeps 1 of"));
+  EXPECT_THAT(middle.message(), ::testing::HasSubstr("after_revision = 5 for"));
+  std::unique_ptr<Watch> latest = Open("grids/naca", 7);
+  EXPECT_THAT(Read(*latest, 1), ::testing::ElementsAre(8));
 }
 
 TEST_F(WatchTest, ServerShutdownEndsWatchesAtOnce) {
