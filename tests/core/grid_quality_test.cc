@@ -605,6 +605,84 @@ TEST(GridQualityVolumeTest, CurvilinearBlockIsOk) {
   ExpectSameWithTinyBudget(fitted, block, q);
 }
 
+// Level 0 against an oracle cell by cell: the fitted grid evaluated at the original parameters,
+// each cell measured with the public single-cell formulas (PlanarCellArea, CellAreaVector,
+// HexahedronVolume), ratio = m_fitted . m_original / |m_original|^2. The check measures whole rows
+// of cells at once; this catches a corner or offset taken from the wrong cell there, which an
+// affine block would not show.
+TEST(GridQualityOracleTest, LevelZeroRatiosAreThoseOfTheEvaluatedCells) {
+  struct Case {
+    Extents n, controls;
+    int spatial_dim;
+  };
+  auto shell_surface = [](double u, double v, double) { return ShellSector(u, v, 0.7); };
+  auto planar = [](double u, double v, double) {
+    return Point3{(1 + v) * std::cos(2 * u), (1 + v) * std::sin(2 * u) + 0.2 * u * u, 0};
+  };
+  for (const Case& c : {Case{{17, 9, 7}, {6, 5, 4}, 3}, Case{{21, 11, 1}, {7, 5, 0}, 3},
+                        Case{{21, 11, 1}, {7, 5, 0}, 2}}) {
+    const int num_active = c.n[2] > 1 ? 3 : 2;
+    const StructuredBlock block =
+        num_active == 3
+            ? MakeBlock(c.n, 3, ShellSector)
+            : (c.spatial_dim == 3 ? MakeBlock(c.n, 3, shell_surface) : MakeBlock(c.n, 2, planar));
+    const FittedBlock fitted = Fit(block, c.controls);
+    CellQualityOptions options;
+    options.max_level = 0;
+    options.max_size_ratio = 1e6;  // only the ratios matter here
+    const CellQuality q = Check(fitted, block, options);
+    std::array<std::vector<double>, 3> params;
+    for (int d = 0; d < 3; ++d) params[d] = fitted.distribution.params(d);
+    const StructuredBlock evaluated = EvaluateGrid(fitted.spline, params);
+    double min_ratio = std::numeric_limits<double>::infinity(), max_ratio = 0;
+    Extents worst = {0, 0, 0};
+    auto point = [](const StructuredBlock& b, int i, int j, int k) {
+      Point3 x = {0, 0, 0};
+      for (int s = 0; s < b.spatial_dim(); ++s) x[s] = b.Point(i, j, k)[s];
+      return x;
+    };
+    for (int k = 0; k + 1 < std::max(c.n[2], 2); ++k) {
+      for (int j = 0; j + 1 < c.n[1]; ++j) {
+        for (int i = 0; i + 1 < c.n[0]; ++i) {
+          double ratio = 0;
+          if (num_active == 3) {
+            std::array<Point3, 8> xf, xo;
+            for (int a = 0; a < 8; ++a) {
+              xf[a] = point(evaluated, i + (a & 1), j + (a >> 1 & 1), k + (a >> 2));
+              xo[a] = point(block, i + (a & 1), j + (a >> 1 & 1), k + (a >> 2));
+            }
+            ratio = HexahedronVolume(xf) / HexahedronVolume(xo);
+          } else {
+            std::array<Point3, 4> xf, xo;
+            for (int a = 0; a < 4; ++a) {
+              xf[a] = point(evaluated, i + (a & 1), j + (a >> 1), 0);
+              xo[a] = point(block, i + (a & 1), j + (a >> 1), 0);
+            }
+            if (c.spatial_dim == 2) {
+              ratio = PlanarCellArea(xf) / PlanarCellArea(xo);
+            } else {
+              const Point3 af = CellAreaVector(xf), ao = CellAreaVector(xo);
+              ratio = (af[0] * ao[0] + af[1] * ao[1] + af[2] * ao[2]) /
+                      (ao[0] * ao[0] + ao[1] * ao[1] + ao[2] * ao[2]);
+            }
+          }
+          if (ratio < min_ratio) {
+            min_ratio = ratio;
+            worst = {i, j, k};
+          }
+          max_ratio = std::max(max_ratio, std::abs(ratio));
+        }
+      }
+    }
+    SCOPED_TRACE(testing::Message() << "extents " << c.n[0] << " x " << c.n[1] << " x " << c.n[2]
+                                    << ", spatial_dim " << c.spatial_dim);
+    EXPECT_NE(min_ratio, max_ratio);  // a fit that varies the ratios from cell to cell
+    EXPECT_NEAR(q.min_ratio, min_ratio, 1e-12 * max_ratio);
+    EXPECT_NEAR(q.max_ratio, max_ratio, 1e-12 * max_ratio);
+    EXPECT_EQ(q.worst_cell, worst);
+  }
+}
+
 // Affine volume with even spacing: exact at every level (sub-cells are parent / 8^l).
 TEST(GridQualityVolumeTest, AffineBlockGivesRatioOne) {
   const StructuredBlock block = MakeBlock({5, 4, 6}, 3, [](double u, double v, double w) {

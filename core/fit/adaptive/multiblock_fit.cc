@@ -4,7 +4,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <tuple>
+#include <vector>
 
 #include "core/fit/adaptive/adaptive_engine.h"
 #include "core/fit/adaptive/segment_model.h"
@@ -259,8 +262,17 @@ EngineOptions EngineOptionsFor(const MultiBlockGrid& grid, const GridFitOptions&
   engine.fairing = options.fairing;
   engine.cancel = quality.cancel;
   if (options.check_quality) {
-    engine.quality = [&grid, &quality](int b, const FittedBlock& fitted) {
-      return CheckCellQuality(fitted, grid.blocks[b], quality);
+    // Each block's reference cells are built at its first check and kept for the later ones
+    // (the engine checks a block again after every accepted change).
+    auto references =
+        std::make_shared<std::vector<std::optional<CellReference>>>(grid.blocks.size());
+    engine.quality = [&grid, &quality, references](
+                         int b, const FittedBlock& fitted) -> absl::StatusOr<CellQuality> {
+      std::optional<CellReference>& reference = (*references)[b];
+      if (!reference) {
+        SG_ASSIGN_OR_RETURN(reference, CellReference::Build(grid.blocks[b]));
+      }
+      return CheckCellQuality(fitted, *reference, quality);
     };
   }
   return engine;
@@ -278,7 +290,8 @@ void TakeRun(EngineResult run, const MultiBlockGrid& grid, const SegmentModel& m
     if (!run.unfaired.empty()) CopySharedControls(model, shared, result.poles, grid, run.unfaired);
   }
   result.fit.blocks.clear();
-  for (FittedBlock& fitted : run.blocks) result.fit.blocks.emplace_back().fitted = std::move(fitted);
+  for (FittedBlock& fitted : run.blocks)
+    result.fit.blocks.emplace_back().fitted = std::move(fitted);
   result.unfaired = std::move(run.unfaired);
   GridFitReport& report = result.fit.report;
   report.iterations = run.iterations;

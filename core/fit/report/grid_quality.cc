@@ -33,66 +33,72 @@ constexpr int kCorners = K == CellKind::kVolume ? 8 : 4;
 // Corner pointers of a cell in binary order.
 using Corners = std::array<const double*, 8>;
 
-void Cross(const double* a, const double* b, double* out) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
+// A point or vector; the measures are written with it once, for single cells (Measure) and for
+// whole rows of cells (RowMeasures, where the compiler vectorises them across cells).
+struct Vec {
+  double x, y, z;
+};
+[[gnu::always_inline]] inline Vec operator-(const Vec& a, const Vec& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
-
-template <int S>
-void Diff(const double* a, const double* b, double* out) {
-  for (int c = 0; c < S; ++c) out[c] = a[c] - b[c];
+[[gnu::always_inline]] inline Vec operator+(const Vec& a, const Vec& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+[[gnu::always_inline]] inline Vec Cross(const Vec& a, const Vec& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+[[gnu::always_inline]] inline double Dot(const Vec& a, const Vec& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
 // Signed volume of the trilinear hexahedron (see the header): the 6-tetrahedra volume around the
 // diagonal x0-x7 (Grandy's formula) plus, per face, half the tetrahedron between that face's two
 // triangulations.
-double HexVolume(const Corners& x) {
-  double d70[3], d10[3], d35[3], d40[3], d56[3], d20[3], d63[3];
-  Diff<3>(x[7], x[0], d70);
-  Diff<3>(x[1], x[0], d10);
-  Diff<3>(x[3], x[5], d35);
-  Diff<3>(x[4], x[0], d40);
-  Diff<3>(x[5], x[6], d56);
-  Diff<3>(x[2], x[0], d20);
-  Diff<3>(x[6], x[3], d63);
-  double c1[3], c2[3], c3[3];
-  Cross(d10, d35, c1);
-  Cross(d40, d56, c2);
-  Cross(d20, d63, c3);
-  double six_tets = 0.0;
-  for (int c = 0; c < 3; ++c) six_tets += d70[c] * (c1[c] + c2[c] + c3[c]);
+[[gnu::always_inline]] inline double HexVolume(const Vec (&x)[8]) {
+  const Vec d70 = x[7] - x[0];
+  const double six_tets =
+      Dot(d70, Cross(x[1] - x[0], x[3] - x[5]) + Cross(x[4] - x[0], x[5] - x[6]) +
+                   Cross(x[2] - x[0], x[6] - x[3]));
   // Faces a b c d in outward cyclic order, a-c the diagonal the six tetrahedra use.
-  static constexpr int kFaces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 4, 6, 2},
-                                       {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}};
-  double warp = 0.0;
-  for (const auto& f : kFaces) {
-    double ab[3], ac[3], ad[3], n[3];
-    Diff<3>(x[f[1]], x[f[0]], ab);
-    Diff<3>(x[f[2]], x[f[0]], ac);
-    Diff<3>(x[f[3]], x[f[0]], ad);
-    Cross(ac, ad, n);
-    warp += ab[0] * n[0] + ab[1] * n[1] + ab[2] * n[2];
-  }
+  auto face = [&x](int a, int b, int c, int d) {
+    return Dot(x[b] - x[a], Cross(x[c] - x[a], x[d] - x[a]));
+  };
+  const double warp = face(0, 2, 3, 1) + face(4, 5, 7, 6) + face(0, 4, 6, 2) + face(1, 3, 7, 5) +
+                      face(0, 1, 5, 4) + face(2, 6, 7, 3);
   return six_tets / 6.0 + warp / 12.0;
+}
+
+// The signed measure of a cell from its corners in binary order (kWidth<K> doubles; planar
+// corners have z = 0).
+template <CellKind K>
+[[gnu::always_inline]] inline void MeasureOf(const Vec (&x)[8], double* m) {
+  if constexpr (K == CellKind::kVolume) {
+    m[0] = HexVolume(x);
+  } else {
+    const Vec a = Cross(x[3] - x[0], x[2] - x[1]);
+    if constexpr (K == CellKind::kPlanar) {
+      m[0] = 0.5 * a.z;
+    } else {
+      m[0] = 0.5 * a.x;
+      m[1] = 0.5 * a.y;
+      m[2] = 0.5 * a.z;
+    }
+  }
 }
 
 // The signed measure of a cell (kWidth<K> doubles).
 template <CellKind K>
-void Measure(const Corners& x, double* m) {
-  if constexpr (K == CellKind::kVolume) {
-    m[0] = HexVolume(x);
-  } else {
-    double d1[kStride<K>], d2[kStride<K>];
-    Diff<kStride<K>>(x[3], x[0], d1);
-    Diff<kStride<K>>(x[2], x[1], d2);
-    if constexpr (K == CellKind::kPlanar) {
-      m[0] = 0.5 * (d1[0] * d2[1] - d1[1] * d2[0]);
-    } else {
-      Cross(d1, d2, m);
-      for (int c = 0; c < 3; ++c) m[c] *= 0.5;
-    }
+void Measure(const Corners& corners, double* m) {
+  Vec x[8] = {};
+  for (int a = 0; a < kCorners<K>; ++a) {
+    x[a] = {corners[a][0], corners[a][1], kStride<K> == 3 ? corners[a][2] : 0.0};
   }
+  MeasureOf<K>(x, m);
+}
+
+template <int S>
+void Diff(const double* a, const double* b, double* out) {
+  for (int c = 0; c < S; ++c) out[c] = a[c] - b[c];
 }
 
 // Whether an edge of the cell is at most kCollapsedEdgeRelTol times its longest edge.
@@ -159,6 +165,48 @@ void ForEachCell(const double* lo, const double* hi, const RowLayout& layout, F&
         x[3] = hi + c + s;
       }
       f(I, J, x);
+    }
+  }
+}
+
+// A row of points, kStride doubles each, rearranged component by component: coordinate c of
+// point p goes to out[c * points + p].
+template <int S>
+void Deinterleave(const double* row, int64_t points, double* out) {
+  for (int64_t p = 0; p < points; ++p) {
+    for (int c = 0; c < S; ++c) out[c * points + p] = row[S * p + c];
+  }
+}
+
+// The measures of the cells between two rows of points given component by component
+// (Deinterleave), component-major: component c of cell I + (fast_points - 1) J goes to
+// out[c * cells + I + (fast_points - 1) J], cells = the row's cells. The formulas of Measure, in
+// loops over I that the compiler vectorises.
+template <CellKind K>
+void RowMeasures(const double* lo, const double* hi, const RowLayout& layout, double* out) {
+  constexpr int s = kStride<K>;
+  const int64_t n0 = layout.fast_points;
+  const int64_t fast_cells = n0 - 1;
+  const int mid_cells = K == CellKind::kVolume ? layout.mid_points - 1 : 1;
+  const int64_t cells = fast_cells * mid_cells;
+  for (int J = 0; J < mid_cells; ++J) {
+    const double* corner[kCorners<K>][s];
+    for (int a = 0; a < kCorners<K>; ++a) {
+      const bool upper = (a & (K == CellKind::kVolume ? 4 : 2)) != 0;
+      const bool next_line = K == CellKind::kVolume && (a & 2) != 0;
+      const int64_t offset = n0 * J + (a & 1) + (next_line ? n0 : 0);
+      for (int c = 0; c < s; ++c) corner[a][c] = (upper ? hi : lo) + c * layout.row_points + offset;
+    }
+    double* m = out + fast_cells * J;
+#pragma GCC ivdep
+    for (int64_t I = 0; I < fast_cells; ++I) {
+      Vec x[8] = {};
+      for (int a = 0; a < kCorners<K>; ++a) {
+        x[a] = {corner[a][0][I], corner[a][1][I], s == 3 ? corner[a][s - 1][I] : 0.0};
+      }
+      double value[kWidth<K>];
+      MeasureOf<K>(x, value);
+      for (int c = 0; c < kWidth<K>; ++c) m[c * cells + I] = value[c];
     }
   }
 }
@@ -311,30 +359,38 @@ class CellChecker {
     GridEvaluator evaluator(fitted_.spline, part, /*first_derivatives=*/false);
     const RowLayout layout = MakeLayout(evaluator.extents(), active_, num_active_);
     const int64_t row_size = kStride<K> * layout.row_points;
-    std::vector<double> lo(row_size), hi(row_size);
-    evaluator.EvaluateLines(0, layout.lines_per_row, lo.data());
+    const int64_t fast_cells = layout.fast_points - 1;
+    const int mid_cells = K == CellKind::kVolume ? layout.mid_points - 1 : 1;
+    const int64_t row_cells = fast_cells * mid_cells;
+    // A row as evaluated, and the lower and upper rows of the cells component by component.
+    std::vector<double> row(row_size), lo(row_size), hi(row_size), measures(width * row_cells);
+    evaluator.EvaluateLines(0, layout.lines_per_row, row.data());
+    Deinterleave<kStride<K>>(row.data(), layout.row_points, lo.data());
     for (int r = 0; r + 1 < layout.rows; ++r) {
       SG_RETURN_IF_ERROR(PollCancel(options_.cancel));
       evaluator.EvaluateLines((r + 1) * layout.lines_per_row, (r + 2) * layout.lines_per_row,
-                              hi.data());
+                              row.data());
+      Deinterleave<kStride<K>>(row.data(), layout.row_points, hi.data());
+      RowMeasures<K>(lo.data(), hi.data(), layout, measures.data());
       const int64_t parent_row = int64_t{ref_.fast_cells} * ref_.mid_cells * (r >> level);
-      ForEachCell<K>(lo.data(), hi.data(), layout, [&](int I, int J, const Corners& x) {
-        const int64_t parent =
-            parent_row + ((first + I) >> level) + int64_t{ref_.fast_cells} * (J >> level);
-        uint8_t& state = state_[parent];
-        if (state == kSkipped) {
-          ++q_.cells_skipped;
-          return;
+      for (int J = 0; J < mid_cells; ++J) {
+        const int64_t parent_line = parent_row + int64_t{ref_.fast_cells} * (J >> level);
+        double line_share = slow_share[r];
+        if constexpr (K == CellKind::kVolume) line_share *= inverse_share[1][J];
+        const double* m = measures.data() + fast_cells * J;
+        for (int64_t I = 0; I < fast_cells; ++I) {
+          const int64_t parent = parent_line + ((first + I) >> level);
+          uint8_t& state = state_[parent];
+          if (state == kSkipped) {
+            ++q_.cells_skipped;
+            continue;
+          }
+          const double* w = ref_.weight.data() + width * parent;
+          double ratio = 0.0;
+          for (int c = 0; c < width; ++c) ratio += m[c * row_cells + I] * w[c];
+          Tally(ratio * (inverse_share[0][first + I] * line_share), level, parent, state);
         }
-        double m[width];
-        Measure<K>(x, m);
-        const double* w = ref_.weight.data() + width * parent;
-        double ratio = 0.0;
-        for (int c = 0; c < width; ++c) ratio += m[c] * w[c];
-        ratio *= inverse_share[0][first + I] * slow_share[r];
-        if constexpr (K == CellKind::kVolume) ratio *= inverse_share[1][J];
-        Tally(ratio, level, parent, state);
-      });
+      }
       std::swap(lo, hi);
     }
     return absl::OkStatus();
@@ -555,8 +611,8 @@ Point3 CellAreaVector(const std::array<Point3, 4>& corners) {
 }
 
 double HexahedronVolume(const std::array<Point3, 8>& corners) {
-  Corners x;
-  for (int n = 0; n < 8; ++n) x[n] = corners[n].data();
+  Vec x[8];
+  for (int n = 0; n < 8; ++n) x[n] = {corners[n][0], corners[n][1], corners[n][2]};
   return HexVolume(x);
 }
 
