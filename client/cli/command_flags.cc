@@ -45,9 +45,10 @@ std::vector<CommandSpec> MakeCommands() {
        {"Plaintext only on a loopback address unless --insecure; --tls_cert and --tls_key "
         "enable TLS."}},
       {"fit",
-       "fit FILE [--name N] [--tol T | --kinds [--wall W --interface I --outer O] | --ctl a,b,c] "
-       "[--fair tol|LAMBDA] [--allow_folds]",
-       "import a Plot3D grid and fit it (revision 1); prints the fit report",
+       "fit FILE|NAME [--name N] [--tol T | --kinds [--wall W --interface I --outer O] | "
+       "--ctl a,b,c] [--fair tol|LAMBDA] [--allow_folds]",
+       "import a Plot3D or CGNS grid and fit it (revision 1), or fit a stored grid's points again "
+       "(a new revision; NAME when no such file exists); prints the fit report",
        /*client=*/true,
        {"name", "planar", "plot3d_layout", SG_FIT_SPEC_FLAGS},
        {"--kinds: tolerances 0.15e-3 (wall), 2e-3 (interface), 8e-3 (outer) times the reference "

@@ -1,9 +1,13 @@
-// `splinegrid fit` (import a file and fit it) and `splinegrid fair` (refit a stored grid).
+// `splinegrid fit` (import a file and fit it, or fit a stored grid again) and `splinegrid fair`
+// (refit a stored grid with fairing).
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 
 #include "absl/flags/flag.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/cli/cgns_output.h"
 #include "client/cli/command_line.h"
@@ -29,16 +33,53 @@ absl::StatusOr<v1::Plot3dLayout> Plot3dLayoutFlag() {
   return Usage(absl::StrCat("--plot3d_layout = '", text, "': give whole or planes"));
 }
 
+// Whether `text` could be a stored grid's name: "grids/ID" or ID, ID of [a-z0-9-] starting with
+// a letter (the server's rule); a path with a directory or an extension is not.
+bool LooksLikeGridName(const std::string& text) {
+  const std::string id = client::GridId(text);
+  if (id.empty() || id.size() > 63 || !std::islower(static_cast<unsigned char>(id[0])))
+    return false;
+  return std::all_of(id.begin(), id.end(), [](char c) {
+    return std::islower(static_cast<unsigned char>(c)) ||
+           std::isdigit(static_cast<unsigned char>(c)) || c == '-';
+  });
+}
+
+// `splinegrid fit NAME`: fits the source points of a stored grid again (a new revision), e.g.
+// one imported by a fit that was interrupted, or with other tolerances.
+absl::Status FitStored(const std::string& name, const v1::FitSpec& spec) {
+  for (const char* flag : {"name", "planar", "plot3d_layout"}) {
+    if (FlagGiven(flag)) {
+      return Usage(absl::StrCat("--", flag, " is about importing a file; ", client::GridName(name),
+                                " is a stored grid: drop --", flag));
+    }
+  }
+  SG_ASSIGN_OR_RETURN(const v1::FitGridResponse fit, Connect()->Fit(name, spec));
+  Print(FormatFit(client::GridName(name), fit), fit);
+  return StoredNotAsAsked(client::GridName(name), fit);
+}
+
 }  // namespace
 
 absl::Status Fit(const Args& args) {
   if (args.size() != 1) {
     return Usage(
-        "usage: splinegrid fit FILE [--name N] [--tol T | --kinds [--wall W ...] | --ctl a,b,c] "
-        "[--fair tol|LAMBDA]");
+        "usage: splinegrid fit FILE|NAME [--name N] [--tol T | --kinds [--wall W ...] | "
+        "--ctl a,b,c] [--fair tol|LAMBDA]");
   }
   const std::string& path = args[0];
   SG_ASSIGN_OR_RETURN(const v1::FitSpec spec, SpecFromFlags());
+  // Not a file but a grid's name: that stored grid is fitted again.
+  std::error_code no_file;
+  if (!std::filesystem::exists(path, no_file) && LooksLikeGridName(path)) {
+    absl::Status fitted = FitStored(path, spec);
+    if (fitted.code() == absl::StatusCode::kNotFound &&
+        absl::StrContains(fitted.message(), client::GridName(path))) {
+      return absl::NotFoundError(
+          absl::StrCat(path, " is neither a file nor a stored grid (", fitted.message(), ")"));
+    }
+    return fitted;
+  }
   SG_ASSIGN_OR_RETURN(const std::string bytes, ReadFileToString(path));
   if (bytes.empty()) {  // the server would name only its header field, total_bytes = 0
     return absl::InvalidArgumentError(absl::StrCat(path, " is empty: no grid to fit"));
@@ -66,11 +107,18 @@ absl::Status Fit(const Args& args) {
   ProgressLine upload("upload");
   const std::string grid_id = client::GridName(id).substr(6);
   const std::string display_name = std::filesystem::path(path).filename().string();
-  SG_ASSIGN_OR_RETURN(
-      const v1::Grid grid,
+  absl::StatusOr<v1::Grid> imported =
       cgns ? client->ImportCgns(bytes, grid_id, display_name, upload.callback())
-           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options, upload.callback()));
+           : client->ImportPlot3d(bytes, grid_id, display_name, plot3d_options, upload.callback());
   upload.Done();
+  if (imported.status().code() == absl::StatusCode::kAlreadyExists) {
+    return absl::AlreadyExistsError(absl::StrCat(
+        imported.status().message(), ": to fit its stored points again, `splinegrid fit ", grid_id,
+        "` (with the tolerance flags); to replace it, `splinegrid rm ", grid_id,
+        "` first, or import under another --name"));
+  }
+  SG_RETURN_IF_ERROR(imported.status());
+  const v1::Grid& grid = *imported;
   // What the import mapped with a choice or left out (CGNS), never silently.
   for (const std::string& note : grid.source().boundaries().notes()) {
     std::fprintf(stderr, "note: %s\n", note.c_str());

@@ -231,6 +231,28 @@ TEST_F(EndToEndTest, CliFitsListsGetsEvaluatesAndRemoves) {
   EXPECT_THAT(gone.out, HasSubstr("NOT_FOUND"));
 }
 
+// `fit NAME` fits a stored grid's points again (a grid left unfitted by an interrupted `fit`,
+// or other tolerances); importing a name that exists says how to do either.
+TEST_F(EndToEndTest, CliFitsAStoredGridAgainByName) {
+  const std::string file = SharedDataPath("grids/n0012_113-33.p2dfmt");
+  ASSERT_EQ(Cli(absl::StrCat("fit ", file, " --name=naca --kinds")).exit_code, 0);
+  const Result again = Cli(absl::StrCat("fit ", file, " --name=naca --kinds"));
+  EXPECT_EQ(again.exit_code, 1) << again.out;
+  EXPECT_THAT(again.out, HasSubstr("ALREADY_EXISTS: grids/naca already exists: to fit its "
+                                   "stored points again, `splinegrid fit naca`"));
+  const Result refit = Cli("fit naca --tol=1e-3");
+  ASSERT_EQ(refit.exit_code, 0) << refit.out;
+  EXPECT_THAT(refit.out, HasSubstr("grids/naca revision 2: 3729 points"));
+  EXPECT_THAT(Cli("fit grids/naca --kinds").out, HasSubstr("grids/naca revision 3: "));
+  const Result renamed = Cli("fit naca --name=other");
+  EXPECT_EQ(renamed.exit_code, 2) << renamed.out;
+  EXPECT_THAT(renamed.out, HasSubstr("--name is about importing a file; grids/naca is a stored "
+                                     "grid"));
+  const Result neither = Cli("fit nothere --kinds");
+  EXPECT_EQ(neither.exit_code, 1) << neither.out;
+  EXPECT_THAT(neither.out, HasSubstr("nothere is neither a file nor a stored grid"));
+}
+
 TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   const Result missing = Cli("fit /nonexistent/grid.x");
   EXPECT_NE(missing.exit_code, 0);
