@@ -144,8 +144,11 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     SG_ASSIGN_OR_RETURN(std::shared_ptr<StoredGrid> grid,
                         assembler_->Finish(/*check_counts=*/true, Cancel()));
     log_.set_grid(absl::StrCat("grids/", grid->id));
+    // An admin restores a grid for its owner (the archive's); anyone else imports a copy of
+    // their own.
+    std::string owner = caller_.role == Role::kAdmin ? grid->owner : caller_.owner();
     SG_RETURN_IF_ERROR(ops::StoreArchived(state_->Ops(), grid, assembler_->stated_connectivity(),
-                                          caller_.owner()));
+                                          std::move(owner)));
     return EncodeGrid(*grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
   }
 

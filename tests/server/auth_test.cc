@@ -262,7 +262,7 @@ TEST_F(AuthTest, GridsMadeWithoutTokensBelongToNoOneAndOwnersSurviveARestart) {
   EXPECT_EQ(alice->Get("alices").value().owner(), "alice");
   ExpectCode(alice->Delete("anonymous"), absl::StatusCode::kPermissionDenied);
   ExpectCode(As("write-token-b1")->Delete("alices"), absl::StatusCode::kPermissionDenied);
-  // An archive imported by bob is bob's, whoever exported it.
+  // An archive imported by a writer is that writer's copy, whoever exported it.
   const std::string archive = (dir_ / "alices.sgrid").string();
   ASSERT_TRUE(alice->ExportGrid("alices", archive).ok());
   auto bob = As("write-token-b1");
@@ -270,6 +270,19 @@ TEST_F(AuthTest, GridsMadeWithoutTokensBelongToNoOneAndOwnersSurviveARestart) {
   ASSERT_TRUE(copy.ok()) << copy.status();
   EXPECT_EQ(copy->owner(), "bob");
   EXPECT_TRUE(bob->Delete("bobs-copy").ok());
+  // Imported by an admin (a restore), it stays alice's: she may go on changing it.
+  auto admin = As("admin-token-z1");
+  const absl::StatusOr<v1::Grid> restored = admin->ImportArchive(archive, "restored");
+  ASSERT_TRUE(restored.ok()) << restored.status();
+  EXPECT_EQ(restored->owner(), "alice");
+  v1::FitSpec spec;
+  spec.set_allow_folds(true);
+  spec.mutable_control_counts()->set_i(12);
+  spec.mutable_control_counts()->set_j(8);
+  const absl::StatusOr<v1::FitGridResponse> refit = alice->Fit("restored", spec);
+  EXPECT_TRUE(refit.ok()) << refit.status();
+  ExpectCode(bob->Delete("restored"), absl::StatusCode::kPermissionDenied);
+  EXPECT_TRUE(alice->Delete("restored").ok());
   EXPECT_TRUE(alice->Delete("alices").ok());
   EXPECT_TRUE(As("admin-token-z1")->Delete("anonymous").ok());
 }
