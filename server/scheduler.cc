@@ -66,27 +66,48 @@ absl::Status Scheduler::TrySubmit(const std::string& principal, WorkKind kind,
     if (kind == WorkKind::kCheap) {
       cheap_.push_back(std::move(task));
     } else {
-      PrincipalQueue& queue = long_[principal];
-      const bool counted = admission == Admission::kNewCall;
+      FairQueue& fair = kind == WorkKind::kLong ? long_ : slices_;
+      PrincipalQueue& queue = fair.queues[principal];
+      const bool counted = kind == WorkKind::kLong && admission == Admission::kNewCall;
       if (counted && queue.counted >= options_.max_queued_long_calls_per_principal) {
-        if (queue.tasks.empty()) long_.erase(principal);
+        if (queue.tasks.empty()) fair.queues.erase(principal);
         return absl::ResourceExhaustedError(absl::StrCat(
             "this caller already has ", queue.counted,
             " long calls waiting (limit "
             "max_queued_long_calls_per_principal = ",
             options_.max_queued_long_calls_per_principal, "); retry when one has finished"));
       }
-      if (queue.tasks.empty()) ring_.push_back(principal);
+      if (queue.tasks.empty()) fair.ring.push_back(principal);
       queue.tasks.push_back({std::move(task), counted});
       queue.counted += counted ? 1 : 0;
     }
     ++queued_;
   }
-  // A cheap task may go to either kind of worker: wake one of each (the one that finds nothing
-  // sleeps again); a long task only to a long-capable one.
-  if (kind == WorkKind::kCheap) cheap_cv_.notify_one();
+  // A cheap task or a slice may go to either kind of worker: wake one of each (the one that
+  // finds nothing sleeps again); a long task only to a long-capable one.
+  if (kind != WorkKind::kLong) cheap_cv_.notify_one();
   any_cv_.notify_one();
   return absl::OkStatus();
+}
+
+std::function<void()> Scheduler::FairQueue::Take() {
+  std::string principal = std::move(ring.front());
+  ring.pop_front();
+  auto it = queues.find(principal);
+  PrincipalQueue& queue = it->second;
+  std::function<void()> task = std::move(queue.tasks.front().run);
+  queue.counted -= queue.tasks.front().counted ? 1 : 0;
+  queue.tasks.pop_front();
+  if (queue.tasks.empty()) {
+    queues.erase(it);
+  } else {
+    ring.push_back(std::move(principal));
+  }
+  return task;
+}
+
+bool Scheduler::HasWorkLocked(bool may_run_long) const {
+  return !cheap_.empty() || (may_run_long && !long_.empty()) || !slices_.empty();
 }
 
 std::function<void()> Scheduler::TakeLocked(bool may_run_long) {
@@ -94,19 +115,10 @@ std::function<void()> Scheduler::TakeLocked(bool may_run_long) {
   if (!cheap_.empty()) {
     task = std::move(cheap_.front());
     cheap_.pop_front();
-  } else if (may_run_long && !ring_.empty()) {
-    std::string principal = std::move(ring_.front());
-    ring_.pop_front();
-    auto it = long_.find(principal);
-    PrincipalQueue& queue = it->second;
-    task = std::move(queue.tasks.front().run);
-    queue.counted -= queue.tasks.front().counted ? 1 : 0;
-    queue.tasks.pop_front();
-    if (queue.tasks.empty()) {
-      long_.erase(it);
-    } else {
-      ring_.push_back(std::move(principal));
-    }
+  } else if (may_run_long && !long_.empty()) {
+    task = long_.Take();
+  } else if (!slices_.empty()) {
+    task = slices_.Take();
   } else {
     return task;
   }
@@ -120,8 +132,7 @@ void Scheduler::Run(bool may_run_long) {
     std::function<void()> task;
     {
       std::unique_lock<std::mutex> lock(mu_);
-      cv.wait(lock,
-              [&] { return stopping_ || !cheap_.empty() || (may_run_long && !ring_.empty()); });
+      cv.wait(lock, [&] { return stopping_ || HasWorkLocked(may_run_long); });
       task = TakeLocked(may_run_long);
       if (!task) return;  // stopping, and nothing left this worker may run
     }
@@ -133,11 +144,15 @@ Scheduler::QueueLengths Scheduler::queue_lengths() const {
   std::lock_guard<std::mutex> lock(mu_);
   QueueLengths lengths;
   lengths.cheap = static_cast<int>(cheap_.size());
-  for (const auto& [principal, queue] : long_) {
-    if (queue.tasks.empty()) continue;
-    lengths.long_tasks += static_cast<int>(queue.tasks.size());
-    lengths.long_by_principal.emplace_back(principal, static_cast<int>(queue.tasks.size()));
+  absl::flat_hash_map<std::string, int> by_principal;
+  for (const FairQueue* fair : {&long_, &slices_}) {
+    for (const auto& [principal, queue] : fair->queues) {
+      if (queue.tasks.empty()) continue;
+      lengths.long_tasks += static_cast<int>(queue.tasks.size());
+      by_principal[principal] += static_cast<int>(queue.tasks.size());
+    }
   }
+  lengths.long_by_principal.assign(by_principal.begin(), by_principal.end());
   return lengths;
 }
 

@@ -15,6 +15,12 @@
 //    at the front, which then goes to the back. A principal with 40 queued fits delays another
 //    principal's newly queued fit by the running fits and at most one more of its own (it may
 //    be at the front of the ring), not by its whole queue. Turns count tasks, not CPU time.
+//  - Slices: a long call that runs as a series of short tasks, each bounded to a few
+//    milliseconds (the chunks of a large grid evaluation, produced at the pace the network takes
+//    them), submits them as slices. They take turns across principals as long tasks do (a ring
+//    of their own), and any worker takes one when no cheap task waits: so a coupling solver's
+//    evaluation of a few hundred thousand points goes on while another principal's fit holds
+//    the long workers for seconds, and a cheap call waits for at most one slice.
 //  - Limits, refused at submission with RESOURCE_EXHAUSTED naming the limit: every waiting
 //    task (`max_queued_tasks`), and the waiting long tasks of one principal that start a call
 //    (`max_queued_long_calls_per_principal`; a continuation of an admitted call, such as the
@@ -39,7 +45,7 @@
 namespace splinegrid::server {
 
 // How a task is scheduled: see the policy above.
-enum class WorkKind { kCheap, kLong };
+enum class WorkKind { kCheap, kLong, kSlice };
 
 // Whether a task starts a call (subject to the per-principal limit) or continues an admitted
 // one.
@@ -82,24 +88,36 @@ class Scheduler {
   // Tasks waiting for a worker now, for the metrics endpoint (takes the lock: not for hot paths).
   struct QueueLengths {
     int cheap = 0;
-    int long_tasks = 0;
+    int long_tasks = 0;                                          // long tasks and slices
     std::vector<std::pair<std::string, int>> long_by_principal;  // principals with any waiting
   };
   QueueLengths queue_lengths() const;
 
  private:
-  struct LongTask {
+  struct FairTask {
     std::function<void()> run;
     bool counted;  // towards the principal's max_queued_long_calls_per_principal
   };
   struct PrincipalQueue {
-    std::deque<LongTask> tasks;
+    std::deque<FairTask> tasks;
     int counted = 0;  // tasks with `counted`
+  };
+  // Tasks that take turns across principals: a FIFO per principal and a ring of the principals
+  // with queued tasks, next first.
+  struct FairQueue {
+    absl::flat_hash_map<std::string, PrincipalQueue> queues;
+    std::deque<std::string> ring;
+    bool empty() const { return ring.empty(); }
+    // The next task of the principal at the front of the ring, which goes to the back.
+    std::function<void()> Take();
   };
 
   // A worker's loop; it takes long tasks only when `may_run_long`.
   void Run(bool may_run_long);
-  // The next task for a worker (cheap first); empty when there is none it may run.
+  // Whether a worker has a task it may run.
+  bool HasWorkLocked(bool may_run_long) const;
+  // The next task for a worker (cheap first, then long ones when it may run them, then slices);
+  // empty when there is none it may run.
   std::function<void()> TakeLocked(bool may_run_long);
 
   const SchedulerOptions options_;
@@ -108,9 +126,9 @@ class Scheduler {
   std::condition_variable cheap_cv_;  // waited on by cheap-only workers
   std::condition_variable any_cv_;    // waited on by long-capable workers
   std::deque<std::function<void()>> cheap_;
-  absl::flat_hash_map<std::string, PrincipalQueue> long_;
-  std::deque<std::string> ring_;  // principals with queued long tasks, next first
-  int queued_ = 0;                // cheap + long waiting
+  FairQueue long_;
+  FairQueue slices_;
+  int queued_ = 0;  // cheap, long and slices waiting
   bool stopping_ = false;
   std::vector<std::thread> threads_;
 };

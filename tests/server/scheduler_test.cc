@@ -153,6 +153,43 @@ TEST(SchedulerTest, LongWorkLeavesAWorkerForCheapWork) {
   second.Open();
 }
 
+// Slices (the chunks of a large evaluation) run on the worker kept for cheap work while a long
+// task holds the long one, after the cheap tasks waiting, taking turns across principals.
+TEST(SchedulerTest, SlicesGoOnWhileLongWorkHoldsTheLongWorkers) {
+  Journal journal;
+  Gate fit, cheap_gate;
+  {
+    SchedulerOptions options;
+    options.threads = 2;
+    options.long_worker_nice = 0;
+    Scheduler scheduler(options);
+    ASSERT_TRUE(scheduler.TrySubmit("fitter", WorkKind::kLong, fit.Task()).ok());
+    fit.WaitStarted();
+    ASSERT_TRUE(scheduler.TrySubmit("fitter", WorkKind::kLong, journal.Entry("fit2")).ok());
+    // Hold the other worker too while the queue is filled, so that the order is the policy's.
+    ASSERT_TRUE(scheduler.TrySubmit("x", WorkKind::kCheap, cheap_gate.Task()).ok());
+    cheap_gate.WaitStarted();
+    for (const char* name : {"a1", "a2", "a3"}) {
+      ASSERT_TRUE(
+          scheduler
+              .TrySubmit("alice", WorkKind::kSlice, journal.Entry(name), Admission::kContinuation)
+              .ok());
+    }
+    ASSERT_TRUE(
+        scheduler.TrySubmit("bob", WorkKind::kSlice, journal.Entry("b1"), Admission::kContinuation)
+            .ok());
+    ASSERT_TRUE(scheduler.TrySubmit("carol", WorkKind::kCheap, journal.Entry("cheap")).ok());
+    cheap_gate.Open();
+    // Every slice runs while the fit still holds the long worker.
+    for (int i = 0; i < 1000 && journal.order().size() < 5; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    EXPECT_THAT(journal.order(), ElementsAre("cheap", "a1", "b1", "a2", "a3"));
+    fit.Open();
+  }
+  EXPECT_THAT(journal.order(), ElementsAre("cheap", "a1", "b1", "a2", "a3", "fit2"));
+}
+
 TEST(SchedulerTest, RunningLongTasksDefaultToAllButOneWorker) {
   for (const auto& [threads, requested, expected] : std::vector<std::tuple<int, int, int>>{
            {1, 0, 1}, {2, 0, 1}, {4, 0, 3}, {4, 2, 2}, {2, 5, 2}}) {
