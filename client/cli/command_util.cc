@@ -89,9 +89,10 @@ std::string ServerAddress() {
   return "localhost:50051";
 }
 
-std::unique_ptr<client::Client> Connect() {
+std::unique_ptr<client::Client> Connect(const client::RetryPolicy& retry) {
   client::ClientOptions options = ConnectionOptions();
   options.timeout = absl::GetFlag(FLAGS_timeout);
+  options.retry = retry;
   return client::Client::Connect(ServerAddress(), options);
 }
 

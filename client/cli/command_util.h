@@ -28,8 +28,8 @@ absl::Status Usage(const std::string& message);
 std::string ServerAddress();
 
 // A client for ServerAddress() with --timeout and the token and TLS settings of
-// PrepareConnection.
-std::unique_ptr<client::Client> Connect();
+// PrepareConnection; calls that break off are retried under `retry` (default: the client's).
+std::unique_ptr<client::Client> Connect(const client::RetryPolicy& retry = {});
 
 // Prints `human`, or with --json `message` as JSON, to stdout.
 void Print(const std::string& human, const google::protobuf::Message& message);

@@ -686,6 +686,44 @@ TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) 
   EXPECT_THAT(unknown.out, HasSubstr("NOT_FOUND"));
 }
 
+// A watch is a monitor: it rides out a restart of its server (here 3 s down, longer than a
+// one-off command retries) and goes on after the last revision it printed.
+TEST_F(EndToEndTest, CliWatchRidesOutAServerRestart) {
+  const std::vector<std::string> durable = {
+      absl::StrCat("--store=dir:", (dir_ / "store").string())};
+  ASSERT_EQ(Stop(), 0);
+  ASSERT_NO_FATAL_FAILURE(StartServer(durable));
+  ASSERT_EQ(Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
+                             " --name=watched --kinds"))
+                .exit_code,
+            0);
+  const std::string out = (dir_ / "watch.out").string();
+  RunCommand(absl::StrCat("(timeout 60 ", kBinary,
+                          " watch watched --after=1 --server=127.0.0.1:", port_, " > ", out,
+                          " 2>&1; echo exit=$? >> ", out, ") > /dev/null 2>&1 < /dev/null &"));
+  const std::string deform = "deform watched --about=0.25,0 --reference=1 ";
+  ASSERT_EQ(Cli(deform + "--rotate=2 --time=0.1 --step=1").exit_code, 0);
+  auto wait_for = [&](const std::string& what) {
+    std::string text;
+    for (int i = 0; i < 300 && text.find(what) == std::string::npos; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      text = ReadFileToString(out).value_or("");
+    }
+    return text;
+  };
+  ASSERT_THAT(wait_for("revision 2 "), HasSubstr("revision 2 ")) << ReadLog();
+  ASSERT_EQ(Stop(SIGKILL), -1);
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  EXPECT_THAT(ReadFileToString(out).value_or(""), Not(HasSubstr("exit=")));
+  ASSERT_NO_FATAL_FAILURE(StartServer(durable));
+  ASSERT_EQ(Cli(deform + "--rotate=4 --time=0.2 --step=2").exit_code, 0);
+  const std::string text = wait_for("revision 3 ");
+  EXPECT_THAT(text, HasSubstr("revision 3 origin DEFORM parent 1 time 0.2 step 2")) << ReadLog();
+  EXPECT_EQ(text.find("revision 2 "), text.rfind("revision 2 ")) << text;  // not repeated
+  ASSERT_EQ(Cli("rm watched").exit_code, 0);
+  EXPECT_THAT(wait_for("exit="), HasSubstr("exit=0"));
+}
+
 TEST_F(EndToEndTest, CliExportRemoveImportGivesByteIdenticalEvaluations) {
   ASSERT_NO_FATAL_FAILURE(MakeGridWithRevisions("naca"));
   // The evaluations to compare: the latest (deformed) revision, the fit, the step.
