@@ -88,7 +88,12 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
 
 Server::~Server() { Shutdown(); }
 
-absl::StatusOr<int> Server::ReloadTokens() { return state_->authenticator.Reload(); }
+absl::StatusOr<int> Server::ReloadTokens() {
+  absl::StatusOr<int> tokens = state_->authenticator.Reload();
+  // Open watches check their tokens again: one whose token went or lost its role ends now.
+  if (tokens.ok()) state_->watches.WakeAll();
+  return tokens;
+}
 
 void Server::SetServing(bool serving) {
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();

@@ -19,6 +19,7 @@
 #include "server/grid_id.h"
 #include "server/grid_store.h"
 #include "server/memory_budget.h"
+#include "server/open_watches.h"
 #include "server/ops/ops_context.h"
 #include "server/scheduler.h"
 #include "server/server_options.h"
@@ -37,6 +38,7 @@ struct ServiceState {
   Authenticator authenticator;
   std::unique_ptr<GridStore> store;
   StreamLimits streams;  // open streaming calls per principal
+  OpenWatches watches;   // woken when the tokens are reloaded
   Scheduler pool;        // the worker threads, cheap work first, long work fair across callers
   DeformerCache deformers;
   std::atomic<bool> draining{false};  // set on shutdown: new calls get UNAVAILABLE

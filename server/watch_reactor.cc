@@ -12,7 +12,10 @@
 //    DEADLINE_EXCEEDED when its deadline passes;
 //  - UNAVAILABLE when the server shuts down: Server::Shutdown closes every subscription before
 //    gRPC waits for calls to finish, so watches end at once instead of holding the grace period;
-//  - RESOURCE_EXHAUSTED when the client falls more than max_watch_lag revisions behind.
+//  - RESOURCE_EXHAUSTED when the client falls more than max_watch_lag revisions behind;
+//  - UNAUTHENTICATED or PERMISSION_DENIED when a reload of the tokens file (SIGHUP) removed the
+//    call's token or took its read role: the reload wakes every open watch (OpenWatches), which
+//    checks its token again before anything more is sent.
 // The initial metadata goes out as soon as the subscription is in place, so a client can wait
 // for it (ClientReader::WaitForInitialMetadata) to know that it will see every revision
 // published from then on; it says where the stream begins and which creation of the id it
@@ -97,6 +100,8 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
 
  private:
   absl::Status Subscribe() {
+    // Read before authenticating: a reload in between makes the first write check again.
+    auth_generation_ = state_->authenticator.generation();
     SG_ASSIGN_OR_RETURN(AdmittedStream admitted,
                         AdmitStream(*state_, context_, Role::kRead, &log_));
     caller_ = std::move(admitted.caller);
@@ -113,6 +118,29 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
     context_->AddInitialMetadata(kIncarnationHeader, feed->incarnation());
     std::lock_guard<std::mutex> lock(mu_);
     feed_ = std::move(feed);
+    state_->watches.Add(std::weak_ptr<GridWatcher>(self_));
+    return absl::OkStatus();
+  }
+
+  // Under mu_: OK while the call's token still admits it. After a reload of the tokens file
+  // (a new generation) it is checked again: UNAUTHENTICATED once the token is gone, and
+  // PERMISSION_DENIED when it lost the read role or names another principal now.
+  absl::Status StillAdmitted() {
+    const int64_t generation = state_->authenticator.generation();
+    if (generation == auth_generation_) return absl::OkStatus();
+    auth_generation_ = generation;
+    absl::StatusOr<Caller> caller = state_->authenticator.Authenticate(*context_);
+    if (!caller.ok()) {
+      return absl::UnauthenticatedError(
+          absl::StrCat("the tokens file was reloaded and this watch's token is no longer in it (",
+                       caller.status().message(), ")"));
+    }
+    if (caller->role < Role::kRead || caller->principal != caller_.principal) {
+      return absl::PermissionDeniedError(
+          absl::StrCat("the tokens file was reloaded and this watch's token now names ",
+                       caller->principal, " with the role ", RoleName(caller->role),
+                       "; the watch was opened by ", caller_.principal));
+    }
     return absl::OkStatus();
   }
 
@@ -121,6 +149,10 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   bool NextMessage() {
     if (state_->draining.load()) {
       status_ = absl::UnavailableError("the server is shutting down");
+      return false;
+    }
+    if (absl::Status admitted = StillAdmitted(); !admitted.ok()) {
+      status_ = std::move(admitted);
       return false;
     }
     const std::optional<RevisionSummary> revision = feed_->Next();
@@ -173,6 +205,7 @@ class WatchReactor : public grpc::ServerWriteReactor<v1::WatchGridResponse>, pub
   const v1::WatchGridRequest* request_;
   CallLog log_;
   Caller caller_;
+  int64_t auth_generation_ = 0;  // the tokens table caller_ was checked against
   // This call's place among its principal's open streams.
   StreamSlot stream_;
   std::shared_ptr<WatchReactor> self_;  // this, until OnDone

@@ -40,6 +40,7 @@ absl::StatusOr<int> Authenticator::LoadTokens(const std::string& path) {
   absl::MutexLock lock(&mu_);
   table_ = std::make_shared<const Table>(*std::move(table));
   path_ = path;
+  ++generation_;
   return count;
 }
 

@@ -8,6 +8,8 @@
 #ifndef SPLINEGRID_SERVER_AUTH_AUTHENTICATOR_H_
 #define SPLINEGRID_SERVER_AUTH_AUTHENTICATOR_H_
 
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,6 +48,10 @@ class Authenticator {
   // The number of tokens in the table; 0: no tokens, calls need none.
   int num_tokens() const;
 
+  // Counts the tables loaded: a call that authenticated under an older one checks its token
+  // again (a reload may have removed it or lowered its role).
+  int64_t generation() const { return generation_.load(); }
+
   // The caller of `context`, or UNAUTHENTICATED.
   absl::StatusOr<Caller> Authenticate(const grpc::CallbackServerContext& context) const;
 
@@ -62,6 +68,7 @@ class Authenticator {
   mutable absl::Mutex mu_;
   std::shared_ptr<const Table> table_ ABSL_GUARDED_BY(mu_);  // null: no tokens
   std::string path_ ABSL_GUARDED_BY(mu_);
+  std::atomic<int64_t> generation_{0};
 };
 
 }  // namespace splinegrid::server

@@ -246,6 +246,43 @@ TEST_F(AuthTest, AReloadChangesRolesAndABadFileKeepsThem) {
   EXPECT_EQ(server_->state().authenticator.num_tokens(), 3);
 }
 
+// A reload that removes a token or lowers its role ends that token's open watches at once (an
+// idle watch too), before anything more is sent; the other watches go on.
+TEST_F(AuthTest, AReloadEndsTheWatchesOfTokensItRemoved) {
+  auto alice = As("write-token-a1");
+  ASSERT_TRUE(Import(*alice, "watched").ok());
+  v1::FitSpec spec;
+  spec.set_allow_folds(true);
+  spec.mutable_control_counts()->set_i(12);
+  spec.mutable_control_counts()->set_j(8);
+  ASSERT_TRUE(alice->Fit("watched", spec).ok());
+  auto carol = As("read-token-r1");
+  auto bob = As("write-token-b1");
+  std::unique_ptr<client::RevisionStream> removed = carol->Watch("watched", 0);
+  std::unique_ptr<client::RevisionStream> lowered = bob->Watch("watched", 0);
+  std::unique_ptr<client::RevisionStream> kept = alice->Watch("watched", 0);
+  v1::WatchGridResponse message;
+  for (auto* watch : {removed.get(), lowered.get(), kept.get()}) {
+    ASSERT_TRUE(watch->Next(&message));  // revision 1; then they wait
+  }
+  std::map<std::string, std::string> tokens = Tokens();
+  tokens.erase("read-token-r1");
+  tokens["write-token-b1"] = "robert write";  // the same token now names someone else
+  WriteTokens(tokens);
+  ASSERT_EQ(server_->ReloadTokens().value(), 3);
+  EXPECT_FALSE(removed->Next(&message));
+  EXPECT_THAT(removed->Finish(),
+              StatusIs(absl::StatusCode::kUnauthenticated,
+                       "the tokens file was reloaded and this watch's token is no longer in it"));
+  EXPECT_FALSE(lowered->Next(&message));
+  EXPECT_THAT(lowered->Finish(), StatusIs(absl::StatusCode::kPermissionDenied,
+                                          "now names robert with the role write"));
+  ASSERT_TRUE(alice->Fit("watched", spec).ok());
+  ASSERT_TRUE(kept->Next(&message));
+  EXPECT_EQ(message.revision().revision(), 2);
+  kept->Cancel();
+}
+
 TEST_F(AuthTest, GridsMadeWithoutTokensBelongToNoOneAndOwnersSurviveARestart) {
   // A durable store, first without tokens: the grid has no owner.
   options_.store = absl::StrCat("dir:", (dir_ / "store").string());
