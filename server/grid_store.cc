@@ -1,7 +1,9 @@
 #include "server/grid_store.h"
 
 #include <algorithm>
+#include <optional>
 #include <random>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -55,12 +57,27 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
       return absl::InvalidArgumentError(
           absl::StrCat(field, " = ", number, " and step = ", *step, " are both given; give one"));
     }
+    std::optional<int64_t> newest_step;  // of the deformed revisions kept
     for (auto it = revisions.rbegin(); it != revisions.rend(); ++it) {
-      if ((*it)->origin == RevisionOrigin::kDeform && (*it)->step == *step) return *it;
+      if ((*it)->origin != RevisionOrigin::kDeform) continue;
+      if ((*it)->step == *step) return *it;
+      newest_step = std::max(newest_step.value_or((*it)->step), (*it)->step);
     }
-    return absl::NotFoundError(absl::StrCat(
-        "grids/", id, " has no revision of step ", *step,
-        DroppedSome(*this) ? " (older deformed revisions were dropped by retention)" : ""));
+    // Say why only as far as it is known: a step beyond every kept one was never stored (as far
+    // as this grid knows); one below may have been dropped by retention.
+    std::string why;
+    if (newest_step && *step > *newest_step) {
+      why = absl::StrCat(" (the newest step stored is ", *newest_step, ")");
+    } else if (DroppedSome(*this)) {
+      why = " (older deformed revisions were dropped by retention)";
+    } else if (!newest_step) {
+      why = " (it has no deformed revision)";
+    }
+    if (!damaged_revisions.empty()) {
+      absl::StrAppend(&why, "; ", damaged_revisions.size(),
+                      " of its revisions were damaged on disk and set aside, their steps unknown");
+    }
+    return absl::NotFoundError(absl::StrCat("grids/", id, " has no revision of step ", *step, why));
   }
   if (revisions.empty()) {
     return absl::FailedPreconditionError(

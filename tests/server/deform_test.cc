@@ -318,6 +318,11 @@ TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
   dropped_step.set_refinement_level(0);
   EXPECT_THAT(client_->Evaluate(dropped_step).status(),
               StatusIs(absl::StatusCode::kNotFound, "dropped by retention"));
+  // A step never stored is not blamed on retention.
+  dropped_step.set_step(99);
+  EXPECT_THAT(client_->Evaluate(dropped_step).status(),
+              StatusIs(absl::StatusCode::kNotFound,
+                       "has no revision of step 99 (the newest step stored is 6)"));
   // A faired revision is kept like the fit; numbers continue.
   v1::Fairing fairing;
   fairing.set_mode(v1::FAIRING_MODE_WEIGHT);
@@ -333,9 +338,9 @@ TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
                        "grids/naca revision 9 is deformed: FairGrid refits the grid's imported "
                        "points, which do not carry the deformation, so the faired grid would "
                        "undo it; fair revision 1"));
-  EXPECT_THAT(client_->Fair("naca", 8, &fairing).status(),
-              StatusIs(absl::StatusCode::kFailedPrecondition,
-                       "revision 8 is faired already, as asked"));
+  EXPECT_THAT(
+      client_->Fair("naca", 8, &fairing).status(),
+      StatusIs(absl::StatusCode::kFailedPrecondition, "revision 8 is faired already, as asked"));
   EXPECT_THAT(numbers(), ::testing::ElementsAre(1, 6, 7, 8, 9));  // nothing stored
 }
 
