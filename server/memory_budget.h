@@ -37,8 +37,10 @@ class MemoryBudget {
  public:
   explicit MemoryBudget(int64_t limit_bytes) : limit_(limit_bytes) {}
 
-  // Reserves `bytes` for `what` (named in the error), or RESOURCE_EXHAUSTED.
-  absl::StatusOr<MemoryReservation> Reserve(int64_t bytes, const std::string& what);
+  // Reserves `bytes` for `what` (named in the error), or RESOURCE_EXHAUSTED; `held`: what
+  // `what` holds already (Extend), which the error states apart from the rest in use.
+  absl::StatusOr<MemoryReservation> Reserve(int64_t bytes, const std::string& what,
+                                            int64_t held = 0);
   // Adds `bytes` to `reservation` (which then holds against this budget), or RESOURCE_EXHAUSTED
   // leaving it as it was: for data charged as it arrives.
   absl::Status Extend(MemoryReservation* reservation, int64_t bytes, const std::string& what);
