@@ -54,13 +54,16 @@ std::vector<CommandSpec> MakeCommands() {
        {"--kinds: tolerances 0.15e-3 (wall), 2e-3 (interface), 8e-3 (outer) times the reference "
         "length (the largest extent of a wall, e.g. the chord; --ref_length overrides).",
         "A fit whose cells fold at levels 0..2 is refused (exit 1, nothing stored); with "
-        "--allow_folds it is stored and the command exits 3."}},
+        "--allow_folds it is stored and the command exits 3. Exit 3 also when a revision was "
+        "stored that misses its tolerances (a --max_ctl cap held it back)."}},
       {"fair",
        "fair NAME [--revision R] [--fair tol|LAMBDA] [--allow_folds]",
        "a faired revision of a grid (default: the largest weight within its tolerances)",
        /*client=*/true,
        {"revision", "fair", "allow_folds"},
-       {}},
+       {"--fair LAMBDA fairs with that weight and refines where the tolerances need it; a weight "
+        "too strong for them refines to interpolation and still misses them: the revision is "
+        "stored and the command exits 3 (the default finds the largest weight that keeps them)."}},
       {"curvature",
        "curvature NAME [--revision R] [--level L] [--block b] [-o OUT.csv]",
        "wall curvature of a revision (CSV with -o)",

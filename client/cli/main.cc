@@ -13,6 +13,7 @@
 
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/str_cat.h"
 #include "client/cli/command_help.h"
 #include "client/cli/command_line.h"
 #include "client/cli/commands.h"
@@ -74,11 +75,15 @@ int main(int argc, char** argv) {
       line->command->client ? splinegrid::cli::PrepareConnection() : absl::OkStatus();
   if (status.ok()) status = command->second(args);
   if (!status.ok()) {
-    // Code and message, without payloads (the exit status is one).
-    std::fprintf(stderr, "splinegrid %s: %s: %s\n", command->first.c_str(),
-                 absl::StatusCodeToString(status.code()).c_str(),
+    // Code and message, without payloads (the exit status is one). A revision stored but not as
+    // asked (exit 3) is no failed call: its message alone.
+    const int exit_code = splinegrid::cli::ExitCodeOf(status);
+    const std::string code = exit_code == splinegrid::cli::kExitQualityNotMet
+                                 ? std::string()
+                                 : absl::StrCat(absl::StatusCodeToString(status.code()), ": ");
+    std::fprintf(stderr, "splinegrid %s: %s%s\n", command->first.c_str(), code.c_str(),
                  std::string(status.message()).c_str());
-    return splinegrid::cli::ExitCodeOf(status);
+    return exit_code;
   }
   return 0;
 }
