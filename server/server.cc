@@ -186,6 +186,19 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   absl::StatusOr<std::unique_ptr<Server>> server = Server::Start(options);
   if (!server.ok()) return server.status();
+  // Everything that can fail at start comes before the banner, which says the server is up.
+  // The metrics endpoint lives from here until the server has shut down: scrapes see the drain.
+  std::unique_ptr<MetricsEndpoint> metrics;
+  if (!options.metrics_address.empty()) {
+    const ServiceState* state = &(*server)->state();
+    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> started = MetricsEndpoint::Start(
+        options.metrics_address, options.metrics_insecure, [state] { return MetricsText(*state); });
+    if (!started.ok()) {
+      (*server)->Shutdown();
+      return started.status();
+    }
+    metrics = *std::move(started);
+  }
   std::fprintf(stderr,
                "splinegrid serving on port %d (%s), store %s, %d workers, memory budget %s, "
                "import idle timeout %s\n",
@@ -206,17 +219,7 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
                  "splinegrid: warning: bearer tokens travel in plaintext (--insecure without "
                  "TLS): anyone on the network path can read and reuse them\n");
   }
-  // The metrics endpoint lives from here until the server has shut down: scrapes see the drain.
-  std::unique_ptr<MetricsEndpoint> metrics;
-  if (!options.metrics_address.empty()) {
-    const ServiceState* state = &(*server)->state();
-    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> started = MetricsEndpoint::Start(
-        options.metrics_address, options.metrics_insecure, [state] { return MetricsText(*state); });
-    if (!started.ok()) {
-      (*server)->Shutdown();
-      return started.status();
-    }
-    metrics = *std::move(started);
+  if (metrics) {
     std::fprintf(stderr, "splinegrid: metrics on port %d (%s, GET /metrics, plaintext HTTP)\n",
                  metrics->port(), options.metrics_address.c_str());
   }

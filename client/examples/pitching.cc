@@ -41,13 +41,15 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/client.h"
 #include "core/io/file_util.h"
 
-ABSL_FLAG(std::string, server, "localhost:50051", "splinegrid server (host:port)");
+ABSL_FLAG(std::string, server, "",
+          "splinegrid server (host:port; default: $SPLINEGRID_SERVER, else localhost:50051)");
 ABSL_FLAG(int, steps, 100, "time steps");
 ABSL_FLAG(double, amplitude, 10.0, "pitch amplitude in degrees");
 ABSL_FLAG(int, period, 0, "steps per pitch cycle (0: --steps, one whole cycle)");
@@ -73,6 +75,14 @@ ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 
 namespace splinegrid {
 namespace {
+
+// --server, else $SPLINEGRID_SERVER (what deploy/local/start.sh prints), else localhost:50051:
+// the CLI's rule.
+std::string ServerAddress() {
+  if (std::string flag = absl::GetFlag(FLAGS_server); !flag.empty()) return flag;
+  const char* env = std::getenv("SPLINEGRID_SERVER");
+  return env != nullptr && *env != '\0' ? env : "localhost:50051";
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -264,7 +274,7 @@ int Run() {
     }
   }
   AckLog acked(acked_file);
-  auto client = client::Client::Connect(absl::GetFlag(FLAGS_server), options);
+  auto client = client::Client::Connect(ServerAddress(), options);
   const std::string name = client::GridName(absl::GetFlag(FLAGS_name));
 
   // Setup: import (2D view of the two-plane file) and fit to the tolerances by kind.
@@ -398,6 +408,13 @@ int Run() {
 }  // namespace splinegrid
 
 int main(int argc, char** argv) {
+  // --help lists this file's flags (absl matches the program's name by default, which this
+  // file's does not).
+  absl::FlagsUsageConfig usage;
+  usage.contains_help_flags = [](absl::string_view file) {
+    return absl::EndsWith(file, "examples/pitching.cc");
+  };
+  absl::SetFlagsUsageConfig(usage);
   absl::SetProgramUsageMessage(
       "splinegrid_pitching --server host:port --steps N [--amplitude DEG]: a pitching NACA 0012 "
       "coupling loop (deform, evaluate, fold check) with latency percentiles");

@@ -20,7 +20,7 @@ port_users() {
   for pid in $pids; do
     ppid=$(sed -n 's/^PPid:[[:space:]]*//p' "/proc/$pid/status" 2>/dev/null)
     grep -qx -- "$ppid" <<<"$pids" && continue
-    out+=("pid $pid ($(tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null | cut -c1-200 | sed 's/ *$//'))")
+    out+=("pid $pid ($(tr '\0' ' ' 2>/dev/null <"/proc/$pid/cmdline" | cut -c1-200 | sed 's/ *$//'))")
   done
   if ((${#out[@]} == 0)); then
     echo "a process ss -ltnp does not name (another user's? run as root to see it)"

@@ -170,7 +170,7 @@ start_process() {
         "$RUN_DIR/logs/$name.log" "$(basename "$1")"
     cat <<'EOS'
 pid=$(cat "$pidfile" 2>/dev/null || true)
-if [[ $pid =~ ^[0-9]+$ ]] && tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null | grep -q -- "$program"; then
+if [[ $pid =~ ^[0-9]+$ ]] && tr '\0' ' ' 2>/dev/null <"/proc/$pid/cmdline" | grep -q -- "$program"; then
   echo "$0: $program is running already (pid $pid in $pidfile); not started" >&2
   exit 1
 fi

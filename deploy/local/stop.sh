@@ -29,7 +29,7 @@ live_pid() {
   [[ -s $pidfile ]] || return 0
   pid=$(<"$pidfile")
   if [[ $pid =~ ^[0-9]+$ ]] && kill -0 "$pid" 2>/dev/null &&
-     tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null | grep -q -- "$expect"; then
+     tr '\0' ' ' 2>/dev/null <"/proc/$pid/cmdline" | grep -q -- "$expect"; then
     echo "$pid"
   else
     rm -f "$pidfile"
