@@ -7,6 +7,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/io/file_util.h"
 #include "core/util/status_macros.h"
 #include "third_party/grpc_health/health.grpc.pb.h"
@@ -21,12 +22,15 @@ Extents ExtentsOf(const v1::Extents& e) { return {e.i(), e.j(), e.k()}; }
 // Reassembles an EvaluateGrid stream (a header, then chunks of every announced block's fields).
 class EvaluationAssembler {
  public:
-  explicit EvaluationAssembler(const ProgressFn& progress) : progress_(progress) {}
+  EvaluationAssembler(const ProgressFn& progress, int64_t max_bytes)
+      : progress_(progress), max_bytes_(max_bytes) {}
 
-  // Takes the next message; DATA_LOSS when it does not fit what the header announced.
+  // Takes the next message; DATA_LOSS when it does not fit what the header announced,
+  // RESOURCE_EXHAUSTED for a header announcing more than max_bytes (nothing allocated).
   absl::Status Add(const v1::EvaluateGridResponse& message) {
     if (message.has_header()) {
       const v1::EvaluationHeader& h = message.header();
+      SG_RETURN_IF_ERROR(CheckSize(h));
       result_.revision = h.revision();
       const int s = h.spatial_dim();
       for (const v1::EvaluatedBlock& eb : h.blocks()) {
@@ -84,6 +88,26 @@ class EvaluationAssembler {
     return absl::OkStatus();
   }
 
+  // RESOURCE_EXHAUSTED when the announced blocks would take more than max_bytes_ here.
+  absl::Status CheckSize(const v1::EvaluationHeader& h) const {
+    if (max_bytes_ <= 0) return absl::OkStatus();
+    double values = 0;  // in double: hostile extents must not overflow the sum
+    for (const v1::EvaluatedBlock& eb : h.blocks()) {
+      values += std::max<double>(eb.extents().i(), 1) * std::max<double>(eb.extents().j(), 1) *
+                std::max<double>(eb.extents().k(), 1) * std::max(h.spatial_dim(), 1) *
+                (h.derivatives() ? 4 : 1);
+    }
+    const double bytes = values * sizeof(double);
+    if (bytes <= static_cast<double>(max_bytes_)) return absl::OkStatus();
+    constexpr double kGiB = double(int64_t{1} << 30);
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "the evaluation holds %.0f points (%.2f GiB of values) but this client may hold %.2f GiB "
+        "(ClientOptions::max_evaluation_bytes; the CLI: three quarters of the memory this "
+        "machine has available): ask for fewer points (--res, --box, a lower --level, or "
+        "--block)",
+        h.total_points(), bytes / kGiB, max_bytes_ / kGiB));
+  }
+
   // The evaluation once the stream has ended OK; DATA_LOSS when values are missing.
   absl::StatusOr<EvaluatedGrid> Finish() && {
     if (received_ != total_values_) {
@@ -95,6 +119,7 @@ class EvaluationAssembler {
 
  private:
   const ProgressFn& progress_;
+  const int64_t max_bytes_;
   EvaluatedGrid result_;
   std::vector<int> slot_;  // block index -> position in result_.blocks
   int64_t total_values_ = 0, received_ = 0;
@@ -540,7 +565,7 @@ absl::StatusOr<EvaluatedGrid> Client::Evaluate(v1::EvaluateGridRequest request,
   std::optional<EvaluationAssembler> assembler;
   absl::Status malformed;  // the stream did not fit together (the call was cancelled)
   const absl::Status status = Call(GridId(request.name()), [&](grpc::ClientContext* context) {
-    assembler.emplace(progress);
+    assembler.emplace(progress, options_.max_evaluation_bytes);
     malformed = absl::OkStatus();
     auto reader = stub_->EvaluateGrid(context, request);
     v1::EvaluateGridResponse message;

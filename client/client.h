@@ -46,6 +46,11 @@ struct ClientOptions {
   // ALREADY_EXISTS, DeleteGrid NOT_FOUND. Set retry.max_attempts = 1 to see every UNAVAILABLE.
   RetryPolicy retry;
 
+  // The most bytes of values an Evaluate may assemble in this process (0: no limit). A larger
+  // evaluation is refused with RESOURCE_EXHAUSTED as soon as its header arrives, before
+  // anything is allocated, instead of growing the process until the machine runs out of memory.
+  int64_t max_evaluation_bytes = 0;
+
   // ---- Security (serve --tokens, --tls_cert) ----
   // Sent with every call as `authorization: Bearer TOKEN` (empty: none). Printable ASCII
   // without blanks; anything else is not sent (the server then answers UNAUTHENTICATED).

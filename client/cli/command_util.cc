@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <utility>
 #include <vector>
@@ -150,8 +151,22 @@ std::string IdFromPath(const std::string& path) {
   return id.substr(0, 63);
 }
 
+// Three quarters of MemAvailable (/proc/meminfo): what an evaluation may assemble in the CLI
+// (0, no limit, when it cannot be read).
+int64_t EvaluationMemoryLimit() {
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string line; std::getline(meminfo, line);) {
+    long long kib = 0;  // "MemAvailable:   12345678 kB"
+    if (std::sscanf(line.c_str(), "MemAvailable: %lld kB", &kib) == 1 && kib > 0) {
+      return static_cast<int64_t>(kib) / 4 * 3 * 1024;
+    }
+  }
+  return 0;
+}
+
 absl::Status PrepareConnection() {
   client::ClientOptions options;
+  options.max_evaluation_bytes = EvaluationMemoryLimit();
   std::string token = absl::GetFlag(FLAGS_token);
   if (token.empty()) {
     if (const char* env = std::getenv("SPLINEGRID_TOKEN")) token = env;

@@ -93,10 +93,14 @@ class FakeSplineGrid final : public v1::SplineGrid::Service {
     header->set_revision(2);
     header->set_spatial_dim(2);
     v1::EvaluatedBlock* block = header->add_blocks();
-    block->mutable_extents()->set_i(2);
-    block->mutable_extents()->set_j(1);
+    // grids/huge: a header announcing 10^12 points (16 TB of values), then nothing.
+    const bool huge = request->name() == "grids/huge";
+    block->mutable_extents()->set_i(huge ? 1000000 : 2);
+    block->mutable_extents()->set_j(huge ? 1000000 : 1);
     block->mutable_extents()->set_k(1);
+    header->set_total_points(huge ? 1e12 : 2);
     writer->Write(message);
+    if (huge) return grpc::Status::OK;
     if (request->name() == "grids/broken") {
       return grpc::Status(grpc::StatusCode::UNAVAILABLE, "broken off");
     }
@@ -314,6 +318,26 @@ TEST_F(ClientCallsTest, ABrokenStreamIsAskedForAgainFromItsStart) {
   EXPECT_TRUE(absl::IsInternal(bug)) << bug;
   EXPECT_EQ(bug.message(), "a server bug");
   EXPECT_EQ(fake_.calls("EvaluateGrid"), 11);
+}
+
+// An evaluation larger than the client may hold is refused at its header, before anything is
+// allocated (16 TB here); one within the limit is assembled.
+TEST_F(ClientCallsTest, AnEvaluationLargerThanTheClientMayHoldIsRefusedAtItsHeader) {
+  client::ClientOptions options;
+  options.retry = Fast();
+  options.max_evaluation_bytes = int64_t{1} << 30;
+  auto client = client::Client::Connect(absl::StrCat("127.0.0.1:", port_), options);
+  v1::EvaluateGridRequest request;
+  request.set_name("huge");
+  const absl::Status huge = client->Evaluate(request).status();
+  EXPECT_EQ(huge.code(), absl::StatusCode::kResourceExhausted) << huge;
+  EXPECT_THAT(huge.message(), HasSubstr("the evaluation holds 1000000000000 points (14901.16 GiB "
+                                        "of values) but this client may hold 1.00 GiB"));
+  EXPECT_EQ(fake_.calls("EvaluateGrid"), 1);  // not retried
+  request.set_name("naca");
+  const absl::StatusOr<client::EvaluatedGrid> small = client->Evaluate(request);
+  ASSERT_TRUE(small.ok()) << small.status();
+  EXPECT_EQ(small->blocks.at(0).points.num_points(), 2);
 }
 
 // The retry is not a resumption: no call ever found the grid, so NOT_FOUND is no deletion.
