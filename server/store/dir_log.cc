@@ -9,7 +9,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <string>
 #include <system_error>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -26,6 +29,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kGridFile[] = "grid.records";
+// Markers of grids set aside as damaged at a start: damaged/{id}, a record file holding why.
+constexpr char kDamagedDir[] = "damaged";
 
 absl::Status ErrnoStatus(const std::string& what) { return ErrnoToStatusWithMessage(errno, what); }
 
@@ -133,6 +138,14 @@ class DirLog final : public DurableLog {
     std::error_code error;
     fs::remove_all(trash, error);  // a start empties the trash if this did not finish
     return absl::OkStatus();
+  }
+
+  absl::Status ForgetDamagedGrid(const std::string& id) override {
+    const fs::path marker = root_ / kDamagedDir / id;
+    if (std::remove(marker.c_str()) != 0 && errno != ENOENT) {
+      return ErrnoStatus(absl::StrCat("cannot remove ", kDamagedDir, "/", id));
+    }
+    return SyncDirectory(root_ / kDamagedDir);
   }
 
  private:
@@ -285,6 +298,37 @@ absl::StatusOr<std::shared_ptr<StoredGrid>> LoadGrid(const fs::path& root, const
   return grid;
 }
 
+// The grids damaged at this start or an earlier one (id -> why), from the markers in damaged/;
+// a marker of an id that was loaded (a stale one) is removed.
+std::map<std::string, std::string> DamagedGrids(
+    const fs::path& root, const std::vector<std::shared_ptr<const StoredGrid>>& loaded) {
+  std::map<std::string, std::string> damaged;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(root / kDamagedDir, error)) {
+    const std::string id = entry.path().filename().string();
+    if (id.ends_with(".tmp")) {
+      fs::remove(entry.path(), error);  // a marker whose write did not finish
+      continue;
+    }
+    const bool is_loaded =
+        std::any_of(loaded.begin(), loaded.end(), [&](const auto& grid) { return grid->id == id; });
+    if (is_loaded) {
+      fs::remove(entry.path(), error);
+      continue;
+    }
+    std::string why = "the reason was not readable";
+    if (absl::StatusOr<RecordReader> reader = RecordReader::Open(entry.path().string());
+        reader.ok()) {
+      std::string payload;
+      if (absl::StatusOr<bool> read = reader->Next(&payload); read.ok() && *read) {
+        why = payload.substr(0, 1000);
+      }
+    }
+    damaged.emplace(id, std::move(why));
+  }
+  return damaged;
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<MemoryStore>> OpenDirStore(const std::string& path,
@@ -292,7 +336,7 @@ absl::StatusOr<std::unique_ptr<MemoryStore>> OpenDirStore(const std::string& pat
                                                           MemoryBudget* budget) {
   const fs::path root(path);
   std::error_code error;
-  for (const char* sub : {"grids", "corrupt", "trash"}) {
+  for (const char* sub : {"grids", "corrupt", "trash", kDamagedDir}) {
     fs::create_directories(root / sub, error);
     if (error) return FsStatus(error, absl::StrCat("--store=dir:", path, ": cannot create ", sub));
   }
@@ -322,15 +366,27 @@ absl::StatusOr<std::unique_ptr<MemoryStore>> OpenDirStore(const std::string& pat
                                                        name, ": ", grid.status().message()));
     } else {
       SetAside(root, entry.path(), grid.status());
+      // A marker in its place, so that asking for the grid says what happened, after later
+      // starts too (until it is deleted).
+      const absl::Status marked =
+          WriteRecordFile(root / kDamagedDir, name, {std::string(grid.status().message())});
+      if (!marked.ok() || !SyncDirectory(root / kDamagedDir).ok()) {
+        std::fprintf(stderr, "splinegrid: store: cannot mark grids/%s as damaged: %s\n",
+                     name.c_str(), std::string(marked.message()).c_str());
+      }
     }
   }
   if (error) {
     close(lock_fd);
     return FsStatus(error, absl::StrCat("--store=dir:", path, ": cannot list grids/"));
   }
-  std::fprintf(stderr, "splinegrid: store dir:%s: %zu grids loaded\n", path.c_str(), loaded.size());
+  std::map<std::string, std::string> damaged = DamagedGrids(root, loaded);
+  std::fprintf(
+      stderr, "splinegrid: store dir:%s: %zu grids loaded%s\n", path.c_str(), loaded.size(),
+      damaged.empty() ? "" : absl::StrCat(", ", damaged.size(), " reported damaged").c_str());
   return std::make_unique<MemoryStore>(max_deform_revisions,
-                                       std::make_unique<DirLog>(root, lock_fd), std::move(loaded));
+                                       std::make_unique<DirLog>(root, lock_fd), std::move(loaded),
+                                       std::move(damaged));
 }
 
 }  // namespace splinegrid::server

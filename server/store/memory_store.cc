@@ -9,13 +9,27 @@
 
 namespace splinegrid::server {
 MemoryStore::MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log,
-                         std::vector<std::shared_ptr<const StoredGrid>> loaded)
-    : max_deform_revisions_(max_deform_revisions), log_(std::move(log)) {
+                         std::vector<std::shared_ptr<const StoredGrid>> loaded,
+                         std::map<std::string, std::string> damaged_grids)
+    : max_deform_revisions_(max_deform_revisions),
+      log_(std::move(log)),
+      damaged_grids_(std::move(damaged_grids)) {
   // A loaded grid keeps its creation's incarnation (older store files have none).
   for (auto& grid : loaded) {
     if (grid->incarnation.empty()) grid = WithIncarnation(*grid, NewIncarnation());
     grids_.emplace(grid->id, std::move(grid));
   }
+}
+
+absl::Status MemoryStore::Missing(const std::string& id) const {
+  if (const auto it = damaged_grids_.find(id); it != damaged_grids_.end()) {
+    return absl::DataLossError(absl::StrCat(
+        "grids/", id, " was damaged on disk (", it->second,
+        "): the server set it aside at a start (its log names the directory in the store's "
+        "corrupt/); delete grids/",
+        id, " to use the id again, or import it from an export"));
+  }
+  return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
 }
 
 std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
@@ -30,6 +44,10 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
     std::lock_guard<std::mutex> lock(mu_);
     if (grids_.contains(grid->id) || creating_.contains(grid->id)) {
       return absl::AlreadyExistsError(absl::StrCat("grids/", grid->id, " already exists"));
+    }
+    if (damaged_grids_.contains(grid->id)) {
+      return absl::AlreadyExistsError(absl::StrCat(
+          "grids/", grid->id, " already exists, damaged on disk: ", Missing(grid->id).message()));
     }
     if (!log_) {
       grids_.emplace(grid->id, WithIncarnation(*grid, NewIncarnation()));
@@ -56,7 +74,7 @@ absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
 absl::StatusOr<std::shared_ptr<const StoredGrid>> MemoryStore::Get(const std::string& id) {
   std::lock_guard<std::mutex> lock(mu_);
   const auto it = grids_.find(id);
-  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+  if (it == grids_.end()) return Missing(id);
   return it->second;
 }
 
@@ -120,17 +138,29 @@ absl::Status MemoryStore::Delete(const std::string& id, const DeleteCheck& check
   const std::shared_ptr<std::mutex> writer = WriterOf(id);
   std::lock_guard<std::mutex> write(*writer);
   std::string owner;
+  bool damaged = false;
   {
     std::lock_guard<std::mutex> lock(mu_);
     const auto it = grids_.find(id);
-    if (it == grids_.end()) {
+    if (it == grids_.end() && !damaged_grids_.contains(id)) {
       writers_.erase(id);
-      return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+      return Missing(id);
     }
-    owner = it->second->owner;
+    damaged = it == grids_.end();
+    if (!damaged) owner = it->second->owner;  // a damaged grid's owner is unknown: admins only
   }
   // Under the grid's writer lock: no one deletes or creates it meanwhile.
   if (check) SG_RETURN_IF_ERROR(check(owner));
+  if (damaged) {
+    if (absl::Status forgotten = log_->ForgetDamagedGrid(id); !forgotten.ok()) {
+      return LogWriteFailed(forgotten, absl::StrCat("grids/", id),
+                            "it was not deleted and is still reported damaged");
+    }
+    std::lock_guard<std::mutex> lock(mu_);
+    damaged_grids_.erase(id);
+    writers_.erase(id);
+    return absl::OkStatus();
+  }
   if (log_) {
     if (absl::Status deleted = log_->DeleteGrid(id); !deleted.ok()) {
       return LogWriteFailed(deleted, absl::StrCat("grids/", id),
@@ -156,7 +186,7 @@ absl::StatusOr<GridStore::Watch> MemoryStore::Subscribe(const std::string& id,
                                                         size_t max_queued) {
   std::lock_guard<std::mutex> lock(mu_);
   const auto it = grids_.find(id);
-  if (it == grids_.end()) return absl::NotFoundError(absl::StrCat("grids/", id, " not found"));
+  if (it == grids_.end()) return Missing(id);
   const auto& revisions = it->second->revisions;
   auto subscription = std::make_shared<GridSubscription>(
       std::move(watcher), max_queued, revisions.empty() ? 0 : revisions.back()->number);

@@ -32,6 +32,8 @@ class DurableLog {
   // when the log is loaded.
   virtual void DropRevisions(const std::string& id, const std::vector<int64_t>& numbers) = 0;
   virtual absl::Status DeleteGrid(const std::string& id) = 0;
+  // Forgets that grid `id` was found damaged at a start (MemoryStore's `damaged_grids`).
+  virtual absl::Status ForgetDamagedGrid(const std::string& id) = 0;
   // Writes, syncs and removes a small file where grids are written: whether writes get
   // through now (after one failed).
   virtual absl::Status Probe() = 0;
@@ -40,9 +42,12 @@ class DurableLog {
 class MemoryStore final : public GridStore {
  public:
   // Keeps the newest `max_deform_revisions` (>= 1) deformed revisions of each grid; starts with
-  // `loaded` grids (what `log` held).
+  // `loaded` grids (what `log` held). `damaged_grids` (id -> why): grids the log found damaged
+  // and set aside; asking for one is DATA_LOSS saying so (not "not found") until it is deleted,
+  // which frees the id.
   explicit MemoryStore(int max_deform_revisions, std::unique_ptr<DurableLog> log = nullptr,
-                       std::vector<std::shared_ptr<const StoredGrid>> loaded = {});
+                       std::vector<std::shared_ptr<const StoredGrid>> loaded = {},
+                       std::map<std::string, std::string> damaged_grids = {});
 
   absl::Status Create(std::shared_ptr<const StoredGrid> grid) override;
   absl::StatusOr<std::shared_ptr<const StoredGrid>> Get(const std::string& id) override;
@@ -71,6 +76,9 @@ class MemoryStore final : public GridStore {
   // other fault of the store (a read-only or failing disk, lost permissions), never an error
   // that would be about the caller's request (PERMISSION_DENIED, NOT_FOUND, ...).
   // `what` failed; `outcome` says what that left ("nothing was stored").
+  // Under mu_: why grid `id` is not here: DATA_LOSS for a grid found damaged at a start,
+  // else NOT_FOUND.
+  absl::Status Missing(const std::string& id) const;
   absl::Status LogWriteFailed(const absl::Status& error, const std::string& what,
                               const char* outcome = "nothing was stored") const;
 
@@ -78,7 +86,8 @@ class MemoryStore final : public GridStore {
   const std::unique_ptr<DurableLog> log_;
   mutable std::mutex mu_;  // before the hub's
   std::map<std::string, std::shared_ptr<const StoredGrid>> grids_;
-  std::set<std::string> creating_;  // ids whose Create is writing to the log
+  std::map<std::string, std::string> damaged_grids_;  // id -> why (the constructor's)
+  std::set<std::string> creating_;                    // ids whose Create is writing to the log
   std::map<std::string, std::shared_ptr<std::mutex>> writers_;
   SubscriptionHub hub_;
   // The log's health: OK, or why its last write (or probe) failed.

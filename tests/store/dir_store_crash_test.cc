@@ -200,7 +200,16 @@ TEST_F(DirStoreCrashTest, DamagedFilesAreSkippedWithAMessage) {
   ASSERT_TRUE(grid.ok()) << grid.status();
   ASSERT_EQ(grid->revisions_size(), 1);
   EXPECT_EQ(grid->revisions(0).revision(), 1);
-  EXPECT_EQ(client->Get("other").status().code(), absl::StatusCode::kNotFound);
+  // A grid whose points file is damaged says so (not "not found"), and keeps its id taken.
+  const auto damaged_grid = [&] {
+    const absl::Status status = client->Get("other").status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kDataLoss) << status;
+    EXPECT_THAT(status.message(), ::testing::HasSubstr("grids/other was damaged on disk ("));
+    EXPECT_THAT(status.message(), ::testing::HasSubstr("delete grids/other to use the id again"));
+  };
+  damaged_grid();
+  EXPECT_EQ(client->ImportPlot3d(bytes, "other", "", false).status().code(),
+            absl::StatusCode::kAlreadyExists);
   const std::string log = server_->ReadLog();
   EXPECT_THAT(log, ::testing::HasSubstr("r000000000002.records is damaged"));
   EXPECT_THAT(log, ::testing::HasSubstr("other is damaged"));
@@ -219,10 +228,18 @@ TEST_F(DirStoreCrashTest, DamagedFilesAreSkippedWithAMessage) {
   EXPECT_EQ(server_->Stop(SIGTERM), 0);
   client = Start();
   damaged();
+  damaged_grid();
   const absl::StatusOr<v1::Grid> again = client->Get("pitch");
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_EQ(again->latest_revision(), 3);
   EXPECT_EQ(again->revisions_size(), 2);
+  // Deleting the damaged grid frees its id, also across a restart.
+  EXPECT_TRUE(client->Delete("other").ok());
+  EXPECT_EQ(client->Get("other").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_EQ(server_->Stop(SIGTERM), 0);
+  client = Start();
+  EXPECT_EQ(client->Get("other").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_TRUE(client->ImportPlot3d(bytes, "other", "", false).ok());
   EXPECT_EQ(server_->Stop(SIGTERM), 0);
 }
 
