@@ -1,5 +1,12 @@
 #include "server/listen_address.h"
 
+#include <netdb.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -49,6 +56,45 @@ absl::StatusOr<int> ParseListenPort(absl::string_view address, int min_port) {
                                                    "-65535"));
   }
   return value;
+}
+
+absl::Status CheckCanListen(const std::string& address) {
+  const absl::StatusOr<int> port = ParseListenPort(address, /*min_port=*/0);
+  if (!port.ok() || *port <= 0) return absl::OkStatus();
+  // The host as gRPC resolves it: brackets off an IPv6 literal; "[::]" and "0.0.0.0" are the
+  // wildcard addresses, bound as such.
+  std::string host = address.substr(0, address.rfind(':'));
+  if (absl::StartsWith(host, "[")) host = host.substr(1, host.size() - 2);
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE;
+  addrinfo* resolved = nullptr;
+  if (getaddrinfo(host.c_str(), std::to_string(*port).c_str(), &hints, &resolved) != 0) {
+    return absl::OkStatus();
+  }
+  int first_error = 0;
+  bool bound = false;
+  for (const addrinfo* a = resolved; a != nullptr && !bound; a = a->ai_next) {
+    const int fd = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;  // e.g. no IPv6 on this machine: gRPC skips it too
+    const int on = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof(on));
+    if (bind(fd, a->ai_addr, a->ai_addrlen) == 0) {
+      bound = true;
+    } else if (first_error == 0) {
+      first_error = errno;
+    }
+    close(fd);
+  }
+  freeaddrinfo(resolved);
+  if (bound || first_error == 0) return absl::OkStatus();
+  const std::string reason = first_error == EADDRINUSE
+                                 ? "the port is in use (is another server listening there?)"
+                             : first_error == EADDRNOTAVAIL ? "it is not an address of this machine"
+                                                            : std::strerror(first_error);
+  return absl::UnavailableError(absl::StrCat("cannot listen on ", QuoteClientString(address),
+                                             ": ", reason));
 }
 
 }  // namespace splinegrid::server

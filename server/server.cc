@@ -42,6 +42,9 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
     if (!port.ok()) {
       return absl::InvalidArgumentError(absl::StrCat("address: ", port.status().message()));
     }
+    // A busy port is refused here, in one line and before the store is opened; gRPC's own
+    // refusal below (a race lost after this check) comes after a page of its log.
+    if (absl::Status free = CheckCanListen(options.address); !free.ok()) return free;
   }
   if (options.drain_notice < absl::ZeroDuration() ||
       options.shutdown_grace < absl::ZeroDuration()) {
