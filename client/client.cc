@@ -240,8 +240,10 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
     if (!wait) {
       absl::Status result = FromGrpc(status);
       if (!result.ok() && attempts > 1) {
-        result = absl::Status(result.code(), absl::StrCat(result.message(), " [attempt ", attempts,
-                                                          "; the earlier ones broke off]"));
+        result = absl::Status(
+            result.code(),
+            absl::StrCat(result.message(), " [attempt ", attempts,
+                         "; each earlier one ended UNAVAILABLE or was reset, and was made again]"));
       }
       // A TLS server closes a plaintext connection at once; say what that usually means.
       if (absl::IsUnavailable(result) && !options_.use_tls &&

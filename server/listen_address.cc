@@ -93,8 +93,8 @@ absl::Status CheckCanListen(const std::string& address) {
                                  ? "the port is in use (is another server listening there?)"
                              : first_error == EADDRNOTAVAIL ? "it is not an address of this machine"
                                                             : std::strerror(first_error);
-  return absl::UnavailableError(absl::StrCat("cannot listen on ", QuoteClientString(address),
-                                             ": ", reason));
+  return absl::UnavailableError(
+      absl::StrCat("cannot listen on ", QuoteClientString(address), ": ", reason));
 }
 
 }  // namespace splinegrid::server

@@ -225,8 +225,8 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                     translated = SplinegridError.from_rpc_error(error)
                     if attempts > 1:
                         translated = SplinegridError(
-                            translated.code, f"{translated.message} [attempt {attempts}; the "
-                            "earlier ones broke off]")
+                            translated.code, f"{translated.message} [attempt {attempts}; each "
+                            "earlier one ended UNAVAILABLE or was reset, and was made again]")
                     if (translated.code == "UNAVAILABLE" and not self._tls
                             and "Socket closed" in translated.message):
                         # A TLS server closes a plaintext connection at once.

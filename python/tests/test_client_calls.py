@@ -146,7 +146,8 @@ def test_retries_stop_after_max_attempts_with_the_last_error(fake):
         with pytest.raises(SplinegridError) as error:
             client.deform("naca", rotate_degrees=1.0)
     assert error.value.code == "UNAVAILABLE"
-    assert "no upstream [attempt 4; the earlier ones broke off]" in str(error.value)
+    assert ("no upstream [attempt 4; each earlier one ended UNAVAILABLE or was reset, and was "
+            "made again]") in str(error.value)
     assert fake.calls["DeformGrid"] == 4
 
 
@@ -194,8 +195,8 @@ def test_a_broken_stream_is_asked_for_again_from_its_start(fake):
         assert grid[0].points.shape == (1, 1, 2, 2)
         assert fake.calls["EvaluateGrid"] == 6
         # Broken off after the first message every time: the retries give up.
-        with pytest.raises(SplinegridError, match=r"UNAVAILABLE: broken off \[attempt 4; the "
-                           r"earlier ones broke off\]$"):
+        with pytest.raises(SplinegridError, match=r"UNAVAILABLE: broken off \[attempt 4; each "
+                           r"earlier one ended UNAVAILABLE or was reset, and was made again\]$"):
             client.evaluate("broken")
         assert fake.calls["EvaluateGrid"] == 10
         # Any other INTERNAL is an answer, not a break.

@@ -255,7 +255,8 @@ TEST_F(ClientCallsTest, RetriesStopAfterMaxAttemptsWithTheLastError) {
   const absl::StatusOr<v1::Grid> grid = Connect()->Get("naca");
   EXPECT_TRUE(absl::IsUnavailable(grid.status())) << grid.status();
   EXPECT_THAT(grid.status().message(),
-              HasSubstr("no upstream [attempt 4; the earlier ones broke off]"));
+              HasSubstr("no upstream [attempt 4; each earlier one ended UNAVAILABLE or was "
+                        "reset, and was made again]"));
   EXPECT_EQ(fake_.calls("GetGrid"), 4);
 }
 
@@ -311,7 +312,9 @@ TEST_F(ClientCallsTest, ABrokenStreamIsAskedForAgainFromItsStart) {
   request.set_name("broken");
   const absl::Status broken = client->Evaluate(request).status();
   EXPECT_TRUE(absl::IsUnavailable(broken)) << broken;
-  EXPECT_EQ(broken.message(), "broken off [attempt 4; the earlier ones broke off]");
+  EXPECT_EQ(broken.message(),
+            "broken off [attempt 4; each earlier one ended UNAVAILABLE or was reset, and was made "
+            "again]");
   // Any other INTERNAL is an answer, not a break.
   request.set_name("bug");
   const absl::Status bug = client->Evaluate(request).status();
