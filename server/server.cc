@@ -204,13 +204,15 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
   }
   std::fprintf(stderr,
                "splinegrid serving on port %d (%s), store %s, %d workers, memory budget %s, "
-               "import idle timeout %s\n",
+               "import idle timeout %s, keeps the newest %d deformed revisions of a grid "
+               "(--keep_revisions)\n",
                (*server)->port(), options.address.c_str(), options.store.c_str(),
                (*server)->state().pool.num_threads(),
                ResolveMemoryBudget(options.memory_budget_bytes).description.c_str(),
                options.import_idle_timeout > absl::ZeroDuration()
                    ? absl::FormatDuration(options.import_idle_timeout).c_str()
-                   : "none");
+                   : "none",
+               options.max_deform_revisions);
   const int num_tokens = (*server)->state().authenticator.num_tokens();
   std::fprintf(stderr, "splinegrid: %s, %s\n", TransportName(options).c_str(),
                num_tokens == 0 ? "no tokens (every caller is an admin)"

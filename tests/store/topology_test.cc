@@ -618,6 +618,11 @@ TEST_F(TopologyTest, SecondServerOnTheSamePortExitsNonZero) {
   std::string out;
   EXPECT_EQ(HealthCli(port, &out), 0) << out;
   EXPECT_TRUE(first->running());
+  // The banner says how many deformed revisions a grid keeps (Serve gives 1000): a coupling run
+  // that reads old steps needs to know.
+  EXPECT_THAT(first->ReadLog(),
+              ::testing::HasSubstr(
+                  "keeps the newest 1000 deformed revisions of a grid (--keep_revisions)"));
   EXPECT_EQ(first->Stop(SIGTERM), 0) << first->ReadLog();
 }
 
