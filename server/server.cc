@@ -14,6 +14,7 @@
 #include "server/metrics_endpoint.h"
 #include "server/metrics_text.h"
 #include "server/store/open_store.h"
+#include "server/store/redis_connection.h"
 
 namespace splinegrid::server {
 
@@ -206,7 +207,7 @@ absl::Status RunServerUntilSignal(const ServerOptions& options) {
                "splinegrid serving on port %d (%s), store %s, %d workers, memory budget %s, "
                "import idle timeout %s, keeps the newest %d deformed revisions of a grid "
                "(--keep_revisions)\n",
-               (*server)->port(), options.address.c_str(), options.store.c_str(),
+               (*server)->port(), options.address.c_str(), RedactRedisSpec(options.store).c_str(),
                (*server)->state().pool.num_threads(),
                ResolveMemoryBudget(options.memory_budget_bytes).description.c_str(),
                options.import_idle_timeout > absl::ZeroDuration()

@@ -18,8 +18,12 @@ struct ServerOptions {
   // host:port to listen on; port 0 picks a free port (see Server::port()); empty: no network
   // port, only Server::InProcessChannel (tests).
   std::string address = "localhost:50051";
-  // Where grids live (store/open_store.h): "memory", "dir:PATH" or "redis://HOST:PORT[/DB]".
+  // Where grids live (store/open_store.h): "memory", "dir:PATH" or
+  // "redis://[USER[:PASSWORD]@]HOST:PORT[/DB]".
   std::string store = "memory";
+  // A redis:// store's password: a file whose first line it is, read at every new connection
+  // (a rotated secret needs no restart); empty: the one in the URL, if any.
+  std::string redis_password_file;
   // Threads of the worker pool that runs fits and evaluations; 0: one per core.
   int worker_threads = 0;
   // Tasks that may wait for a worker before calls are refused with RESOURCE_EXHAUSTED.

@@ -14,11 +14,13 @@ namespace {
 std::vector<CommandSpec> MakeCommands() {
   return {
       {"serve",
-       "serve [--address localhost:50051] [--store memory|dir:PATH|redis://H:P[/DB]] [flags]",
+       "serve [--address localhost:50051] [--store memory|dir:PATH|redis://[U@]H:P[/DB]] "
+       "[flags]",
        "run the gRPC server (in the foreground; SIGTERM drains and stops it)",
        /*client=*/false,
        {"address",
         "store",
+        "redis_password_file",
         "threads",
         "memory_budget_mb",
         "keep_revisions",

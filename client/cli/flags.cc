@@ -158,7 +158,11 @@ ABSL_FLAG(std::string, service, "splinegrid.v1.SplineGrid",
 ABSL_FLAG(std::string, address, "localhost:50051", "serve: address to listen on");
 ABSL_FLAG(std::string, store, "memory",
           "serve: where grids live: memory (default), dir:PATH (durable) or "
-          "redis://HOST:PORT[/DB] (shared by replicas)");
+          "redis://[USER[:PASSWORD]@]HOST:PORT[/DB] (shared by replicas)");
+ABSL_FLAG(std::string, redis_password_file, "",
+          "serve: a file whose first line is the Redis password (of the default user, or of "
+          "USER in redis://USER@HOST:PORT), read at every new connection, so a rotated secret "
+          "needs no restart; keeps the password out of process listings");
 ABSL_FLAG(int, threads, 0, "serve: worker threads (0: one per core)");
 ABSL_FLAG(int64_t, memory_budget_mb, 0,
           "serve: memory budget for grids and work, MiB (0: half of the cgroup memory limit, or "

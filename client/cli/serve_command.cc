@@ -16,6 +16,7 @@ absl::Status Serve(const Args& args) {
   options.drain_notice = absl::GetFlag(FLAGS_drain_notice);
   options.address = absl::GetFlag(FLAGS_address);
   options.store = absl::GetFlag(FLAGS_store);
+  options.redis_password_file = absl::GetFlag(FLAGS_redis_password_file);
   options.worker_threads = absl::GetFlag(FLAGS_threads);
   options.memory_budget_bytes = absl::GetFlag(FLAGS_memory_budget_mb) << 20;
   options.import_idle_timeout = absl::GetFlag(FLAGS_import_idle_timeout);

@@ -1,7 +1,8 @@
 // `serve --store`: which GridStore backend holds the grids.
 //   memory                  in this process (the default; nothing to install, lost on exit)
 //   dir:PATH                in this process and in PATH, durable (dir_log.h)
-//   redis://HOST:PORT[/DB]  in Redis, shared by any number of replicas (redis_store.h)
+//   redis://[USER[:PASSWORD]@]HOST:PORT[/DB]  in Redis, shared by any number of replicas
+//                           (redis_store.h; the password also from --redis_password_file)
 #ifndef SPLINEGRID_SERVER_STORE_OPEN_STORE_H_
 #define SPLINEGRID_SERVER_STORE_OPEN_STORE_H_
 

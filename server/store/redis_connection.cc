@@ -5,6 +5,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <optional>
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -16,10 +20,50 @@ namespace {
 
 constexpr std::string_view kScheme = "redis://";
 
+constexpr size_t kMaxPasswordFileBytes = 4096;
+
 absl::Status BadSpec(std::string_view spec, std::string_view why) {
-  return absl::InvalidArgumentError(absl::StrCat("--store = '", Absl(spec.substr(0, 200)),
-                                                 "': ", Absl(why),
-                                                 "; a Redis store is redis://HOST:PORT[/DB]"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("--store = '", RedactRedisSpec(spec.substr(0, 200)), "': ", Absl(why),
+                   "; a Redis store is redis://[USER[:PASSWORD]@]HOST:PORT[/DB]"));
+}
+
+int HexDigit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// `text` with its %XX escapes decoded; nullopt for a '%' not followed by two hex digits.
+std::optional<std::string> PercentDecode(std::string_view text) {
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '%') {
+      out.push_back(text[i]);
+      continue;
+    }
+    const int high = i + 2 < text.size() ? HexDigit(text[i + 1]) : -1;
+    const int low = i + 2 < text.size() ? HexDigit(text[i + 2]) : -1;
+    if (high < 0 || low < 0) return std::nullopt;
+    out.push_back(static_cast<char>(high * 16 + low));
+    i += 2;
+  }
+  return out;
+}
+
+// The user of `address` for messages: quoted, or "the default user".
+std::string UserName(const RedisAddress& address) {
+  return address.user.empty() ? std::string("the default user")
+                              : absl::StrCat("user '", address.user.substr(0, 64), "'");
+}
+
+// The refusal of an error reply that asks for credentials (NOAUTH) the address does not have.
+absl::Status NeedsCredentials(const std::string& name, std::string_view error) {
+  return absl::UnavailableError(
+      absl::StrCat("Redis at ", name, " requires a password (", Absl(error.substr(0, 200)),
+                   "): give it in a file with --redis_password_file, or in the URL as "
+                   "redis://[USER]:PASSWORD@HOST:PORT (which process listings show)"));
 }
 
 // A decimal number of at most 10 digits (no sign, no spaces), or -1.
@@ -40,16 +84,65 @@ std::string RedisAddress::ToString() const {
                       db != 0 ? absl::StrCat("/", db) : "");
 }
 
+std::string RedactRedisSpec(std::string_view spec) {
+  // Any SCHEME://, so that a mistyped scheme does not show the password either.
+  const size_t scheme = spec.find("://");
+  if (scheme == std::string_view::npos) return std::string(spec);
+  const size_t at = spec.rfind('@');
+  const size_t colon = spec.find(':', scheme + 3);
+  if (at == std::string_view::npos || colon == std::string_view::npos || colon > at) {
+    return std::string(spec);
+  }
+  return absl::StrCat(Absl(spec.substr(0, colon + 1)), "***", Absl(spec.substr(at)));
+}
+
+absl::StatusOr<std::string> RedisPassword(const RedisAddress& address) {
+  if (address.password_file.empty()) return address.password;
+  const std::string file = absl::StrCat("--redis_password_file '", address.password_file, "'");
+  std::FILE* f = std::fopen(address.password_file.c_str(), "rb");
+  if (f == nullptr) {
+    return absl::UnavailableError(absl::StrCat("cannot read ", file, ": ", std::strerror(errno)));
+  }
+  std::string content(kMaxPasswordFileBytes + 1, '\0');
+  content.resize(std::fread(content.data(), 1, content.size(), f));
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) return absl::UnavailableError(absl::StrCat("cannot read ", file));
+  if (content.size() > kMaxPasswordFileBytes) {
+    return absl::UnavailableError(
+        absl::StrCat(file, " is larger than ", kMaxPasswordFileBytes, " bytes: not a password"));
+  }
+  content = content.substr(0, content.find('\n'));  // the first line
+  if (!content.empty() && content.back() == '\r') content.pop_back();
+  if (content.empty()) return absl::UnavailableError(absl::StrCat(file, " holds no password"));
+  return content;
+}
+
 absl::StatusOr<RedisAddress> ParseRedisSpec(std::string_view spec) {
   if (!spec.starts_with(kScheme)) return BadSpec(spec, "it does not start with redis://");
   std::string_view rest = spec.substr(kScheme.size());
-  if (rest.find('@') != std::string_view::npos) {
-    return BadSpec(spec, "credentials (USER:PASSWORD@) are not supported");
+  RedisAddress address;
+  // Credentials: everything before the last '@' (a host, port or database has none).
+  if (const size_t at = rest.rfind('@'); at != std::string_view::npos) {
+    const std::string_view userinfo = rest.substr(0, at);
+    rest.remove_prefix(at + 1);
+    const size_t colon = userinfo.find(':');
+    const std::optional<std::string> user = PercentDecode(userinfo.substr(0, colon));
+    const std::optional<std::string> password =
+        colon == std::string_view::npos ? std::string() : PercentDecode(userinfo.substr(colon + 1));
+    if (!user || !password) {
+      return BadSpec(spec, "a '%' in USER:PASSWORD@ is not followed by two hex digits");
+    }
+    if (colon != std::string_view::npos && password->empty()) {
+      return BadSpec(spec, "the password after USER: is empty");
+    }
+    if (user->empty() && password->empty()) return BadSpec(spec, "the credentials are empty");
+    address.user = *user;
+    address.password = *password;
   }
   if (rest.find_first_of("?#") != std::string_view::npos) {
     return BadSpec(spec, "options (?...) are not supported");
   }
-  RedisAddress address;
   if (rest.starts_with('[')) {  // [IPv6]:PORT
     const size_t close = rest.find(']');
     if (close == std::string_view::npos) return BadSpec(spec, "the IPv6 host has no closing ]");
@@ -122,8 +215,8 @@ absl::Status MapRedisError(std::string_view error, const std::string& address) {
   }
   if (error.starts_with("OOM")) return absl::ResourceExhaustedError(message);
   if (error.starts_with("NOAUTH") || error.starts_with("WRONGPASS")) {
-    return absl::FailedPreconditionError(
-        absl::StrCat(message, " (the store does not support Redis passwords)"));
+    return absl::FailedPreconditionError(absl::StrCat(
+        message, " (give the password with --redis_password_file or in the --store URL)"));
   }
   return absl::InternalError(message);
 }
@@ -147,16 +240,31 @@ absl::StatusOr<std::unique_ptr<RedisConnection>> RedisConnection::Open(
   if (redisSetTimeout(context, absl::ToTimeval(options.command_timeout)) != REDIS_OK) {
     return connection->IoError("setting the timeout");
   }
+  std::string error;
+  if (address.has_credentials()) {
+    SG_ASSIGN_OR_RETURN(const std::string password, RedisPassword(address));
+    std::vector<std::string_view> auth = {"AUTH"};
+    if (!address.user.empty()) auth.push_back(address.user);
+    auth.push_back(password);
+    SG_RETURN_IF_ERROR(connection->Send(auth, &error).status());
+    if (!error.empty()) {
+      return absl::UnavailableError(absl::StrCat("Redis at ", name, " refuses the password of ",
+                                                 UserName(address), ": ",
+                                                 Absl(std::string_view(error).substr(0, 200))));
+    }
+  }
   if (address.db != 0) {
-    std::string error;
     const std::string db = absl::StrCat(address.db);
     SG_RETURN_IF_ERROR(connection->Send({"SELECT", db}, &error).status());
+    if (error.starts_with("NOAUTH")) return NeedsCredentials(name, error);
     if (!error.empty()) {
       return absl::InvalidArgumentError(
           absl::StrCat("Redis at ", name, " refuses database ", address.db, ": ", error));
     }
   }
-  SG_RETURN_IF_ERROR(connection->Command({"PING"}).status());
+  SG_RETURN_IF_ERROR(connection->Send({"PING"}, &error).status());
+  if (error.starts_with("NOAUTH")) return NeedsCredentials(name, error);
+  if (!error.empty()) return MapRedisError(error, name);
   return connection;
 }
 

@@ -1,6 +1,7 @@
-// Talking to one Redis endpoint with hiredis (synchronous API): the `redis://HOST:PORT[/DB]`
-// address, one connection with timeouts, replies, a small pool of connections with reconnect
-// backoff, and Lua scripts run by EVALSHA (EVAL when Redis does not know them yet).
+// Talking to one Redis endpoint with hiredis (synchronous API): the
+// `redis://[USER[:PASSWORD]@]HOST:PORT[/DB]` address, one connection with timeouts and AUTH,
+// replies, a small pool of connections with reconnect backoff, and Lua scripts run by EVALSHA
+// (EVAL when Redis does not know them yet).
 //
 // hiredis contexts are not thread safe: a RedisConnection is used by one thread at a time (the
 // pool hands each out to one caller). A connection whose socket failed or timed out is broken
@@ -8,7 +9,9 @@
 //
 // Errors: a failed or timed-out connection is UNAVAILABLE naming Redis and the address; error
 // replies map by their prefix (MapRedisError): LOADING, READONLY, BUSY, MISCONF, MASTERDOWN are
-// UNAVAILABLE, OOM is RESOURCE_EXHAUSTED, NOAUTH/WRONGPASS FAILED_PRECONDITION, others INTERNAL.
+// UNAVAILABLE, OOM is RESOURCE_EXHAUSTED, NOAUTH/WRONGPASS FAILED_PRECONDITION, others INTERNAL;
+// credentials that Redis refuses when a connection is opened are UNAVAILABLE (the store is
+// unavailable to this process until they are mended: health turns NOT_SERVING).
 #ifndef SPLINEGRID_SERVER_STORE_REDIS_CONNECTION_H_
 #define SPLINEGRID_SERVER_STORE_REDIS_CONNECTION_H_
 
@@ -34,20 +37,39 @@ namespace splinegrid::server {
 // This Abseil has its own string_view (not std's): the bridge for StrCat, SimpleAtoi etc.
 inline absl::string_view Absl(std::string_view s) { return absl::string_view(s.data(), s.size()); }
 
-// Where Redis is: `redis://HOST:PORT[/DB]`.
+// Where Redis is: `redis://[USER[:PASSWORD]@]HOST:PORT[/DB]`, and how to log in.
 struct RedisAddress {
   std::string host;  // a name or an IPv4 address; IPv6 in brackets in the spec
   int port = 0;      // 1..65535
   int db = 0;        // SELECT index (Redis has 0..15 unless configured otherwise)
+  // Credentials, sent with AUTH on every new connection: an ACL user (empty: Redis's default
+  // user, as with `requirepass`) and its password, given in the spec or read from
+  // `password_file` at every connect, so that a rotated secret reaches new connections without
+  // a restart. At most one of password and password_file. Never printed.
+  std::string user;
+  std::string password;
+  std::string password_file;
 
-  // "host:port" or "host:port/db", for messages.
+  bool has_credentials() const { return !password.empty() || !password_file.empty(); }
+  // "host:port" or "host:port/db", for messages (no credentials).
   std::string ToString() const;
 };
 
-// Parses `redis://HOST:PORT[/DB]`: PORT in 1..65535 (digits only), DB a non-negative number
-// (whether Redis has that many databases is checked when connecting), nothing after. No
-// credentials, TLS or query options. INVALID_ARGUMENT saying which part is wrong.
+// Parses `redis://[USER[:PASSWORD]@]HOST:PORT[/DB]`: USER and PASSWORD percent-encoded where
+// they hold '@', ':', '/' or '%' (as in any URL), PORT in 1..65535 (digits only), DB a
+// non-negative number (whether Redis has that many databases is checked when connecting),
+// nothing after. No TLS or query options. INVALID_ARGUMENT saying which part is wrong, quoting
+// the spec without its password (RedactRedisSpec).
 absl::StatusOr<RedisAddress> ParseRedisSpec(std::string_view spec);
+
+// `spec` with the password of its SCHEME://USER:PASSWORD@ part, if any, replaced by "***": what
+// messages and the server's banner show of a --store flag (anything else is returned unchanged).
+std::string RedactRedisSpec(std::string_view spec);
+
+// The password of `address`: the one given, or the first line of its password_file (at most
+// 4 KiB, a trailing newline dropped; empty or unreadable is UNAVAILABLE naming the file and the
+// reason, never the content).
+absl::StatusOr<std::string> RedisPassword(const RedisAddress& address);
 
 struct RedisConnectionOptions {
   absl::Duration connect_timeout = absl::Seconds(2);  // TCP connect (and name resolution)
@@ -93,8 +115,9 @@ absl::Status MapRedisError(std::string_view error, const std::string& address);
 // One connection (one hiredis context) with the options' timeouts, on the address's database.
 class RedisConnection {
  public:
-  // Connects, SELECTs the database and PINGs. UNAVAILABLE if Redis cannot be reached;
-  // INVALID_ARGUMENT if it refuses the database index.
+  // Connects, logs in (AUTH, when the address has credentials), SELECTs the database and PINGs.
+  // UNAVAILABLE if Redis cannot be reached, refuses the credentials or wants some that were not
+  // given (saying how to give them); INVALID_ARGUMENT if it refuses the database index.
   static absl::StatusOr<std::unique_ptr<RedisConnection>> Open(
       const RedisAddress& address, const RedisConnectionOptions& options);
   ~RedisConnection();

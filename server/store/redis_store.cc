@@ -461,14 +461,28 @@ void RedisStore::FollowHealth() {
 absl::StatusOr<std::unique_ptr<GridStore>> OpenRedisStore(const std::string& spec,
                                                           const RedisStoreOptions& options,
                                                           MemoryBudget* budget) {
-  SG_ASSIGN_OR_RETURN(const RedisAddress address, ParseRedisSpec(spec));
+  SG_ASSIGN_OR_RETURN(RedisAddress address, ParseRedisSpec(spec));
+  if (!options.password_file.empty()) {
+    if (!address.password.empty()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--store = '", RedactRedisSpec(spec),
+                       "' has a password and --redis_password_file gives one too: give it once"));
+    }
+    address.password_file = options.password_file;
+  }
+  if (!address.user.empty() && !address.has_credentials()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--store = '", RedactRedisSpec(spec), "' names user '", address.user.substr(0, 64),
+        "' without a password: give it with --redis_password_file or as USER:PASSWORD@"));
+  }
   if (options.max_deform_revisions < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_deform_revisions = ", options.max_deform_revisions, " must be at least 1"));
   }
   if (options.key_prefix.empty()) return absl::InvalidArgumentError("key_prefix is empty");
   SG_ASSIGN_OR_RETURN(const std::unique_ptr<RedisConnection> first,
-                      RedisConnection::Open(address, options.connection), "--store=", spec, ": ");
+                      RedisConnection::Open(address, options.connection),
+                      "--store=", RedactRedisSpec(spec), ": ");
   SG_RETURN_IF_ERROR(CheckVersion(*first));
   WarnAboutDurability(*first);
   return std::make_unique<RedisStore>(address, options, budget);
@@ -479,6 +493,7 @@ absl::StatusOr<std::unique_ptr<GridStore>> OpenRedisStore(const std::string& spe
                                                           MemoryBudget* budget) {
   RedisStoreOptions redis;
   redis.max_deform_revisions = options.max_deform_revisions;
+  redis.password_file = options.redis_password_file;
   return OpenRedisStore(spec, redis, budget);
 }
 

@@ -109,6 +109,9 @@ struct RedisStoreOptions {
   int64_t max_revision_bytes = kMaxRedisRevisionBytes;
   // Timeouts of every connection.
   RedisConnectionOptions connection;
+  // A file whose first line is the Redis password (ServerOptions::redis_password_file), read
+  // at every new connection; empty: the spec's password, if any.
+  std::string password_file;
   // Connections the calls share.
   int max_connections = 8;
   // How often Available() is brought up to date (PING).
@@ -125,8 +128,10 @@ struct RedisStoreOptions {
   absl::Duration cached_read_window = absl::Seconds(1);
 };
 
-// Opens the store at `spec` (`redis://HOST:PORT[/DB]`): INVALID_ARGUMENT for a bad spec or a
-// database Redis does not have, UNAVAILABLE naming the address if Redis cannot be reached.
+// Opens the store at `spec` (`redis://[USER[:PASSWORD]@]HOST:PORT[/DB]`): INVALID_ARGUMENT for
+// a bad spec, a password given twice (in the spec and as a file), a user without a password or
+// a database Redis does not have; UNAVAILABLE naming the address if Redis cannot be reached,
+// refuses the credentials or wants some (and the password file's problem if it cannot be read).
 absl::StatusOr<std::unique_ptr<GridStore>> OpenRedisStore(const std::string& spec,
                                                           const RedisStoreOptions& options,
                                                           MemoryBudget* budget);

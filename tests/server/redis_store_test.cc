@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -49,6 +50,7 @@ using server::RevisionOrigin;
 using server::StoredGrid;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using End = GridSubscription::End;
 
 // ---- A redis-server child process ----
@@ -76,6 +78,15 @@ int FreePort() {
   return ntohs(address.sin_port);
 }
 
+// Redis on 127.0.0.1:port, logging in with `password` (the default user's) when given.
+server::RedisAddress Loopback(int port, const std::string& password = "") {
+  server::RedisAddress address;
+  address.host = "127.0.0.1";
+  address.port = port;
+  address.password = password;
+  return address;
+}
+
 bool WaitFor(absl::Duration timeout, const std::function<bool()>& done) {
   const absl::Time deadline = absl::Now() + timeout;
   while (absl::Now() < deadline) {
@@ -87,8 +98,14 @@ bool WaitFor(absl::Duration timeout, const std::function<bool()>& done) {
 
 class RedisProcess {
  public:
-  RedisProcess(std::string binary, std::string dir, int port, bool durable)
-      : binary_(std::move(binary)), dir_(std::move(dir)), port_(port), durable_(durable) {}
+  // `password`: the default user's (requirepass); empty: none.
+  RedisProcess(std::string binary, std::string dir, int port, bool durable,
+               std::string password = "")
+      : binary_(std::move(binary)),
+        dir_(std::move(dir)),
+        port_(port),
+        durable_(durable),
+        password_(std::move(password)) {}
   ~RedisProcess() { Kill(); }
 
   // Starts redis-server and waits (up to 5 s) until it answers PING.
@@ -110,6 +127,10 @@ class RedisProcess {
                                      dir_,
                                      "--logfile",
                                      log};
+    if (!password_.empty()) {
+      args.push_back("--requirepass");
+      args.push_back(password_);
+    }
     pid_ = fork();
     if (pid_ == 0) {
       prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the test
@@ -121,7 +142,7 @@ class RedisProcess {
       execv(binary_.c_str(), argv.data());
       _exit(127);
     }
-    server::RedisAddress address{"127.0.0.1", port_, 0};
+    const server::RedisAddress address = Loopback(port_, password_);
     running_ = WaitFor(absl::Seconds(5), [&] {
       return server::RedisConnection::Open(address, server::RedisConnectionOptions()).ok();
     });
@@ -144,6 +165,7 @@ class RedisProcess {
   const std::string dir_;
   const int port_;
   const bool durable_;
+  const std::string password_;
   pid_t pid_ = -1;
   bool running_ = false;
 };
@@ -373,7 +395,7 @@ TEST_F(RedisStoreTest, DeleteWithAnOwnerCheckIsCompareAndDelete) {
 TEST_F(RedisStoreTest, DeleteRemovesEveryKeyOfTheGrid) {
   CreateFitted("g");
   Deform(*b_, "g");
-  server::RedisAddress address{"127.0.0.1", redis_->port(), 0};
+  const server::RedisAddress address = Loopback(redis_->port());
   auto redis = server::RedisConnection::Open(address, {}).value();
   auto keys = [&] {
     std::vector<std::string> names;
@@ -405,7 +427,7 @@ TEST_F(RedisStoreTest, CreateIsAtomicAcrossReplicas) {
     EXPECT_EQ(lost.code(), absl::StatusCode::kAlreadyExists) << lost;
   }
   // The losers' uploads were removed: 8 grids of 3 keys (grid, header, source) and the index.
-  server::RedisAddress address{"127.0.0.1", redis_->port(), 0};
+  const server::RedisAddress address = Loopback(redis_->port());
   auto redis = server::RedisConnection::Open(address, {}).value();
   EXPECT_EQ(redis->Command({"DBSIZE"}).value().value().AsInt(), 8 * 3 + 1);
 }
@@ -413,7 +435,7 @@ TEST_F(RedisStoreTest, CreateIsAtomicAcrossReplicas) {
 // A crashed creation leaves keys under its own generation: they do not block the id, they are
 // not seen, and they expire.
 TEST_F(RedisStoreTest, LeftoversOfACrashedCreateDoNotBlockTheId) {
-  server::RedisAddress address{"127.0.0.1", redis_->port(), 0};
+  const server::RedisAddress address = Loopback(redis_->port());
   auto redis = server::RedisConnection::Open(address, {}).value();
   for (const char* part : {"header", "source", "revs"}) {
     ASSERT_TRUE(redis
@@ -829,7 +851,9 @@ TEST_F(RedisStoreTest, SpecsAreParsedStrictly) {
       {"redis://host:6379/", "the database ''"},
       {"redis://host:6379/x", "the database 'x'"},
       {"redis://host:6379/1/2", "the database '1/2'"},
-      {"redis://user:pw@host:6379", "credentials"},
+      {"redis://:@host:6379", "the password after USER: is empty"},
+      {"redis://u%4@host:6379", "two hex digits"},
+      {"redis://u%zz:pw@host:6379", "two hex digits"},
       {"redis://host:6379?db=1", "options"},
       {"rediss://host:6379", "redis://"},
       {"redis://[::1:6379", "closing ]"},
@@ -848,6 +872,121 @@ TEST_F(RedisStoreTest, SpecsAreParsedStrictly) {
   ASSERT_TRUE(a_->Create(MakeGrid("g")).ok());
   EXPECT_EQ(other->Get("g").status().code(), absl::StatusCode::kNotFound);
   ASSERT_TRUE(other->Create(MakeGrid("g")).ok());
+}
+
+TEST_F(RedisStoreTest, CredentialsAreParsedAndNeverQuoted) {
+  const server::RedisAddress acl =
+      server::ParseRedisSpec("redis://solver:p%40ss%3Aw%2Frd%25@cache.local:6380/2").value();
+  EXPECT_EQ(acl.user, "solver");
+  EXPECT_EQ(acl.password, "p@ss:w/rd%");
+  EXPECT_EQ(acl.host, "cache.local");
+  EXPECT_EQ(acl.port, 6380);
+  EXPECT_EQ(acl.db, 2);
+  EXPECT_EQ(acl.ToString(), "cache.local:6380/2");
+  // A raw '@' or '/' in the password: everything before the last '@' is the credentials.
+  const server::RedisAddress raw = server::ParseRedisSpec("redis://:a@b/c@h:1").value();
+  EXPECT_EQ(raw.user, "");
+  EXPECT_EQ(raw.password, "a@b/c");
+  EXPECT_EQ(raw.host, "h");
+  EXPECT_EQ(server::ParseRedisSpec("redis://solver@h:1").value().user, "solver");
+
+  EXPECT_EQ(server::RedactRedisSpec("redis://u:s3cret@h:1/2"), "redis://u:***@h:1/2");
+  EXPECT_EQ(server::RedactRedisSpec("redis://:s3cret@h:1"), "redis://:***@h:1");
+  EXPECT_EQ(server::RedactRedisSpec("redis://:a@b/c@h:1"), "redis://:***@h:1");
+  EXPECT_EQ(server::RedactRedisSpec("reddis://u:s3cret@h:1"), "reddis://u:***@h:1");
+  EXPECT_EQ(server::RedactRedisSpec("redis://u@h:1"), "redis://u@h:1");
+  EXPECT_EQ(server::RedactRedisSpec("redis://h:1/2"), "redis://h:1/2");
+  EXPECT_EQ(server::RedactRedisSpec("dir:/var/lib/a:b@c"), "dir:/var/lib/a:b@c");
+
+  // Refusals of specs with a password quote them without it.
+  server::MemoryBudget budget(1 << 20);
+  server::RedisStoreOptions options;
+  options.max_deform_revisions = 2;
+  for (const std::string spec : {"redis://u:s3cret@h:0", "redis://u:s3cret@h:1?x",
+                                 "redis://u:s3cret@:1", "redis://u:s3cret@h:1/x"}) {
+    const absl::Status status = server::OpenRedisStore(spec, options, &budget).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << spec;
+    EXPECT_THAT(status.message(), Not(HasSubstr("s3cret"))) << status;
+    EXPECT_THAT(status.message(), HasSubstr("u:***@")) << status;
+  }
+  // A user needs a password; a password is given once.
+  EXPECT_THAT(server::OpenRedisStore("redis://solver@h:1", options, &budget).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "user 'solver' without a password"));
+  options.password_file = dir_ + "/unused";
+  EXPECT_THAT(server::OpenRedisStore("redis://:pw@h:1", options, &budget).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "give it once"));
+}
+
+// A Redis with a password (requirepass) and an ACL user: logging in from the spec or from a
+// file, what a missing, wrong, unreadable or empty password gets (never quoting it), and a
+// rotated password taken by new connections without reopening the store.
+TEST_F(RedisStoreTest, PasswordsFromTheSpecOrAFileAreSentOnEveryConnection) {
+  const std::string secret = "s3cret-a9";
+  const std::string auth_dir = dir_ + "/auth";
+  std::filesystem::create_directories(auth_dir);
+  RedisProcess locked(binary_, auth_dir, FreePort(), /*durable=*/false, secret);
+  ASSERT_TRUE(locked.Start()) << "see " << auth_dir << "/redis.log";
+  const std::string at = absl::StrCat("127.0.0.1:", locked.port());
+  server::MemoryBudget budget(int64_t{1} << 30);
+  server::RedisStoreOptions options;
+  options.max_deform_revisions = 2;
+  auto open = [&](const std::string& spec) {
+    return server::OpenRedisStore(spec, options, &budget);
+  };
+
+  // Nothing given, or a wrong password: UNAVAILABLE saying what Redis wants.
+  absl::Status status = open("redis://" + at).status();
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kUnavailable, "requires a password"));
+  EXPECT_THAT(status.message(), HasSubstr("--redis_password_file"));
+  status = open("redis://:wrong-a9@" + at).status();
+  EXPECT_THAT(status,
+              StatusIs(absl::StatusCode::kUnavailable, "refuses the password of the default user"));
+  EXPECT_THAT(status.message(), Not(HasSubstr("wrong-a9")));
+
+  // The password in the spec: a working store.
+  std::unique_ptr<GridStore> from_spec = open("redis://:" + secret + "@" + at).value();
+  ASSERT_TRUE(from_spec->Create(MakeGrid("g")).ok());
+  EXPECT_TRUE(from_spec->Get("g").ok());
+
+  // An ACL user whose password needs escapes in a URL, on database 2.
+  auto admin = server::RedisConnection::Open(Loopback(locked.port(), secret), {}).value();
+  ASSERT_TRUE(
+      admin->Command({"ACL", "SETUSER", "solver", "on", ">p@ss:w/rd%", "~*", "&*", "+@all"}).ok());
+  std::unique_ptr<GridStore> as_user =
+      open("redis://solver:p%40ss%3Aw%2Frd%25@" + at + "/2").value();
+  EXPECT_EQ(as_user->Get("g").status().code(), absl::StatusCode::kNotFound);  // database 2
+  EXPECT_THAT(open("redis://solver:p%40ss@" + at).status(),
+              StatusIs(absl::StatusCode::kUnavailable, "refuses the password of user 'solver'"));
+
+  // From a file: its first line; missing, empty or oversized files are refused by name.
+  const std::string file = auth_dir + "/password";
+  std::ofstream(file) << secret << "\r\nsecond line\n";
+  options.password_file = file;
+  std::unique_ptr<GridStore> from_file = open("redis://" + at).value();
+  EXPECT_TRUE(from_file->Get("g").ok());
+  options.password_file = auth_dir + "/missing";
+  EXPECT_THAT(open("redis://" + at).status(),
+              StatusIs(absl::StatusCode::kUnavailable, "cannot read --redis_password_file"));
+  const std::string empty = auth_dir + "/empty";
+  std::ofstream(empty) << "\n";
+  options.password_file = empty;
+  EXPECT_THAT(open("redis://" + at).status(),
+              StatusIs(absl::StatusCode::kUnavailable, "holds no password"));
+  const std::string large = auth_dir + "/large";
+  std::ofstream(large) << std::string(5000, 'x');
+  options.password_file = large;
+  EXPECT_THAT(open("redis://" + at).status(),
+              StatusIs(absl::StatusCode::kUnavailable, "larger than 4096 bytes"));
+
+  // Rotation: a new password in Redis and in the file, every connection dropped; the store
+  // opened from the file logs in again with the new one, the one from the spec cannot.
+  std::ofstream(file) << "rotated-b7\n";
+  ASSERT_TRUE(admin->Command({"CONFIG", "SET", "requirepass", "rotated-b7"}).ok());
+  ASSERT_TRUE(admin->Command({"CLIENT", "KILL", "TYPE", "normal"}).ok());
+  EXPECT_TRUE(WaitFor(absl::Seconds(3), [&] { return from_file->Get("g").ok(); }))
+      << from_file->Get("g").status();
+  EXPECT_THAT(from_spec->Get("g").status(),
+              StatusIs(absl::StatusCode::kUnavailable, "refuses the password"));
 }
 
 // Not a check: what a Get costs (printed for the record).

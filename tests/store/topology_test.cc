@@ -210,6 +210,8 @@ class TopologyTest : public ::testing::Test {
                         << "appendonly yes\n"
                         << "appendfsync always\n"
                         << "save \"\"\n";
+    if (!redis_password_.empty())
+      std::ofstream(conf, std::ios::app) << "requirepass " << redis_password_ << "\n";
     redis_ = std::make_unique<ChildProcess>(std::vector<std::string>{redis_server_, conf.string()},
                                             (dir_ / "redis.log").string());
     ASSERT_TRUE(WaitForPort(redis_port_, absl::Seconds(10))) << redis_->ReadLog();
@@ -218,12 +220,18 @@ class TopologyTest : public ::testing::Test {
   std::string RedisStore() const { return absl::StrCat("--store=redis://127.0.0.1:", redis_port_); }
 
   // A `splinegrid serve` on a free port, logging to dir_/NAME.log; not waited for.
-  std::unique_ptr<ChildProcess> Serve(const std::string& name, int port, const std::string& store) {
-    return std::make_unique<ChildProcess>(
-        std::vector<std::string>{kBinary, "serve", absl::StrCat("--address=", Address(port)), store,
-                                 "--threads=1", "--keep_revisions=1000", "--shutdown_grace=2s",
-                                 "--drain_notice=0s"},
-        (dir_ / (name + ".log")).string());
+  std::unique_ptr<ChildProcess> Serve(const std::string& name, int port, const std::string& store,
+                                      const std::string& extra_flag = "") {
+    std::vector<std::string> argv = {kBinary,
+                                     "serve",
+                                     absl::StrCat("--address=", Address(port)),
+                                     store,
+                                     "--threads=1",
+                                     "--keep_revisions=1000",
+                                     "--shutdown_grace=2s",
+                                     "--drain_notice=0s"};
+    if (!extra_flag.empty()) argv.push_back(extra_flag);
+    return std::make_unique<ChildProcess>(std::move(argv), (dir_ / (name + ".log")).string());
   }
 
   // Waits until the server on `port` answers its health check with SERVING.
@@ -291,6 +299,7 @@ class TopologyTest : public ::testing::Test {
   fs::path dir_;
   std::string redis_server_, nginx_binary_;
   int redis_port_ = 0, nginx_port_ = 0;
+  std::string redis_password_;  // StartRedis: requirepass, when not empty
   std::unique_ptr<ChildProcess> redis_, nginx_;
   std::vector<int> replica_ports_;
   std::vector<std::unique_ptr<ChildProcess>> replicas_;
@@ -543,6 +552,55 @@ TEST_F(TopologyTest, ReplicaWithoutRedisExitsNonZero) {
   EXPECT_THAT(log, ::testing::HasSubstr(absl::StrCat(nothing))) << "names the address: " << log;
   std::printf("without Redis: exit %d after %.2f s: %s", code, absl::ToDoubleSeconds(took),
               log.c_str());
+}
+
+// A Redis with a password: a replica logs in with --redis_password_file or with the password in
+// the URL, and no log shows it (the banner shows ***); without it, or with a wrong one, a
+// replica exits non-zero saying what Redis wants and how to give it.
+TEST_F(TopologyTest, ReplicasLogInToRedisWithAPasswordThatNoLogShows) {
+  if (MissingPrograms(/*need_nginx=*/false)) {
+    GTEST_SKIP() << "redis-server is not installed (.ci/setup installs it: redis-server)";
+  }
+  const std::string secret = "s3cret-7Hq2";
+  redis_password_ = secret;
+  ASSERT_NO_FATAL_FAILURE(StartRedis());
+  const fs::path good = dir_ / "redis-password";
+  const fs::path wrong = dir_ / "wrong-password";
+  std::ofstream(good) << secret << "\n";
+  std::ofstream(wrong) << "not-" << secret << "\n";
+  const std::string plain = absl::StrCat("--store=redis://127.0.0.1:", redis_port_);
+  const std::string in_url = absl::StrCat("--store=redis://:", secret, "@127.0.0.1:", redis_port_);
+
+  // Logged in from the file, and from the URL: both SERVING, the grid one replica stores is
+  // read through the other.
+  const int from_file_port = FreePort(), from_url_port = FreePort();
+  std::unique_ptr<ChildProcess> from_file =
+      Serve("from-file", from_file_port, plain, "--redis_password_file=" + good.string());
+  std::unique_ptr<ChildProcess> from_url = Serve("from-url", from_url_port, in_url);
+  ASSERT_TRUE(WaitServing(from_file_port, absl::Seconds(20))) << from_file->ReadLog();
+  ASSERT_TRUE(WaitServing(from_url_port, absl::Seconds(20))) << from_url->ReadLog();
+  const std::string bytes = ReadFileToString(SharedDataPath("grids/n0012_113-33.p2dfmt")).value();
+  ASSERT_TRUE(DirectClient(from_file_port)->ImportPlot3d(bytes, "locked", "", false).ok());
+  EXPECT_TRUE(DirectClient(from_url_port)->Get("locked").ok());
+
+  // Without the password, and with a wrong one: exit non-zero, saying so.
+  std::unique_ptr<ChildProcess> without = Serve("without", FreePort(), plain);
+  std::unique_ptr<ChildProcess> mistaken =
+      Serve("mistaken", FreePort(), plain, "--redis_password_file=" + wrong.string());
+  EXPECT_GT(without->Wait(absl::Seconds(15)), 0) << "exit code (-1: still running)";
+  EXPECT_GT(mistaken->Wait(absl::Seconds(15)), 0) << "exit code (-1: still running)";
+  EXPECT_THAT(without->ReadLog(), ::testing::HasSubstr("requires a password"));
+  EXPECT_THAT(without->ReadLog(), ::testing::HasSubstr("--redis_password_file"));
+  EXPECT_THAT(mistaken->ReadLog(),
+              ::testing::HasSubstr("refuses the password of the default user"));
+
+  // The banner of the URL's replica hides the password; no log has it.
+  EXPECT_THAT(from_url->ReadLog(), ::testing::HasSubstr("store redis://:***@127.0.0.1:"));
+  for (ChildProcess* process : {from_file.get(), from_url.get(), without.get(), mistaken.get()}) {
+    EXPECT_THAT(process->ReadLog(), ::testing::Not(::testing::HasSubstr(secret))) << process->log();
+  }
+  EXPECT_EQ(from_file->Stop(SIGTERM), 0) << from_file->ReadLog();
+  EXPECT_EQ(from_url->Stop(SIGTERM), 0) << from_url->ReadLog();
 }
 
 // Redis goes away: the replica says NOT_SERVING and calls fail UNAVAILABLE; Redis comes back on
