@@ -354,7 +354,8 @@ Vec FullWeighting(const std::vector<double>& fine, int ni, int i, int j) {
 
 }  // namespace
 
-ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
+absl::StatusOr<ControlFunctions> TrackingControls(const StructuredBlock& grid, int inner,
+                                                  const CancelCheck& cancel) {
   const int ni = grid.extent(0), nj = grid.extent(1);
   inner = std::clamp(inner, 0, nj - 2);
   ControlFunctions c;
@@ -376,6 +377,9 @@ ControlFunctions TrackingControls(const StructuredBlock& grid, int inner) {
     }
   }
   for (int j = 0; j < nj; ++j) {
+    // A layer of 4097 points takes about 8 ms: a 4097 x 2049 grid took 15 s unpolled, and a
+    // GenerateGrid overran its deadline by that much.
+    SG_RETURN_IF_ERROR(PollCancel(cancel));
     const double t = std::max(0.0, static_cast<double>(j - inner) / (nj - 1 - inner));
     for (int i = 0; i < ni; ++i) {
       const int64_t p = grid.Index(i, j, 0);
@@ -648,7 +652,8 @@ absl::StatusOr<EllipticResult> SmoothMultigrid(const StructuredBlock& initial,
   StructuredBlock grid_l = initial;
   int held = std::clamp(held_layers, 1, initial.extent(1) - 2);
   for (;;) {
-    const ControlFunctions control = TrackingControls(algebraic_l, held - 1);
+    SG_ASSIGN_OR_RETURN(const ControlFunctions control,
+                        TrackingControls(algebraic_l, held - 1, options.cancel));
     levels.push_back(std::make_unique<Level>(grid_l, control, held, options.relaxation));
     const int ni = algebraic_l.extent(0), nj = algebraic_l.extent(1);
     const int coarse_held = (held + 1) / 2;
@@ -743,7 +748,8 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
   // (fine held = 2 coarse held - 1).
   const int coarse_held = std::clamp((held_layers + 2) / 2, 1, coarse_algebraic.extent(1) - 2);
   out.held_layers = 2 * coarse_held - 1;
-  const ControlFunctions coarse_control = TrackingControls(coarse_algebraic, coarse_held - 1);
+  SG_ASSIGN_OR_RETURN(const ControlFunctions coarse_control,
+                      TrackingControls(coarse_algebraic, coarse_held - 1, options.cancel));
   SG_ASSIGN_OR_RETURN(out.coarse,
                       SmoothElliptic(coarse_algebraic, coarse_control, coarse_held, options));
   // The coarse solution's spline at level 1 of its point distribution, with the fine level's
@@ -775,9 +781,10 @@ absl::StatusOr<CoarseToFine> SmoothCoarseToFine(const StructuredBlock& algebraic
   }
   SG_ASSIGN_OR_RETURN(out.fine, SmoothMultigrid(guess, algebraic, out.held_layers, fine_options));
   if (compare) {
+    SG_ASSIGN_OR_RETURN(const ControlFunctions control,
+                        TrackingControls(algebraic, out.held_layers - 1, options.cancel));
     SG_ASSIGN_OR_RETURN(out.fine_from_transfinite,
-                        SmoothElliptic(algebraic, TrackingControls(algebraic, out.held_layers - 1),
-                                       out.held_layers, options));
+                        SmoothElliptic(algebraic, control, out.held_layers, options));
   }
   return out;
 }
