@@ -102,9 +102,9 @@ class EvaluationAssembler {
     constexpr double kGiB = double(int64_t{1} << 30);
     return absl::ResourceExhaustedError(absl::StrFormat(
         "the evaluation holds %.0f points (%.2f GiB of values) but this client may hold %.2f GiB "
-        "(ClientOptions::max_evaluation_bytes; the CLI: three quarters of the memory this "
-        "machine has available): ask for fewer points (--res, --box, a lower --level, or "
-        "--block)",
+        "(ClientOptions::max_evaluation_bytes; the CLI: three quarters of the memory available "
+        "to it, divided by the copies of the values its output format holds while writing): "
+        "ask for fewer points (--res, --box, a lower --level, or --block)",
         h.total_points(), bytes / kGiB, max_bytes_ / kGiB));
   }
 

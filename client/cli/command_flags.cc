@@ -101,7 +101,7 @@ std::vector<CommandSpec> MakeCommands() {
        "evaluate a revision at a refinement level or resolution into a file",
        /*client=*/true,
        {"o", "level", "res", "revision", "step", "block", "box", "dist", "derivs", "float32",
-        "steps", "compress", "jacobian", "quality", "deviation"},
+        "steps", "compress", "jacobian", "quality", "deviation", "max_memory_mb"},
        {}},
       {"deform",
        "deform NAME [--rotate DEG [--about X,Y[,Z]] [--axis X,Y,Z]] [--translate DX,DY[,DZ]] "
@@ -120,8 +120,8 @@ std::vector<CommandSpec> MakeCommands() {
        "an O-grid around an airfoil file, or a volume grid off a stored surface grid "
        "(GenerateGrid), stored and fitted",
        /*client=*/true,
-       {"name", "o", "layers", "first", "far", "points", "method", "orthogonalize", "profile_tol",
-        "side", "normal_smoothing", "symmetry", SG_FIT_SPEC_FLAGS},
+       {"name", "o", "max_memory_mb", "layers", "first", "far", "points", "method", "orthogonalize",
+        "profile_tol", "side", "normal_smoothing", "symmetry", SG_FIT_SPEC_FLAGS},
        {"The profile file is Selig or Lednicer. An argument that is no file (or grids/NAME) names "
         "a "
         "stored grid of 3D surface blocks: hexahedral layers are marched off all its blocks (k "

@@ -17,6 +17,7 @@
 #include "client/cli/commands.h"
 #include "client/cli/output.h"
 #include "core/util/status_macros.h"
+#include "server/memory_limit.h"
 
 namespace splinegrid::cli {
 namespace {
@@ -97,6 +98,19 @@ std::unique_ptr<client::Client> Connect(const client::RetryPolicy& retry) {
   return client::Client::Connect(ServerAddress(), options);
 }
 
+std::unique_ptr<client::Client> ConnectForEvaluation(double output_copies) {
+  client::ClientOptions options = ConnectionOptions();
+  options.timeout = absl::GetFlag(FLAGS_timeout);
+  if (const int64_t mb = absl::GetFlag(FLAGS_max_memory_mb); mb > 0) {
+    options.max_evaluation_bytes = mb << 20;
+  }
+  if (options.max_evaluation_bytes > 0 && output_copies > 1.0) {
+    options.max_evaluation_bytes =
+        static_cast<int64_t>(static_cast<double>(options.max_evaluation_bytes) / output_copies);
+  }
+  return client::Client::Connect(ServerAddress(), options);
+}
+
 void Print(const std::string& human, const google::protobuf::Message& message) {
   const std::string text = absl::GetFlag(FLAGS_json) ? ToJson(message) : human;
   std::fwrite(text.data(), 1, text.size(), stdout);
@@ -151,17 +165,23 @@ std::string IdFromPath(const std::string& path) {
   return id.substr(0, 63);
 }
 
-// Three quarters of MemAvailable (/proc/meminfo): what an evaluation may assemble in the CLI
-// (0, no limit, when it cannot be read).
+// Three quarters of the memory this process may use: MemAvailable (/proc/meminfo), or the
+// memory limit of its cgroup when that is lower (a container, a batch job's allocation; the
+// server's budget reads the same limit, server/memory_limit.h). 0, no limit, when neither can
+// be read.
 int64_t EvaluationMemoryLimit() {
+  int64_t available = 0;
   std::ifstream meminfo("/proc/meminfo");
   for (std::string line; std::getline(meminfo, line);) {
     long long kib = 0;  // "MemAvailable:   12345678 kB"
     if (std::sscanf(line.c_str(), "MemAvailable: %lld kB", &kib) == 1 && kib > 0) {
-      return static_cast<int64_t>(kib) / 4 * 3 * 1024;
+      available = static_cast<int64_t>(kib) * 1024;
+      break;
     }
   }
-  return 0;
+  const server::MemoryLimit limit = server::DetectMemoryLimit();
+  if (limit.bytes > 0 && (available == 0 || limit.bytes < available)) available = limit.bytes;
+  return available / 4 * 3;
 }
 
 absl::Status PrepareConnection() {
@@ -180,6 +200,9 @@ absl::Status PrepareConnection() {
                                           absl::GetFlag(FLAGS_tls_key), &options));
   options.tls_server_name = absl::GetFlag(FLAGS_tls_server_name);
   if (!options.tls_server_name.empty()) options.use_tls = true;
+  if (const int64_t mb = absl::GetFlag(FLAGS_max_memory_mb); mb < 0 || mb > (int64_t{1} << 43)) {
+    return Usage(absl::StrCat("--max_memory_mb = ", mb, " is outside [0, 2^43]"));
+  }
   if (const absl::Duration timeout = absl::GetFlag(FLAGS_timeout);
       !(timeout > absl::ZeroDuration())) {
     return Usage(absl::StrCat("--timeout = ", absl::FormatDuration(timeout),

@@ -112,7 +112,7 @@ absl::Status Eval(const Args& args) {
     return absl::OkStatus();
   }
   SG_RETURN_IF_ERROR(CheckGridOutput(out, ", or .pvd with --steps A:B"));
-  auto client = Connect();
+  auto client = ConnectForEvaluation(OutputCopies(out, eval_options.compress));
   // A CGNS file also carries the grid's boundary conditions and connectivity at the level.
   std::optional<CgnsOutputContext> cgns;
   if (IsCgnsPath(out)) {
@@ -124,7 +124,11 @@ absl::Status Eval(const Args& args) {
     SG_RETURN_IF_ERROR(CheckEveryDirectionGiven(facts, args[0]));
   }
   ProgressLine download("evaluate");
-  SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client->Evaluate(request, download.callback()));
+  absl::StatusOr<client::EvaluatedGrid> evaluated = client->Evaluate(request, download.callback());
+  if (!evaluated.ok()) {
+    return ExplainEvaluationLimit(evaluated.status(), out, eval_options.compress);
+  }
+  client::EvaluatedGrid result = *std::move(evaluated);
   download.Done();
   v1::EvaluationHeader summary;  // for --json; taken before the blocks move to the writer
   summary.set_revision(result.revision);

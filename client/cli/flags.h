@@ -91,6 +91,7 @@ ABSL_DECLARE_FLAG(std::string, service);
 // serve
 ABSL_DECLARE_FLAG(std::string, address);
 ABSL_DECLARE_FLAG(std::string, store);
+ABSL_DECLARE_FLAG(int64_t, max_memory_mb);
 ABSL_DECLARE_FLAG(std::string, redis_password_file);
 ABSL_DECLARE_FLAG(int, threads);
 ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);

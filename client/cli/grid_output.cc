@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 
@@ -30,6 +31,24 @@ absl::StatusOr<int64_t> WriteGridOutput(const std::string& out, client::Evaluate
   SG_RETURN_IF_ERROR(CheckGridOutput(out));
   if (IsCgnsPath(out)) return WriteCgnsOutput(out, std::move(result), cgns);
   return WriteEvaluation(out, std::move(result), facts, options);
+}
+
+double OutputCopies(const std::string& out, bool compress) {
+  if (IsCgnsPath(out)) return 2.5;
+  if (absl::EndsWith(out, ".xyz")) return 9.5;
+  if (absl::EndsWith(out, ".x")) return 7.0;
+  return compress ? 5.0 : 6.5;  // .vts, .vtm (and each step of a .pvd series)
+}
+
+absl::Status ExplainEvaluationLimit(absl::Status status, const std::string& out, bool compress) {
+  if (!absl::IsResourceExhausted(status) ||
+      !absl::StrContains(status.message(), "this client may hold")) {
+    return status;
+  }
+  return absl::Status(
+      status.code(), absl::StrCat(status.message(), "; writing ", out, " holds about ",
+                                  OutputCopies(out, compress),
+                                  " copies of the values (--max_memory_mb sets what may be used)"));
 }
 
 }  // namespace splinegrid::cli

@@ -99,7 +99,7 @@ absl::Status Offset(const Args& args) {
     *request.mutable_spec() = spec;
   }
   request.set_allow_folds(absl::GetFlag(FLAGS_allow_folds));
-  auto client = Connect();
+  auto client = out.empty() ? Connect() : ConnectForEvaluation(OutputCopies(out, true));
   SG_ASSIGN_OR_RETURN(const v1::GenerateGridResponse response, client->Generate(request));
   std::string human =
       request.has_stored_surface() ? FormatGenerateVolume(response) : FormatGenerate(response);
@@ -109,8 +109,10 @@ absl::Status Offset(const Args& args) {
     evaluate.set_revision(response.fit().revision());
     evaluate.set_refinement_level(0);
     ProgressLine download("evaluate");
-    SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result,
-                        client->Evaluate(evaluate, download.callback()));
+    absl::StatusOr<client::EvaluatedGrid> evaluated =
+        client->Evaluate(evaluate, download.callback());
+    if (!evaluated.ok()) return ExplainEvaluationLimit(evaluated.status(), out, true);
+    client::EvaluatedGrid result = *std::move(evaluated);
     download.Done();
     const int64_t revision = result.revision;
     // Through eval's writers: no source layout (a generated grid has no file), parametric

@@ -253,6 +253,28 @@ TEST_F(EndToEndTest, CliFitsAStoredGridAgainByName) {
   EXPECT_THAT(neither.out, HasSubstr("nothere is neither a file nor a stored grid"));
 }
 
+// eval refuses, when its header arrives, an evaluation whose values times the copies its output
+// format holds while writing would not fit in what the CLI may use (--max_memory_mb; by default
+// three quarters of MemAvailable or the cgroup limit): a trial's eval to .xyz peaked at 8.8 and
+// to .vts at 4.6 times the values it had been allowed, and was killed by the OOM killer.
+TEST_F(EndToEndTest, CliEvalRefusesWhatItsOutputCouldNotHoldWhileWriting) {
+  ASSERT_EQ(
+      Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --name=naca --kinds"))
+          .exit_code,
+      0);
+  // 1000 x 1000 points of 2 doubles: 15.3 MiB of values.
+  const std::string eval = "eval naca --res=1000,1000 --max_memory_mb=100 -o ";
+  const Result xyz = Cli(eval + (dir_ / "big.xyz").string());
+  EXPECT_EQ(xyz.exit_code, 1) << xyz.out;
+  EXPECT_THAT(xyz.out, HasSubstr("RESOURCE_EXHAUSTED: the evaluation holds 1000000 points"));
+  EXPECT_THAT(xyz.out, HasSubstr("holds about 9.5 copies of the values"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "big.xyz"));
+  const Result vts = Cli(eval + (dir_ / "big.vts").string());  // 5 copies: 76 MiB
+  EXPECT_EQ(vts.exit_code, 0) << vts.out;
+  EXPECT_THAT(vts.out, HasSubstr("1000000 points"));
+  EXPECT_EQ(Cli("eval naca --level=0 --max_memory_mb=-1 -o x.vts").exit_code, 2);
+}
+
 TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   const Result missing = Cli("fit /nonexistent/grid.x");
   EXPECT_NE(missing.exit_code, 0);
