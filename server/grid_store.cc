@@ -183,6 +183,17 @@ int64_t SourceBytes(const MultiBlockGrid& source) {
   return bytes;
 }
 
+std::shared_ptr<const StoredGrid> WithinRetention(std::shared_ptr<const StoredGrid> grid,
+                                                  int max_deform_revisions) {
+  const std::vector<int64_t> dropped = DeformRevisionsBeyond(grid->revisions, max_deform_revisions);
+  if (dropped.empty()) return grid;
+  auto kept = std::make_shared<StoredGrid>(*grid);
+  std::erase_if(kept->revisions, [&](const std::shared_ptr<const GridRevision>& r) {
+    return std::binary_search(dropped.begin(), dropped.end(), r->number);
+  });
+  return kept;
+}
+
 std::vector<int64_t> DeformRevisionsBeyond(
     const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions) {
   int64_t excess = -max_deform_revisions;

@@ -278,6 +278,12 @@ class GridStore {
 std::vector<int64_t> DeformRevisionsBeyond(
     const std::vector<std::shared_ptr<const GridRevision>>& revisions, int max_deform_revisions);
 
+// `grid` without the deformed revisions beyond the newest `max_deform_revisions` (itself when
+// none is beyond): what a store creates, so that a grid imported from an archive keeps what a
+// grid deformed here keeps (the numbers of the kept ones unchanged).
+std::shared_ptr<const StoredGrid> WithinRetention(std::shared_ptr<const StoredGrid> grid,
+                                                  int max_deform_revisions);
+
 // A new incarnation (StoredGrid::incarnation): 64 random bits as 16 hex digits.
 std::string NewIncarnation();
 

@@ -40,6 +40,7 @@ std::shared_ptr<std::mutex> MemoryStore::WriterOf(const std::string& id) {
 }
 
 absl::Status MemoryStore::Create(std::shared_ptr<const StoredGrid> grid) {
+  grid = WithinRetention(std::move(grid), max_deform_revisions_);
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (grids_.contains(grid->id) || creating_.contains(grid->id)) {

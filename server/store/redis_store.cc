@@ -196,6 +196,7 @@ absl::Status RedisStore::CheckRevisionSize(const std::string& id, int64_t number
 }
 
 absl::Status RedisStore::Create(std::shared_ptr<const StoredGrid> grid) {
+  grid = WithinRetention(std::move(grid), options_.max_deform_revisions);
   const std::string& id = grid->id;
   if (!grid->source || grid->source->grid().blocks.empty()) {
     return absl::InvalidArgumentError(absl::StrCat("grids/", id, " has no source points"));

@@ -162,6 +162,25 @@ TEST_F(OpsTest, EveryCreationOfAnIdHasItsOwnIncarnation) {
   EXPECT_NE(drawn, second->incarnation);
 }
 
+// The memory and dir: stores keep what retention keeps of a grid created with many deformed
+// revisions (an imported archive), as the Redis store does (RedisStoreTest).
+TEST_F(OpsTest, ACreatedGridKeepsOnlyTheDeformedRevisionsRetentionKeeps) {
+  auto grid = std::make_shared<StoredGrid>(*store_.Get("naca").value());
+  grid->id = "imported";
+  grid->revisions.clear();
+  for (int64_t n = 1; n <= 6; ++n) {
+    auto revision = std::make_shared<GridRevision>();
+    revision->number = n;
+    revision->origin = n == 1 ? RevisionOrigin::kFit : RevisionOrigin::kDeform;
+    grid->revisions.push_back(std::move(revision));
+  }
+  MemoryStore store(/*max_deform_revisions=*/3);
+  ASSERT_TRUE(store.Create(grid).ok());
+  std::vector<int64_t> numbers;
+  for (const auto& r : store.Get("imported").value()->revisions) numbers.push_back(r->number);
+  EXPECT_EQ(numbers, (std::vector<int64_t>{1, 4, 5, 6}));
+}
+
 // A kept deformer keeps its fold gate per check level, charged to the memory budget until the
 // deformer goes, unless the gate's reference is larger than the cap (level 4 of the 224 x 64
 // cells is 3.7M cells): then it is made for each call and charged while the call holds it. A

@@ -566,6 +566,23 @@ TEST_F(RedisStoreTest, RetentionDropsOldDeformedRevisionsAndNumbersAreNeverReuse
 }
 
 // Revision numbers of any size survive the script's number encoding (varints of 1-3 bytes).
+// A grid created with more deformed revisions than retention keeps (an imported archive) keeps
+// the newest ones, as if they had been deformed here; a trial's import kept all 64 under
+// --keep_revisions=5 until the next deform.
+TEST_F(RedisStoreTest, ACreatedGridKeepsOnlyTheDeformedRevisionsRetentionKeeps) {
+  auto grid = MakeGrid("imported");
+  for (int64_t n = 1; n <= 6; ++n) {
+    auto revision = std::make_shared<GridRevision>(
+        n == 1 ? MakeRevision(RevisionOrigin::kFit) : MakeRevision(RevisionOrigin::kDeform, 1, n));
+    revision->number = n;
+    grid->revisions.push_back(std::move(revision));
+  }
+  ASSERT_TRUE(a_->Create(grid).ok());
+  EXPECT_THAT(Numbers(*b_->Get("imported").value()), ElementsAre(1, 5, 6));  // keeps 2
+  EXPECT_EQ(Deform(*b_, "imported"), 7);
+  EXPECT_THAT(Numbers(*a_->Get("imported").value()), ElementsAre(1, 6, 7));
+}
+
 TEST_F(RedisStoreTest, ImportedNumbersAreKeptAndContinued) {
   for (int64_t number : {127, 300, 20000}) {
     const std::string id = absl::StrCat("n", number);
