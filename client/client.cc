@@ -253,6 +253,16 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
                                            " (the server closed the connection: if it uses TLS, "
                                            "give its CA: --tls_ca, ClientOptions.tls_root_certs)"));
       }
+      // A server that asks for client certificates closes a TLS connection without one.
+      if (absl::IsUnavailable(result) && options_.use_tls && options_.tls_cert_chain.empty() &&
+          absl::StrContains(result.message(), "Socket closed")) {
+        result =
+            absl::Status(result.code(),
+                         absl::StrCat(result.message(),
+                                      " (the server closed the connection: if it asks for client "
+                                      "certificates (mTLS), give yours: --tls_cert and --tls_key, "
+                                      "ClientOptions.tls_cert_chain and tls_private_key)"));
+      }
       return result;
     }
     PauseBeforeRetry(*channel_, *wait);

@@ -155,6 +155,7 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                          max(1, int(self.retry.max_backoff * 1000)))]
         self._tls = (tls or tls_ca is not None or tls_cert is not None
                      or tls_server_name is not None)
+        self._client_cert = tls_cert is not None
         if self._tls:
             credentials = grpc.ssl_channel_credentials(
                 root_certificates=_read_pem(tls_ca, "tls_ca"),
@@ -233,6 +234,14 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                         translated = SplinegridError(
                             translated.code, f"{translated.message} (the server closed the "
                             "connection: if it uses TLS, give its CA: tls_ca=)")
+                    elif (translated.code == "UNAVAILABLE" and self._tls and not self._client_cert
+                            and "Socket closed" in translated.message):
+                        # A server that asks for client certificates closes a TLS connection
+                        # without one.
+                        translated = SplinegridError(
+                            translated.code, f"{translated.message} (the server closed the "
+                            "connection: if it asks for client certificates (mTLS), give yours: "
+                            "tls_cert= and tls_key=)")
                     raise translated from error
             self._pause_before_retry(wait)
 
