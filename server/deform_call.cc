@@ -30,19 +30,26 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
   CallLog log("DeformGrid", request->name(), state_->options);
   CancelCheck cancel = CallCancelCheck(context);
   // Converted before admission only to schedule it: a deform with a kept deformer is cheap work
-  // (ops::HasKeptDeformer); errors are answered after admission, on the pool.
+  // (ops::HasKeptDeformer); any other is sized once its grid is read (ops::DeformIsSmall): a
+  // small one runs in that slice, a large one on the long workers. Errors are answered after
+  // admission, on the pool.
   auto parsed = std::make_shared<absl::StatusOr<ops::DeformRequest>>(ParseRequest(*request));
-  const WorkKind kind =
-      parsed->ok() && ops::HasKeptDeformer(Ops(), **parsed) ? WorkKind::kCheap : WorkKind::kLong;
-  return RunOnPool(context, log, Role::kWrite, kind,
-                   [this, parsed, response, cancel](const Caller& caller) -> absl::Status {
-                     SG_RETURN_IF_ERROR(parsed->status());
-                     SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> published,
-                                         ops::Deform(Ops(caller), **parsed, cancel));
-                     response->set_revision(published->number);
-                     EncodeDeformReport(published->deform, response->mutable_report());
-                     return absl::OkStatus();
-                   });
+  Work deform = [this, parsed, response, cancel](const Caller& caller) -> absl::Status {
+    SG_RETURN_IF_ERROR(parsed->status());
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const GridRevision> published,
+                        ops::Deform(Ops(caller), **parsed, cancel));
+    response->set_revision(published->number);
+    EncodeDeformReport(published->deform, response->mutable_report());
+    return absl::OkStatus();
+  };
+  if (parsed->ok() && ops::HasKeptDeformer(Ops(), **parsed)) {
+    return RunOnPool(context, log, Role::kWrite, WorkKind::kCheap, std::move(deform));
+  }
+  SizeUp small = [this, parsed](const Caller& caller) -> absl::StatusOr<bool> {
+    SG_RETURN_IF_ERROR(parsed->status());
+    return ops::DeformIsSmall(Ops(caller), **parsed);
+  };
+  return RunSizedOnPool(context, log, Role::kWrite, std::move(small), std::move(deform));
 }
 
 }  // namespace splinegrid::server

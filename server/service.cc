@@ -122,6 +122,49 @@ grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerConte
   return reactor;
 }
 
+grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServerContext* context,
+                                                            CallLog log, Role needed,
+                                                            SizeUp size_up, Work work) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  absl::StatusOr<Caller> caller = AdmitCall(*state_, context, needed, &log);
+  if (!caller.ok()) {
+    log.Finish(caller.status());
+    reactor->Finish(ToGrpcStatus(caller.status()));
+    return reactor;
+  }
+  SG_HAPPENS_BEFORE(reactor);
+  const std::string principal = caller->principal;
+  auto finish = [state = state_, reactor, context, log](const absl::Status& status) {
+    const absl::Status explained = ExplainCancellation(*state, context, status);
+    log.Finish(explained);
+    reactor->Finish(ToGrpcStatus(explained));
+  };
+  auto slice = [state = state_, reactor, caller = *std::move(caller), size_up = std::move(size_up),
+                work = std::move(work), finish] {
+    SG_HAPPENS_AFTER(reactor);
+    const absl::StatusOr<bool> small = size_up(caller);
+    if (!small.ok() || *small) {
+      finish(small.ok() ? work(caller) : small.status());
+      return;
+    }
+    SG_HAPPENS_BEFORE(reactor);
+    auto long_task = [reactor, caller, work, finish] {
+      SG_HAPPENS_AFTER(reactor);
+      finish(work(caller));
+    };
+    if (absl::Status status = state->pool.TrySubmit(caller.principal, WorkKind::kLong,
+                                                    std::move(long_task), Admission::kContinuation);
+        !status.ok()) {
+      finish(status);
+    }
+  };
+  if (absl::Status status = state_->pool.TrySubmit(principal, WorkKind::kSlice, std::move(slice));
+      !status.ok()) {
+    finish(status);
+  }
+  return reactor;
+}
+
 grpc::ServerUnaryReactor* SplineGridService::RunInline(grpc::CallbackServerContext* context,
                                                        CallLog log, Role needed, const Work& work) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();

@@ -155,6 +155,12 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   // refuses it).
   grpc::ServerUnaryReactor* RunOnPool(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, WorkKind kind, Work work);
+  // The same for work whose cost is known only once the grid is read: `size_up` runs first as
+  // a slice (any worker, turns across principals); when it answers true (small) `work` runs in
+  // that slice, otherwise `work` goes to the long workers as the call's continuation.
+  using SizeUp = std::function<absl::StatusOr<bool>(const Caller&)>;
+  grpc::ServerUnaryReactor* RunSizedOnPool(grpc::CallbackServerContext* context, CallLog log,
+                                           Role needed, SizeUp size_up, Work work);
   // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, const Work& work);

@@ -97,6 +97,29 @@ bool HasKeptDeformer(const OpsContext& context, const DeformRequest& request) {
              request.check_level);
 }
 
+absl::StatusOr<bool> DeformIsSmall(const OpsContext& context, const DeformRequest& request) {
+  SG_ASSIGN_OR_RETURN(const std::shared_ptr<const StoredGrid> grid,
+                      context.store.GetHolding(request.grid_id, {request.reference_revision}));
+  SG_ASSIGN_OR_RETURN(
+      const std::shared_ptr<const GridRevision> reference,
+      grid->ResolveRevision(request.reference_revision, std::nullopt, "reference_revision"));
+  if (context.deformers.HasReady(ShapeKey(grid->id, reference->number, request.options),
+                                 request.check_level)) {
+    return true;
+  }
+  int64_t controls = 0, cells = 0;
+  for (const BlockFit& block : reference->blocks) {
+    controls += block.fitted.spline.num_control_points();
+    int64_t block_cells = 1;
+    for (int d = 0; d < 3; ++d) {
+      const int64_t points = block.fitted.distribution.num_points(d);
+      if (points > 1) block_cells *= (points - 1) << std::clamp(request.check_level, 0, 8);
+    }
+    cells += block_cells;
+  }
+  return controls <= kSmallDeformerControls && cells <= kSmallDeformerCells;
+}
+
 absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& context,
                                                            const DeformRequest& request,
                                                            const CancelCheck& cancel) {

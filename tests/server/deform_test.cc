@@ -5,6 +5,7 @@
 #include <cmath>
 #include <thread>
 
+#include "absl/synchronization/notification.h"
 #include "core/bspline/evaluation.h"
 #include "gmock/gmock.h"
 #include "proto/convert/convert.h"
@@ -288,6 +289,40 @@ TEST_F(DeformTest, ConcurrentWritersOnOneBaseOneWinsTheOtherIsAborted) {
     }
     EXPECT_EQ(client_->Get("naca").value().latest_revision(), base + 1);
   }
+}
+
+// A deform whose deformer is not kept yet (a solver's first step, or every grid's first step on
+// a replica after a failover) was long work and waited for the long workers, behind other
+// principals' fits (a trial: 4.6 s instead of 1.5 ms). Once its grid is read it is sized: a small
+// one runs as a slice while the long worker is busy; a large one still goes to the long workers.
+TEST_F(DeformTest, AFirstSmallDeformDoesNotWaitForTheLongWorkers) {
+  ImportAndFit("grids/n0012_113-33.p2dfmt", "naca");  // 112 x 32 cells
+  // Hold the one long worker (2 threads) as another principal's fit would. The test reaches the
+  // scheduler directly: no call of the API blocks on demand.
+  absl::Notification started, release;
+  auto& pool = const_cast<server::ServiceState&>(server_->state()).pool;
+  ASSERT_TRUE(pool.TrySubmit("another", server::WorkKind::kLong,
+                             [&] {
+                               started.Notify();
+                               release.WaitForNotification();
+                             })
+                  .ok());
+  started.WaitForNotification();
+  // Level 1: 14k cells to check, a small deformer: done while the long worker is held.
+  const absl::StatusOr<v1::DeformGridResponse> small = client_->Deform(Pitch("naca", 2, 1));
+  EXPECT_TRUE(small.ok()) << small.status();
+  // Level 4: 918k cells, a large gate: it waits for the long worker.
+  v1::DeformGridRequest large = Pitch("naca", 3, 2);
+  large.set_check_level(4);
+  absl::Notification large_done;
+  std::thread deform([&] {
+    EXPECT_TRUE(client_->Deform(large).ok());
+    large_done.Notify();
+  });
+  EXPECT_FALSE(large_done.WaitForNotificationWithTimeout(absl::Milliseconds(300)));
+  release.Notify();
+  EXPECT_TRUE(large_done.WaitForNotificationWithTimeout(absl::Seconds(30)));
+  deform.join();
 }
 
 TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
