@@ -102,7 +102,8 @@ absl::Status Eval(const Args& args) {
   SG_ASSIGN_OR_RETURN(const EvalOutputOptions eval_options,
                       EvalOutputOptionsFromFlags(out, &request));
   if (IsSeriesPath(out)) {
-    auto series_client = Connect();
+    // One step at a time is held (WriteSeries), with its writer's copies.
+    auto series_client = ConnectForEvaluation(OutputCopies(out, eval_options.compress));
     SG_ASSIGN_OR_RETURN(const EvalGridFacts facts,
                         FetchEvalFacts(*series_client, request, eval_options));
     SG_RETURN_IF_ERROR(CheckEveryDirectionGiven(facts, args[0]));

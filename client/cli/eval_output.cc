@@ -253,9 +253,10 @@ absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, client::Evaluate
       absl::StrCat("-o ", out, ": WriteEvaluation writes .vts, .vtm, .x or .xyz"));
 }
 
-absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, std::vector<SeriesStep> steps,
-                                    const EvalGridFacts& facts, const EvalOutputOptions& options,
-                                    std::string* note) {
+absl::StatusOr<int64_t> WriteSeries(
+    const std::string& pvd, const std::vector<SeriesStep>& steps,
+    const std::function<absl::StatusOr<client::EvaluatedGrid>(const SeriesStep&)>& evaluate,
+    const EvalGridFacts& facts, const EvalOutputOptions& options, std::string* note) {
   const std::filesystem::path path(pvd);
   if (path.extension() != ".pvd" || path.stem().empty()) {
     return absl::InvalidArgumentError(absl::StrCat("-o ", pvd, ": a series is a <name>.pvd"));
@@ -278,12 +279,12 @@ absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, std::vector<SeriesSt
   }
   std::vector<PvdEntry> entries;
   int64_t points = 0;
-  for (SeriesStep& step : steps) {
+  for (const SeriesStep& step : steps) {
+    SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, evaluate(step));
     const std::string name =
-        absl::StrCat(stem, "_", step.step, step.result.blocks.size() == 1 ? ".vts" : ".vtm");
-    SG_ASSIGN_OR_RETURN(
-        const int64_t written,
-        WriteEvaluation((directory / name).string(), std::move(step.result), facts, options));
+        absl::StrCat(stem, "_", step.step, result.blocks.size() == 1 ? ".vts" : ".vtm");
+    SG_ASSIGN_OR_RETURN(const int64_t written, WriteEvaluation((directory / name).string(),
+                                                               std::move(result), facts, options));
     points += written;
     entries.push_back(
         {use_steps ? static_cast<double>(step.step) : step.time, absl::StrCat(stem, "/", name)});

@@ -6,6 +6,7 @@
 #define SPLINEGRID_CLIENT_CLI_EVAL_OUTPUT_H_
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -59,21 +60,23 @@ absl::StatusOr<int64_t> WriteEvaluation(const std::string& out, client::Evaluate
                                         const EvalGridFacts& facts,
                                         const EvalOutputOptions& options);
 
-// One time step of a series: the evaluation of a deformed revision.
+// One time step of a series: a deformed revision.
 struct SeriesStep {
   int64_t step = 0;
   double time = 0.0;
-  client::EvaluatedGrid result;
+  int64_t revision = 0;
 };
 
 // Writes the steps as `pvd` (which ends in ".pvd", say out/run.pvd): out/run/run_<step>.vts
 // (one block) or .vtm, and the .pvd listing them with TimeValue = each revision's time. When
 // times repeat (revisions deformed without --time), the steps are used as TimeValue and
-// `*note` says so. Returns the points written over all steps. Moves each step's evaluation
-// into its writer (pass `steps` with std::move).
-absl::StatusOr<int64_t> WriteSeries(const std::string& pvd, std::vector<SeriesStep> steps,
-                                    const EvalGridFacts& facts, const EvalOutputOptions& options,
-                                    std::string* note);
+// `*note` says so. Each step is evaluated by `evaluate` and written before the next is asked
+// for, so a series takes the memory of one step however many it has. Returns the points
+// written over all steps.
+absl::StatusOr<int64_t> WriteSeries(
+    const std::string& pvd, const std::vector<SeriesStep>& steps,
+    const std::function<absl::StatusOr<client::EvaluatedGrid>(const SeriesStep&)>& evaluate,
+    const EvalGridFacts& facts, const EvalOutputOptions& options, std::string* note);
 
 }  // namespace splinegrid::cli
 

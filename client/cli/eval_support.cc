@@ -17,6 +17,7 @@
 #include "absl/strings/str_split.h"
 #include "client/cli/command_line.h"
 #include "client/cli/flags.h"
+#include "client/cli/grid_output.h"
 #include "core/io/file_util.h"
 #include "core/io/record_file.h"
 #include "core/util/status_macros.h"
@@ -223,16 +224,18 @@ absl::StatusOr<std::string> RunEvalSeries(client::Client& client, v1::EvaluateGr
                                             range.first, " to ", range.second));
   }
   std::vector<SeriesStep> steps;
-  for (const auto& [step, info] : by_step) {
-    request.set_revision(info->revision());
-    request.clear_step();
-    SG_ASSIGN_OR_RETURN(client::EvaluatedGrid result, client.Evaluate(request));
-    steps.push_back({step, info->time(), std::move(result)});
-  }
+  for (const auto& [step, info] : by_step) steps.push_back({step, info->time(), info->revision()});
+  request.clear_step();
+  auto evaluate = [&](const SeriesStep& step) -> absl::StatusOr<client::EvaluatedGrid> {
+    request.set_revision(step.revision);
+    absl::StatusOr<client::EvaluatedGrid> result = client.Evaluate(request);
+    if (!result.ok()) return ExplainEvaluationLimit(result.status(), out, options.compress);
+    return result;
+  };
   std::string note;
   const int64_t written_steps = static_cast<int64_t>(steps.size());
   SG_ASSIGN_OR_RETURN(const int64_t points,
-                      WriteSeries(out, std::move(steps), facts, options, &note));
+                      WriteSeries(out, steps, evaluate, facts, options, &note));
   const int64_t missing = range.second - range.first + 1 - written_steps;
   std::string summary = absl::StrCat("wrote ", out, ": ", written_steps, " time step(s) (steps ",
                                      by_step.begin()->first, " to ", by_step.rbegin()->first, "), ",

@@ -84,9 +84,10 @@ absl::StatusOr<BlockSampling> BlockSampling::Create(const TensorSpline& spline,
       Point3 fixed = {0.0, 0.0, 0.0};
       fixed[e1] = sampling.params_[e1][a];
       fixed[e2] = sampling.params_[e2][c];
-      const auto line_name = [&] {
-        return absl::StrCat("the grid line at output ", std::string(1, kNames[e1]), " = ", a, ", ",
-                            std::string(1, kNames[e2]), " = ", c);
+      // The directions by value: clang 14 does not capture structured bindings.
+      const auto line_name = [&, i1 = e1, i2 = e2] {
+        return absl::StrCat("the grid line at output ", std::string(1, kNames[i1]), " = ", a, ", ",
+                            std::string(1, kNames[i2]), " = ", c);
       };
       const LineArcLength line(spline, d, fixed, t0, t1);
       double* t = sampling.line_params_.data() + (int64_t{a} + int64_t{n[e1]} * c) * n[d];
