@@ -54,7 +54,8 @@ CallMetrics::Row* CallMetrics::Find(absl::string_view method) const {
   return it == by_method_.end() ? rows_.back().get() : it->second;
 }
 
-void CallMetrics::Record(absl::string_view method, absl::StatusCode code, absl::Duration latency) {
+void CallMetrics::Record(absl::string_view method, absl::StatusCode code,
+                         absl::Duration latency) {
   static_assert(kCodes == static_cast<int>(absl::StatusCode::kUnauthenticated) + 1);
   Row& row = *Find(method);
   row.calls[CodeIndex(code)].fetch_add(1, std::memory_order_relaxed);
@@ -63,9 +64,9 @@ void CallMetrics::Record(absl::string_view method, absl::StatusCode code, absl::
       std::lower_bound(kBucketBounds.begin(), kBucketBounds.end(), seconds) -
       kBucketBounds.begin();  // first bound >= seconds (le is inclusive); size(): +Inf
   row.buckets[bucket].fetch_add(1, std::memory_order_relaxed);
-  row.sum_nanos.fetch_add(
-      static_cast<uint64_t>(std::max<int64_t>(0, absl::ToInt64Nanoseconds(latency))),
-      std::memory_order_relaxed);
+  row.sum_nanos.fetch_add(static_cast<uint64_t>(std::max<int64_t>(0, absl::ToInt64Nanoseconds(
+                                                                         latency))),
+                          std::memory_order_relaxed);
 }
 
 uint64_t CallMetrics::calls(absl::string_view method, absl::StatusCode code) const {
@@ -81,7 +82,8 @@ void CallMetrics::AppendText(std::string* out) const {
       const uint64_t n = row->calls[c].load(std::memory_order_relaxed);
       if (n == 0 && c != 0) continue;
       absl::StrAppend(out, "splinegrid_calls_total{method=\"", row->method, "\",code=\"",
-                      absl::StatusCodeToString(static_cast<absl::StatusCode>(c)), "\"} ", n, "\n");
+                      absl::StatusCodeToString(static_cast<absl::StatusCode>(c)), "\"} ", n,
+                      "\n");
     }
   }
   absl::StrAppend(out,
@@ -96,10 +98,11 @@ void CallMetrics::AppendText(std::string* out) const {
                       "\",le=\"", b < kBucketBounds.size() ? Bound(kBucketBounds[b]) : "+Inf",
                       "\"} ", cumulative, "\n");
     }
-    absl::StrAppend(out, "splinegrid_call_duration_seconds_sum{method=\"", row->method, "\"} ",
-                    absl::StrFormat("%.9g", row->sum_nanos.load(std::memory_order_relaxed) * 1e-9),
-                    "\n", "splinegrid_call_duration_seconds_count{method=\"", row->method, "\"} ",
-                    cumulative, "\n");
+    absl::StrAppend(
+        out, "splinegrid_call_duration_seconds_sum{method=\"", row->method, "\"} ",
+        absl::StrFormat("%.9g", row->sum_nanos.load(std::memory_order_relaxed) * 1e-9), "\n",
+        "splinegrid_call_duration_seconds_count{method=\"", row->method, "\"} ", cumulative,
+        "\n");
   }
 }
 

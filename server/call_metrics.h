@@ -59,7 +59,7 @@ class CallMetrics {
   // The row of `method`, or "other" (rows are shared: the counters are atomic).
   Row* Find(absl::string_view method) const;
 
-  std::vector<std::unique_ptr<Row>> rows_;            // the last one is "other"
+  std::vector<std::unique_ptr<Row>> rows_;  // the last one is "other"
   absl::flat_hash_map<std::string, Row*> by_method_;  // read-only after construction
 };
 

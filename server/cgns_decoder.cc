@@ -93,7 +93,8 @@ std::string LimitScript(int64_t memory_bytes, int64_t cpu_seconds) {
   const int64_t cpu_hard = WithinHardLimit(RLIMIT_CPU, cpu_seconds + 5);
   const int64_t cpu_soft = std::min(cpu_seconds, cpu_hard);
   return absl::StrCat("ulimit -v ", memory_kib, " && ulimit -t ", cpu_hard, " && ulimit -S -t ",
-                      cpu_soft, " && ulimit -c 0 || exit ", kLimitsFailed, "; exec \"$0\" \"$1\"");
+                      cpu_soft, " && ulimit -c 0 || exit ", kLimitsFailed,
+                      "; exec \"$0\" \"$1\"");
 }
 
 // posix_spawn attributes and file actions, destroyed on scope exit.

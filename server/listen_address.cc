@@ -82,8 +82,8 @@ absl::Status CheckCanListen(const std::string& address) {
     setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof(on));
     if (bind(fd, a->ai_addr, a->ai_addrlen) == 0) {
       bound = true;
-    } else if (first_error == 0) {
-      first_error = errno;
+    } else if (first_error == 0 || errno == EADDRINUSE) {
+      first_error = errno;  // "in use" says more than another address's refusal
     }
     close(fd);
   }
@@ -94,7 +94,7 @@ absl::Status CheckCanListen(const std::string& address) {
                              : first_error == EADDRNOTAVAIL ? "it is not an address of this machine"
                                                             : std::strerror(first_error);
   return absl::UnavailableError(
-      absl::StrCat("cannot listen on ", QuoteClientString(address), ": ", reason));
+      absl::StrCat("address: cannot listen on ", QuoteClientString(address), ": ", reason));
 }
 
 }  // namespace splinegrid::server

@@ -61,11 +61,13 @@ std::pair<std::string, std::string> SplitHostPort(absl::string_view address) {
 absl::Status CheckMetricsAddress(absl::string_view address, bool insecure) {
   const absl::StatusOr<int> port = ParseListenPort(address, /*min_port=*/0);
   if (!port.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("--metrics_address: ", port.status().message()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--metrics_address: ", port.status().message()));
   }
   if (*port < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--metrics_address = ", QuoteClientString(address), ": give HOST:PORT (unix sockets: no)"));
+    return absl::InvalidArgumentError(absl::StrCat("--metrics_address = ",
+                                                   QuoteClientString(address),
+                                                   ": give HOST:PORT (unix sockets: no)"));
   }
   if (!insecure && !IsLoopbackAddress(address)) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -77,8 +79,8 @@ absl::Status CheckMetricsAddress(absl::string_view address, bool insecure) {
 }
 
 absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(absl::string_view address,
-                                                                        bool insecure,
-                                                                        Render render) {
+                                                                         bool insecure,
+                                                                         Render render) {
   if (absl::Status status = CheckMetricsAddress(address, insecure); !status.ok()) return status;
   const auto [host, port] = SplitHostPort(address);
   addrinfo hints{};
@@ -87,9 +89,10 @@ absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(absl::st
   hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
   addrinfo* found = nullptr;
   if (const int error = getaddrinfo(host.c_str(), port.c_str(), &hints, &found); error != 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--metrics_address = ", QuoteClientString(address),
-                     ": cannot resolve the host: ", gai_strerror(error)));
+    return absl::InvalidArgumentError(absl::StrCat("--metrics_address = ",
+                                                   QuoteClientString(address),
+                                                   ": cannot resolve the host: ",
+                                                   gai_strerror(error)));
   }
   std::unique_ptr<MetricsEndpoint> endpoint(new MetricsEndpoint(std::move(render)));
   // AUTO picks epoll or poll: select() would refuse a scrape whose socket number is above
@@ -97,8 +100,8 @@ absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(absl::st
   unsigned flags = MHD_USE_AUTO_INTERNAL_THREAD | MHD_USE_ERROR_LOG;
   if (found->ai_family == AF_INET6) flags |= MHD_USE_IPv6;
   endpoint->daemon_ = MHD_start_daemon(
-      flags, /*port=*/0, /*apc=*/nullptr, nullptr, &Handle, endpoint.get(), MHD_OPTION_SOCK_ADDR,
-      found->ai_addr,
+      flags, /*port=*/0, /*apc=*/nullptr, nullptr, &Handle, endpoint.get(),
+      MHD_OPTION_SOCK_ADDR, found->ai_addr,
       // Scrapes are small and rare: a few connections, and idle ones closed after 10 s.
       MHD_OPTION_CONNECTION_LIMIT, 16u, MHD_OPTION_CONNECTION_TIMEOUT, 10u, MHD_OPTION_END);
   freeaddrinfo(found);

@@ -12,8 +12,8 @@ namespace splinegrid::server {
 namespace {
 
 void Gauge(std::string* out, absl::string_view name, absl::string_view help, int64_t value) {
-  absl::StrAppend(out, "# HELP ", name, " ", help, "\n# TYPE ", name, " gauge\n", name, " ", value,
-                  "\n");
+  absl::StrAppend(out, "# HELP ", name, " ", help, "\n# TYPE ", name, " gauge\n", name, " ",
+                  value, "\n");
 }
 
 // Grids and revisions held by the store (GridStore::Count: no listing, no revision read); a

@@ -142,9 +142,11 @@ grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServer
   auto slice = [state = state_, reactor, caller = *std::move(caller), size_up = std::move(size_up),
                 work = std::move(work), finish] {
     SG_HAPPENS_AFTER(reactor);
+    // An error of the sizing (the grid is not there, say) is left to `work`, which fails early
+    // with the answer and the precedence of its own checks (ownership before a bad reference).
     const absl::StatusOr<bool> small = size_up(caller);
     if (!small.ok() || *small) {
-      finish(small.ok() ? work(caller) : small.status());
+      finish(work(caller));
       return;
     }
     SG_HAPPENS_BEFORE(reactor);
@@ -152,8 +154,10 @@ grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServer
       SG_HAPPENS_AFTER(reactor);
       finish(work(caller));
     };
-    if (absl::Status status = state->pool.TrySubmit(caller.principal, WorkKind::kLong,
-                                                    std::move(long_task), Admission::kContinuation);
+    // Counted as the caller's new long call (max_queued_long_calls_per_principal), as it would
+    // have been had it been known to be long at admission.
+    if (absl::Status status =
+            state->pool.TrySubmit(caller.principal, WorkKind::kLong, std::move(long_task));
         !status.ok()) {
       finish(status);
     }

@@ -26,7 +26,7 @@ class UploadReactor : public grpc::ServerReadReactor<Decoded<Request>> {
  public:
   void OnReadDone(bool ok) override {
     SG_HAPPENS_AFTER(this);
-    if (!ok) {       // the client closed its side: everything has arrived
+    if (!ok) {  // the client closed its side: everything has arrived
       idle_.Stop();  // from here on the call is the pool's
       if (std::lock_guard<std::mutex> lock(mu_); ended_) return;  // the idle timeout ended it
       // Reads also end when the client cancels or the shutdown's grace runs out: then nothing
@@ -35,8 +35,8 @@ class UploadReactor : public grpc::ServerReadReactor<Decoded<Request>> {
         End(WhyCallEnded(*state_, context_));
         return;
       }
-      if (absl::Status status =
-              state_->pool.TrySubmit(caller_.principal, WorkKind::kLong, [this] { RunComplete(); });
+      if (absl::Status status = state_->pool.TrySubmit(caller_.principal, WorkKind::kLong,
+                                                       [this] { RunComplete(); });
           !status.ok()) {
         End(status);
       }
@@ -69,7 +69,8 @@ class UploadReactor : public grpc::ServerReadReactor<Decoded<Request>> {
 
   // Admits the call and starts reading (the last statement of the subclass's constructor).
   void Start() {
-    absl::StatusOr<AdmittedStream> admitted = AdmitStream(*state_, context_, Role::kWrite, &log_);
+    absl::StatusOr<AdmittedStream> admitted =
+        AdmitStream(*state_, context_, Role::kWrite, &log_);
     if (!admitted.ok()) {
       End(admitted.status());
       return;

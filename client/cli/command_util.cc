@@ -200,8 +200,8 @@ absl::Status PrepareConnection() {
                                           absl::GetFlag(FLAGS_tls_key), &options));
   options.tls_server_name = absl::GetFlag(FLAGS_tls_server_name);
   if (!options.tls_server_name.empty()) options.use_tls = true;
-  if (const int64_t mb = absl::GetFlag(FLAGS_max_memory_mb); mb < 0 || mb > (int64_t{1} << 43)) {
-    return Usage(absl::StrCat("--max_memory_mb = ", mb, " is outside [0, 2^43]"));
+  if (const int64_t mb = absl::GetFlag(FLAGS_max_memory_mb); mb < 0 || mb >= (int64_t{1} << 43)) {
+    return Usage(absl::StrCat("--max_memory_mb = ", mb, " is outside [0, 2^43)"));
   }
   if (const absl::Duration timeout = absl::GetFlag(FLAGS_timeout);
       !(timeout > absl::ZeroDuration())) {

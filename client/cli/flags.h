@@ -55,6 +55,7 @@ ABSL_DECLARE_FLAG(bool, derivs);
 ABSL_DECLARE_FLAG(bool, float32);
 ABSL_DECLARE_FLAG(std::string, steps);
 ABSL_DECLARE_FLAG(bool, compress);
+ABSL_DECLARE_FLAG(int64_t, max_memory_mb);
 ABSL_DECLARE_FLAG(bool, jacobian);
 ABSL_DECLARE_FLAG(bool, quality);
 ABSL_DECLARE_FLAG(bool, deviation);
@@ -91,7 +92,6 @@ ABSL_DECLARE_FLAG(std::string, service);
 // serve
 ABSL_DECLARE_FLAG(std::string, address);
 ABSL_DECLARE_FLAG(std::string, store);
-ABSL_DECLARE_FLAG(int64_t, max_memory_mb);
 ABSL_DECLARE_FLAG(std::string, redis_password_file);
 ABSL_DECLARE_FLAG(int, threads);
 ABSL_DECLARE_FLAG(int64_t, memory_budget_mb);

@@ -103,10 +103,6 @@ absl::StatusOr<bool> DeformIsSmall(const OpsContext& context, const DeformReques
   SG_ASSIGN_OR_RETURN(
       const std::shared_ptr<const GridRevision> reference,
       grid->ResolveRevision(request.reference_revision, std::nullopt, "reference_revision"));
-  if (context.deformers.HasReady(ShapeKey(grid->id, reference->number, request.options),
-                                 request.check_level)) {
-    return true;
-  }
   int64_t controls = 0, cells = 0;
   for (const BlockFit& block : reference->blocks) {
     controls += block.fitted.spline.num_control_points();
@@ -117,7 +113,11 @@ absl::StatusOr<bool> DeformIsSmall(const OpsContext& context, const DeformReques
     }
     cells += block_cells;
   }
-  return controls <= kSmallDeformerControls && cells <= kSmallDeformerCells;
+  const int64_t sweeps = std::max<int64_t>(request.options.smoothing_iterations, 1);
+  if (controls * sweeps > kSmallDeformControlSweeps) return false;
+  return context.deformers.HasReady(ShapeKey(grid->id, reference->number, request.options),
+                                    request.check_level) ||
+         (controls <= kSmallDeformerControls && cells <= kSmallDeformerCells);
 }
 
 absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& context,

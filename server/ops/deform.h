@@ -41,14 +41,17 @@ bool HasKeptDeformer(const OpsContext& context, const DeformRequest& request);
 
 // A deformer smaller than this is cheap enough to build in a slice of work (about 0.5 ms of
 // classifying the controls and 5 ms of the fold gate at these sizes: BM_DeformerCreate,
-// BM_DeformCheck): controls of the reference, and cells of its fold gate at the check level.
+// BM_DeformCheck): controls of the reference, and cells of its fold gate at the check level;
+// and a deform of at most kSmallDeformControlSweeps control updates (controls times the
+// smoothing iterations of DeformOptions, each a Jacobi sweep over the net).
 inline constexpr int64_t kSmallDeformerControls = int64_t{1} << 14;
 inline constexpr int64_t kSmallDeformerCells = int64_t{1} << 17;
+inline constexpr int64_t kSmallDeformControlSweeps = int64_t{1} << 20;
 
-// Whether the deform `request` asks for is small work once its grid is read: its deformer is
-// kept, or building it and its fold gate is (kSmall*). Reads the grid (NOT_FOUND, and the
-// reference's errors, as Deform would answer). The service runs small deforms as a slice, so
-// that a solver's first step after a start or a failover does not wait behind other
+// Whether the deform `request` asks for is small work once its grid is read: its smoothing is
+// small and its deformer is kept, or building it and its fold gate is (kSmall*). Reads the grid
+// (NOT_FOUND, and the reference's errors, as Deform would answer). The service runs small deforms
+// as a slice, so that a solver's first step after a start or a failover does not wait behind other
 // principals' fits for the long workers.
 absl::StatusOr<bool> DeformIsSmall(const OpsContext& context, const DeformRequest& request);
 

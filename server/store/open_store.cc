@@ -14,7 +14,7 @@ absl::StatusOr<std::unique_ptr<GridStore>> OpenStore(const ServerOptions& option
   if (!options.redis_password_file.empty() && !spec.starts_with("redis://")) {
     return absl::InvalidArgumentError(
         absl::StrCat("--redis_password_file is for a redis:// store, and --store = '",
-                     RedactRedisSpec(spec.substr(0, 200)), "' is none"));
+                     RedactRedisSpec(spec).substr(0, 200), "' is none"));
   }
   if (spec == "memory") return std::make_unique<MemoryStore>(options.max_deform_revisions);
   if (spec.starts_with("dir:")) {
@@ -27,7 +27,7 @@ absl::StatusOr<std::unique_ptr<GridStore>> OpenStore(const ServerOptions& option
   }
   if (spec.starts_with("redis://")) return OpenRedisStore(spec, options, budget);
   return absl::InvalidArgumentError(
-      absl::StrCat("--store = '", RedactRedisSpec(spec.substr(0, 200)),
+      absl::StrCat("--store = '", RedactRedisSpec(spec).substr(0, 200),
                    "' is not a store: give memory, dir:PATH or redis://HOST:PORT[/DB]"));
 }
 

@@ -24,7 +24,7 @@ constexpr size_t kMaxPasswordFileBytes = 4096;
 
 absl::Status BadSpec(std::string_view spec, std::string_view why) {
   return absl::InvalidArgumentError(
-      absl::StrCat("--store = '", RedactRedisSpec(spec.substr(0, 200)), "': ", Absl(why),
+      absl::StrCat("--store = '", RedactRedisSpec(spec).substr(0, 200), "': ", Absl(why),
                    "; a Redis store is redis://[USER[:PASSWORD]@]HOST:PORT[/DB]"));
 }
 
@@ -89,11 +89,12 @@ std::string RedactRedisSpec(std::string_view spec) {
   const size_t scheme = spec.find("://");
   if (scheme == std::string_view::npos) return std::string(spec);
   const size_t at = spec.rfind('@');
+  if (at == std::string_view::npos || at < scheme) return std::string(spec);
+  // USER:***@, or ***@ for credentials without a colon (a user, or a password typed without the
+  // colon before it: not shown either way).
   const size_t colon = spec.find(':', scheme + 3);
-  if (at == std::string_view::npos || colon == std::string_view::npos || colon > at) {
-    return std::string(spec);
-  }
-  return absl::StrCat(Absl(spec.substr(0, colon + 1)), "***", Absl(spec.substr(at)));
+  const size_t keep = colon != std::string_view::npos && colon < at ? colon + 1 : scheme + 3;
+  return absl::StrCat(Absl(spec.substr(0, keep)), "***", Absl(spec.substr(at)));
 }
 
 absl::StatusOr<std::string> RedisPassword(const RedisAddress& address) {

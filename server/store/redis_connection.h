@@ -62,8 +62,10 @@ struct RedisAddress {
 // the spec without its password (RedactRedisSpec).
 absl::StatusOr<RedisAddress> ParseRedisSpec(std::string_view spec);
 
-// `spec` with the password of its SCHEME://USER:PASSWORD@ part, if any, replaced by "***": what
-// messages and the server's banner show of a --store flag (anything else is returned unchanged).
+// `spec` with the password of its SCHEME://USER:PASSWORD@ part, if any, replaced by "***" (and
+// credentials without a colon, SCHEME://X@, by "***@": X may be a password typed without the
+// colon): what messages and the server's banner show of a --store flag (anything else is
+// returned unchanged).
 std::string RedactRedisSpec(std::string_view spec);
 
 // The password of `address`: the one given, or the first line of its password_file (at most

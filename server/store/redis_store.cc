@@ -442,7 +442,10 @@ absl::Status RedisStore::Ping(std::unique_ptr<RedisConnection>& connection, bool
 void RedisStore::FollowHealth() {
   std::unique_ptr<RedisConnection> connection;
   std::unique_lock<std::mutex> lock(health_mu_);
-  while (!stopping_) {
+  for (int64_t pings = 0; !stopping_; ++pings) {
+    // With credentials, log in afresh every 20 checks (10 s by default): a connection that is
+    // logged in stays so after the password changed, while new ones would be refused.
+    if (pool_.address().has_credentials() && pings % 20 == 19) connection.reset();
     lock.unlock();
     bool stale = false;
     const absl::Status status = Ping(connection, &stale);
@@ -472,9 +475,10 @@ absl::StatusOr<std::unique_ptr<GridStore>> OpenRedisStore(const std::string& spe
     address.password_file = options.password_file;
   }
   if (!address.user.empty() && !address.has_credentials()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--store = '", RedactRedisSpec(spec), "' names user '", address.user.substr(0, 64),
-        "' without a password: give it with --redis_password_file or as USER:PASSWORD@"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--store = '", RedactRedisSpec(spec),
+                     "' names a user without a password: give it with --redis_password_file or as "
+                     "USER:PASSWORD@"));
   }
   if (options.max_deform_revisions < 1) {
     return absl::InvalidArgumentError(absl::StrCat(

@@ -27,8 +27,8 @@ TEST(CallMetrics, CountsByMethodAndCodeWithInclusiveCumulativeBuckets) {
   std::string before;
   metrics.AppendText(&before);
   const uint64_t ok = metrics.calls("WatchGrid", absl::StatusCode::kOk);
-  metrics.Record("WatchGrid", absl::StatusCode::kOk, absl::Milliseconds(1));     // le="0.001"
-  metrics.Record("WatchGrid", absl::StatusCode::kOk, absl::Milliseconds(3));     // le="0.005"
+  metrics.Record("WatchGrid", absl::StatusCode::kOk, absl::Milliseconds(1));  // le="0.001"
+  metrics.Record("WatchGrid", absl::StatusCode::kOk, absl::Milliseconds(3));  // le="0.005"
   metrics.Record("WatchGrid", absl::StatusCode::kNotFound, absl::Seconds(400));  // +Inf only
   metrics.Record("NoSuchMethod", absl::StatusCode::kInternal, absl::Microseconds(1));
   std::string after;
@@ -45,7 +45,8 @@ TEST(CallMetrics, CountsByMethodAndCodeWithInclusiveCumulativeBuckets) {
   EXPECT_EQ(delta(bucket + R"("300"} )"), 2);
   EXPECT_EQ(delta(bucket + R"("+Inf"} )"), 3);
   EXPECT_EQ(delta(R"(splinegrid_call_duration_seconds_count{method="WatchGrid"} )"), 3);
-  EXPECT_NEAR(delta(R"(splinegrid_call_duration_seconds_sum{method="WatchGrid"} )"), 400.004, 1e-6);
+  EXPECT_NEAR(delta(R"(splinegrid_call_duration_seconds_sum{method="WatchGrid"} )"), 400.004,
+              1e-6);
   EXPECT_EQ(delta(R"(splinegrid_calls_total{method="WatchGrid",code="NOT_FOUND"} )"), 1);
   EXPECT_GE(LineValue(after, R"(splinegrid_calls_total{method="other",code="INTERNAL"} )"), 1);
 }

@@ -1,13 +1,13 @@
 // Imports hold memory for what arrived, not for what the header announced; quiet import
 // streams are ended after --import_idle_timeout; the Plot3D parser's memory is charged before it
 // runs (issue 12, point 4).
-#include <sys/resource.h>
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <thread>
+
+#include <sys/resource.h>
 
 #include "gmock/gmock.h"
 #include "tests/server/service_fixture.h"

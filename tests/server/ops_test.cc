@@ -162,8 +162,9 @@ TEST_F(OpsTest, EveryCreationOfAnIdHasItsOwnIncarnation) {
   EXPECT_NE(drawn, second->incarnation);
 }
 
-// The memory and dir: stores keep what retention keeps of a grid created with many deformed
-// revisions (an imported archive), as the Redis store does (RedisStoreTest).
+// The memory store (and so the dir: store, the same class with a log) keeps what retention keeps
+// of a grid created with many deformed revisions (an imported archive), as the Redis store does
+// (RedisStoreTest).
 TEST_F(OpsTest, ACreatedGridKeepsOnlyTheDeformedRevisionsRetentionKeeps) {
   auto grid = std::make_shared<StoredGrid>(*store_.Get("naca").value());
   grid->id = "imported";

@@ -565,7 +565,6 @@ TEST_F(RedisStoreTest, RetentionDropsOldDeformedRevisionsAndNumbersAreNeverReuse
   EXPECT_THAT(Numbers(*a_->Get("g").value()), ElementsAre(1, 4, 5, 6));
 }
 
-// Revision numbers of any size survive the script's number encoding (varints of 1-3 bytes).
 // A grid created with more deformed revisions than retention keeps (an imported archive) keeps
 // the newest ones, as if they had been deformed here; a trial's import kept all 64 under
 // --keep_revisions=5 until the next deform.
@@ -583,6 +582,7 @@ TEST_F(RedisStoreTest, ACreatedGridKeepsOnlyTheDeformedRevisionsRetentionKeeps) 
   EXPECT_THAT(Numbers(*a_->Get("imported").value()), ElementsAre(1, 6, 7));
 }
 
+// Revision numbers of any size survive the script's number encoding (varints of 1-3 bytes).
 TEST_F(RedisStoreTest, ImportedNumbersAreKeptAndContinued) {
   for (int64_t number : {127, 300, 20000}) {
     const std::string id = absl::StrCat("n", number);
@@ -911,7 +911,7 @@ TEST_F(RedisStoreTest, CredentialsAreParsedAndNeverQuoted) {
   EXPECT_EQ(server::RedactRedisSpec("redis://:s3cret@h:1"), "redis://:***@h:1");
   EXPECT_EQ(server::RedactRedisSpec("redis://:a@b/c@h:1"), "redis://:***@h:1");
   EXPECT_EQ(server::RedactRedisSpec("reddis://u:s3cret@h:1"), "reddis://u:***@h:1");
-  EXPECT_EQ(server::RedactRedisSpec("redis://u@h:1"), "redis://u@h:1");
+  EXPECT_EQ(server::RedactRedisSpec("redis://s3cret@h:1"), "redis://***@h:1");
   EXPECT_EQ(server::RedactRedisSpec("redis://h:1/2"), "redis://h:1/2");
   EXPECT_EQ(server::RedactRedisSpec("dir:/var/lib/a:b@c"), "dir:/var/lib/a:b@c");
 
@@ -928,7 +928,13 @@ TEST_F(RedisStoreTest, CredentialsAreParsedAndNeverQuoted) {
   }
   // A user needs a password; a password is given once.
   EXPECT_THAT(server::OpenRedisStore("redis://solver@h:1", options, &budget).status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, "user 'solver' without a password"));
+              StatusIs(absl::StatusCode::kInvalidArgument, "names a user without a password"));
+  // A long password is redacted before a message cuts the spec to 200 characters.
+  const std::string long_secret = std::string(300, 'q') + "s3cret";
+  const absl::Status long_spec =
+      server::OpenRedisStore("redis://u:" + long_secret + "@h:0", options, &budget).status();
+  EXPECT_EQ(long_spec.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(long_spec.message(), Not(HasSubstr("qqqq")));
   options.password_file = dir_ + "/unused";
   EXPECT_THAT(server::OpenRedisStore("redis://:pw@h:1", options, &budget).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, "give it once"));
@@ -965,13 +971,20 @@ TEST_F(RedisStoreTest, PasswordsFromTheSpecOrAFileAreSentOnEveryConnection) {
   ASSERT_TRUE(from_spec->Create(MakeGrid("g")).ok());
   EXPECT_TRUE(from_spec->Get("g").ok());
 
-  // An ACL user whose password needs escapes in a URL, on database 2.
+  // An ACL user with what deploy/README.md says it needs, whose password needs escapes in a
+  // URL, on database 2: it creates, deforms and reads.
   auto admin = server::RedisConnection::Open(Loopback(locked.port(), secret), {}).value();
-  ASSERT_TRUE(
-      admin->Command({"ACL", "SETUSER", "solver", "on", ">p@ss:w/rd%", "~*", "&*", "+@all"}).ok());
+  ASSERT_TRUE(admin
+                  ->Command({"ACL", "SETUSER", "solver", "on", ">p@ss:w/rd%", "~splinegrid:*",
+                             "+@all", "-@dangerous", "+info"})
+                  .ok());
   std::unique_ptr<GridStore> as_user =
       open("redis://solver:p%40ss%3Aw%2Frd%25@" + at + "/2").value();
   EXPECT_EQ(as_user->Get("g").status().code(), absl::StatusCode::kNotFound);  // database 2
+  ASSERT_TRUE(as_user->Create(MakeGrid("g2")).ok());
+  ASSERT_TRUE(as_user->AddRevision("g2", MakeRevision(RevisionOrigin::kFit)).ok());
+  EXPECT_EQ(Deform(*as_user, "g2"), 2);
+  EXPECT_THAT(Numbers(*as_user->Get("g2").value()), ElementsAre(1, 2));
   EXPECT_THAT(open("redis://solver:p%40ss@" + at).status(),
               StatusIs(absl::StatusCode::kUnavailable, "refuses the password of user 'solver'"));
 

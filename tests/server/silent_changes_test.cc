@@ -134,7 +134,8 @@ TEST_F(SilentChangesTest, DegenerateGridsAreRefusedAtImport) {
     }
   }
   EXPECT_THAT(client_->ImportPoints(flat, "flat", "").status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, "block 1: direction j has zero length"));
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       "block 1: direction j has zero length"));
   EXPECT_EQ(client_->List().value().size(), grids);
   // A polar disc (its j = 0 edge collapsed to the centre) is a legitimate grid.
   MultiBlockGrid disc;
