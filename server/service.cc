@@ -95,35 +95,37 @@ absl::StatusOr<AdmittedStream> AdmitStream(ServiceState& state,
   return AdmittedStream{std::move(caller), std::move(slot)};
 }
 
+namespace {
+
+// Finishes a unary call: its status (a cancellation explained), logged.
+std::function<void(const absl::Status&)> Finisher(const ServiceState* state,
+                                                  grpc::ServerUnaryReactor* reactor,
+                                                  grpc::CallbackServerContext* context,
+                                                  CallLog log) {
+  return [state, reactor, context, log = std::move(log)](const absl::Status& status) {
+    const absl::Status explained = ExplainCancellation(*state, context, status);
+    log.Finish(explained);
+    reactor->Finish(ToGrpcStatus(explained));
+  };
+}
+
+}  // namespace
+
 grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerContext* context,
                                                        CallLog log, Role needed, WorkKind kind,
                                                        Work work) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  absl::StatusOr<Caller> caller = AdmitCall(*state_, context, needed, &log);
-  if (!caller.ok()) {
-    log.Finish(caller.status());
-    reactor->Finish(ToGrpcStatus(caller.status()));
-    return reactor;
-  }
-  SG_HAPPENS_BEFORE(reactor);
-  const std::string principal = caller->principal;
-  auto task = [state = state_, reactor, context, log, caller = *std::move(caller),
-               work = std::move(work)] {
-    SG_HAPPENS_AFTER(reactor);
-    const absl::Status status = ExplainCancellation(*state, context, work(caller));
-    log.Finish(status);
-    reactor->Finish(ToGrpcStatus(status));
-  };
-  if (absl::Status status = state_->pool.TrySubmit(principal, kind, std::move(task));
-      !status.ok()) {
-    log.Finish(status);
-    reactor->Finish(ToGrpcStatus(status));
-  }
-  return reactor;
+  return RunSizedOnPool(context, std::move(log), needed, kind, nullptr, std::move(work));
 }
 
 grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServerContext* context,
                                                             CallLog log, Role needed,
+                                                            SizeUp size_up, Work work) {
+  return RunSizedOnPool(context, std::move(log), needed, WorkKind::kSlice, std::move(size_up),
+                        std::move(work));
+}
+
+grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServerContext* context,
+                                                            CallLog log, Role needed, WorkKind kind,
                                                             SizeUp size_up, Work work) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   absl::StatusOr<Caller> caller = AdmitCall(*state_, context, needed, &log);
@@ -134,17 +136,14 @@ grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServer
   }
   SG_HAPPENS_BEFORE(reactor);
   const std::string principal = caller->principal;
-  auto finish = [state = state_, reactor, context, log](const absl::Status& status) {
-    const absl::Status explained = ExplainCancellation(*state, context, status);
-    log.Finish(explained);
-    reactor->Finish(ToGrpcStatus(explained));
-  };
-  auto slice = [state = state_, reactor, caller = *std::move(caller), size_up = std::move(size_up),
-                work = std::move(work), finish] {
+  auto finish = Finisher(state_, reactor, context, std::move(log));
+  auto task = [state = state_, reactor, caller = *std::move(caller), size_up = std::move(size_up),
+               work = std::move(work), finish] {
     SG_HAPPENS_AFTER(reactor);
-    // An error of the sizing (the grid is not there, say) is left to `work`, which fails early
-    // with the answer and the precedence of its own checks (ownership before a bad reference).
-    const absl::StatusOr<bool> small = size_up(caller);
+    // Unsized work runs here. An error of the sizing (the grid is not there, say) is left to
+    // `work`, which fails early with the answer and the precedence of its own checks
+    // (ownership before a bad reference).
+    const absl::StatusOr<bool> small = size_up ? size_up(caller) : true;
     if (!small.ok() || *small) {
       finish(work(caller));
       return;
@@ -162,7 +161,7 @@ grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServer
       finish(status);
     }
   };
-  if (absl::Status status = state_->pool.TrySubmit(principal, WorkKind::kSlice, std::move(slice));
+  if (absl::Status status = state_->pool.TrySubmit(principal, kind, std::move(task));
       !status.ok()) {
     finish(status);
   }

@@ -162,6 +162,9 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   using SizeUp = std::function<absl::StatusOr<bool>(const Caller&)>;
   grpc::ServerUnaryReactor* RunSizedOnPool(grpc::CallbackServerContext* context, CallLog log,
                                            Role needed, SizeUp size_up, Work work);
+  // Both: the first task runs as `kind`; without `size_up` (null) `work` runs in it.
+  grpc::ServerUnaryReactor* RunSizedOnPool(grpc::CallbackServerContext* context, CallLog log,
+                                           Role needed, WorkKind kind, SizeUp size_up, Work work);
   // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.
   grpc::ServerUnaryReactor* RunInline(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, const Work& work);

@@ -305,14 +305,19 @@ TEST(EllipticTest, AStallAtTheSmallestFactorEndsItUnconverged) {
   EXPECT_EQ(grid.quality.negative_cells, 0);
 }
 
-// The control functions cost about 2 us a point: a 4097 x 2049 grid took 15 s, in which a
-// GenerateGrid overran its deadline because nothing polled. Every layer polls now.
-TEST(EllipticTest, TrackingControlsPollsTheCancelCheckEveryLayer) {
+// A small transfinite O-grid around the RAE 2822 (65 wall points, 8 layers).
+ProfileGrid SmallTransfiniteGrid() {
   ProfileGridOptions options;
   options.method = LayerMethod::kTransfinite;
   options.wall_points = 65;
   options.layers = 8;
-  const ProfileGrid grid = GenerateProfileGrid(Coordinates("rae2822"), options).value();
+  return GenerateProfileGrid(Coordinates("rae2822"), options).value();
+}
+
+// The control functions cost about 2 us a point: a 4097 x 2049 grid took 15 s, in which a
+// GenerateGrid overran its deadline because nothing polled. Every layer polls now.
+TEST(EllipticTest, TrackingControlsPollsTheCancelCheckEveryLayer) {
+  const ProfileGrid grid = SmallTransfiniteGrid();
   int polls = 0;
   ASSERT_TRUE(TrackingControls(grid.block, 0, [&] { return ++polls > 1000; }).ok());
   EXPECT_EQ(polls, grid.block.extent(1));
@@ -323,11 +328,7 @@ TEST(EllipticTest, TrackingControlsPollsTheCancelCheckEveryLayer) {
 }
 
 TEST(EllipticTest, RejectsBadOptionsAndGrids) {
-  ProfileGridOptions options;
-  options.method = LayerMethod::kTransfinite;
-  options.wall_points = 65;
-  options.layers = 8;
-  const ProfileGrid grid = GenerateProfileGrid(Coordinates("rae2822"), options).value();
+  const ProfileGrid grid = SmallTransfiniteGrid();
   const ControlFunctions control = TrackingControls(grid.block, 0).value();
   EllipticOptions bad;
   bad.relaxation = 2.0;
