@@ -65,25 +65,37 @@ CgroupPaths ParseProcSelfCgroup(absl::string_view text) {
 MemoryLimit FindMemoryLimit(
     const std::function<std::optional<std::string>(const std::string&)>& read_file,
     int64_t physical_bytes, const std::string& root) {
-  MemoryLimit limit{physical_bytes, "physical memory"};
+  MemoryLimit limit{physical_bytes, "physical memory", std::nullopt};
   const std::optional<std::string> self = read_file("/proc/self/cgroup");
   const CgroupPaths paths = ParseProcSelfCgroup(self.value_or(""));
-  auto consider = [&](const std::string& file) {
+  std::optional<int64_t> headroom;
+  auto consider = [&](const std::string& file, const std::string& usage_file) {
     const std::optional<std::string> text = read_file(file);
     if (!text) return;
     const absl::StatusOr<std::optional<int64_t>> bytes = ParseCgroupLimit(*text);
-    if (bytes.ok() && bytes->has_value() && **bytes < limit.bytes) {
-      limit = MemoryLimit{**bytes, absl::StrCat("cgroup limit (", file, ")")};
+    if (!bytes.ok() || !bytes->has_value()) return;
+    if (**bytes < limit.bytes) {
+      limit = MemoryLimit{**bytes, absl::StrCat("cgroup limit (", file, ")"), std::nullopt};
+    }
+    const std::optional<std::string> usage_text = read_file(usage_file);
+    const absl::StatusOr<std::optional<int64_t>> usage =
+        usage_text ? ParseCgroupLimit(*usage_text) : absl::NotFoundError(usage_file);
+    if (usage.ok() && usage->has_value()) {
+      const int64_t left = std::max<int64_t>(0, **bytes - **usage);
+      headroom = headroom ? std::min(*headroom, left) : left;
     }
   };
   // Without a /proc/self/cgroup line the mount's own files are still the process's group in a
   // container with a cgroup namespace, so the root files are always read.
   for (const std::string& group : GroupAndAncestors(paths.v2)) {
-    consider(absl::StrCat(root, group, "/memory.max"));
+    const std::string dir = absl::StrCat(root, group);
+    consider(dir + "/memory.max", dir + "/memory.current");
   }
   for (const std::string& group : GroupAndAncestors(paths.v1_memory)) {
-    consider(absl::StrCat(root, "/memory", group, "/memory.limit_in_bytes"));
+    const std::string dir = absl::StrCat(root, "/memory", group);
+    consider(dir + "/memory.limit_in_bytes", dir + "/memory.usage_in_bytes");
   }
+  limit.headroom = headroom;
   return limit;
 }
 

@@ -39,6 +39,11 @@ CgroupPaths ParseProcSelfCgroup(absl::string_view text);
 struct MemoryLimit {
   int64_t bytes = 0;
   std::string source;  // "physical memory" or "cgroup limit (FILE)"
+  // What the most constrained group has left: the smallest limit minus usage (memory.current,
+  // memory.usage_in_bytes beside the limit file) over the groups with a limit; unset without a
+  // cgroup limit or when no usage can be read. A process sharing its group with others (a
+  // batch job's allocation) may use only this much more.
+  std::optional<int64_t> headroom;
 };
 
 // The effective limit: the smallest limit among the cgroup files of the process's groups and

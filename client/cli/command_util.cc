@@ -165,10 +165,9 @@ std::string IdFromPath(const std::string& path) {
   return id.substr(0, 63);
 }
 
-// Three quarters of the memory this process may use: MemAvailable (/proc/meminfo), or the
-// memory limit of its cgroup when that is lower (a container, a batch job's allocation; the
-// server's budget reads the same limit, server/memory_limit.h). 0, no limit, when neither can
-// be read.
+// Three quarters of the memory this process may use: MemAvailable (/proc/meminfo), or what its
+// cgroup has left under its limit when that is lower (a container, a batch job's allocation
+// shared with a solver; server/memory_limit.h). 0, no limit, when neither can be read.
 int64_t EvaluationMemoryLimit() {
   int64_t available = 0;
   std::ifstream meminfo("/proc/meminfo");
@@ -179,8 +178,10 @@ int64_t EvaluationMemoryLimit() {
       break;
     }
   }
+  // What the cgroup has left when it says (shared with a solver in one job, say), else its limit.
   const server::MemoryLimit limit = server::DetectMemoryLimit();
-  if (limit.bytes > 0 && (available == 0 || limit.bytes < available)) available = limit.bytes;
+  const int64_t group = limit.headroom.value_or(limit.bytes);
+  if (group > 0 && (available == 0 || group < available)) available = group;
   return available / 4 * 3;
 }
 

@@ -33,8 +33,8 @@ std::unique_ptr<client::Client> Connect(const client::RetryPolicy& retry = {});
 // The same for an evaluation written to a file whose writer holds `output_copies` copies of
 // the values at its peak (OutputCopies in grid_output.h): the client refuses, at the
 // evaluation's header, one whose copies would not fit in --max_memory_mb, by default three
-// quarters of the memory available to this process (MemAvailable, or its cgroup's limit if
-// lower).
+// quarters of the memory available to this process (MemAvailable, or what its cgroup has left
+// under its limit if lower).
 std::unique_ptr<client::Client> ConnectForEvaluation(double output_copies);
 
 // Prints `human`, or with --json `message` as JSON, to stdout.

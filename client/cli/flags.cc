@@ -93,8 +93,8 @@ ABSL_FLAG(
 ABSL_FLAG(bool, compress, true, "eval: zlib-compress VTK XML data (--nocompress: raw)");
 ABSL_FLAG(int64_t, max_memory_mb, 0,
           "eval/offset -o: memory an evaluation may take here while it is received and written "
-          "(MiB; 0: three quarters of what is available: MemAvailable, or the cgroup limit if "
-          "lower); larger ones are refused when their header arrives");
+          "(MiB; 0: three quarters of what is available: MemAvailable, or what the cgroup has "
+          "left under its limit if lower); larger ones are refused when their header arrives");
 ABSL_FLAG(bool, jacobian, false, "eval: VTK point field 'jacobian' of the spline mapping");
 ABSL_FLAG(bool, quality, false, "eval: VTK cell field 'scaled_jacobian' (1 ideal, <= 0 folded)");
 ABSL_FLAG(bool, deviation, false,

@@ -82,6 +82,25 @@ TEST(FindMemoryLimitTest, V2LimitOfTheGroupOrAnAncestor) {
   EXPECT_EQ(limit.source, "cgroup limit (/sys/fs/cgroup/kubepods/pod1/memory.max)");
 }
 
+// What a limited group has left, for a client sharing it (the CLI's evaluation guard): the
+// smallest limit minus usage over the limited groups.
+TEST(FindMemoryLimitTest, HeadroomIsTheLeastThatALimitedGroupHasLeft) {
+  FakeFiles fs;
+  fs.files["/proc/self/cgroup"] = "0::/job/step\n";
+  fs.files["/sys/fs/cgroup/job/step/memory.max"] = "max\n";
+  fs.files["/sys/fs/cgroup/job/step/memory.current"] = "100\n";
+  fs.files["/sys/fs/cgroup/job/memory.max"] = "4294967296\n";      // 4 GiB
+  fs.files["/sys/fs/cgroup/job/memory.current"] = "3221225472\n";  // 3 GiB used
+  fs.files["/sys/fs/cgroup/memory.max"] = "8589934592\n";          // 8 GiB
+  fs.files["/sys/fs/cgroup/memory.current"] = "1073741824\n";      // 1 GiB used
+  const MemoryLimit limit = FindMemoryLimit(fs.reader(), 24 * kGiB);
+  EXPECT_EQ(limit.bytes, 4 * kGiB);
+  EXPECT_EQ(limit.headroom, kGiB);
+  fs.files["/sys/fs/cgroup/job/memory.current"] = "5368709120\n";  // over its limit
+  EXPECT_EQ(FindMemoryLimit(fs.reader(), 24 * kGiB).headroom, 0);
+  EXPECT_FALSE(FindMemoryLimit(FakeFiles().reader(), 24 * kGiB).headroom.has_value());
+}
+
 TEST(FindMemoryLimitTest, V2InACgroupNamespaceReadsTheMountRoot) {
   FakeFiles fs;
   fs.files["/proc/self/cgroup"] = "0::/\n";
@@ -115,14 +134,15 @@ TEST(FindMemoryLimitTest, LimitAbovePhysicalMemoryIsPhysical) {
 }
 
 TEST(ChooseMemoryBudgetTest, HalfOfTheLimitUnlessRequested) {
-  const BudgetChoice auto_budget = ChooseMemoryBudget(0, MemoryLimit{24 * kGiB, "physical memory"});
+  const BudgetChoice auto_budget =
+      ChooseMemoryBudget(0, MemoryLimit{24 * kGiB, "physical memory", {}});
   EXPECT_EQ(auto_budget.bytes, 12 * kGiB);
   EXPECT_EQ(auto_budget.description, "12288 MiB (50% of physical memory 24576 MiB)");
-  const BudgetChoice flag = ChooseMemoryBudget(64 * kMiB, MemoryLimit{24 * kGiB, "x"});
+  const BudgetChoice flag = ChooseMemoryBudget(64 * kMiB, MemoryLimit{24 * kGiB, "x", {}});
   EXPECT_EQ(flag.bytes, 64 * kMiB);
   EXPECT_EQ(flag.description, "64 MiB (--memory_budget_mb)");
   // A tiny limit still leaves a usable budget.
-  EXPECT_EQ(ChooseMemoryBudget(0, MemoryLimit{1000, "cgroup"}).bytes, kMiB);
+  EXPECT_EQ(ChooseMemoryBudget(0, MemoryLimit{1000, "cgroup", {}}).bytes, kMiB);
 }
 
 TEST(DetectMemoryLimitTest, ThisMachineHasAPositiveLimit) {
