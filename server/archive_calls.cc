@@ -149,10 +149,10 @@ class ImportArchiveReactor : public UploadReactor<v1::ImportArchiveRequest> {
     std::string owner = caller_.role == Role::kAdmin ? grid->owner : caller_.owner();
     SG_RETURN_IF_ERROR(ops::StoreArchived(state_->Ops(), grid, assembler_->stated_connectivity(),
                                           std::move(owner)));
-    // The reply shows what was stored: retention (--keep_revisions) may have dropped the oldest
-    // deformed revisions of the archive. (The archive's grid if it is gone again already.)
-    const absl::StatusOr<std::shared_ptr<const StoredGrid>> stored = state_->store->Get(grid->id);
-    return EncodeGrid(stored.ok() ? **stored : *grid, 0, v1::GRID_VIEW_BASIC, {}, response_);
+    // The reply shows what was stored: the store kept the newest --keep_revisions deformed
+    // revisions of the archive (GridStore::Create), as this does.
+    return EncodeGrid(*WithinRetention(grid, state_->options.max_deform_revisions), 0,
+                      v1::GRID_VIEW_BASIC, {}, response_);
   }
 
   v1::Grid* response_;

@@ -2,7 +2,10 @@
 // would drive it (revisions stamped with time and step, addressable by step), control
 // displacements and boundary points, every error without side effects, concurrent writers, and
 // the retention of deformed revisions.
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include "absl/synchronization/notification.h"
@@ -323,6 +326,30 @@ TEST_F(DeformTest, AFirstSmallDeformDoesNotWaitForTheLongWorkers) {
   release.Notify();
   EXPECT_TRUE(large_done.WaitForNotificationWithTimeout(absl::Seconds(30)));
   deform.join();
+}
+
+// An archive's deformed revisions beyond the server's --keep_revisions are dropped when it is
+// imported, and the import's reply says what was kept (it listed all of them, and the store
+// kept them all until the next deform).
+TEST_F(DeformTest, AnImportedArchiveKeepsWhatRetentionKeeps) {
+  ImportAndFit("grids/n0012_113-33.p2dfmt", "naca");
+  for (int step = 1; step <= 6; ++step)
+    ASSERT_TRUE(client_->Deform(Pitch("naca", step, step)).ok());
+  const std::string path =
+      ::testing::TempDir() + "/retention-" + std::to_string(getpid()) + ".sgrid";
+  ASSERT_TRUE(client_->ExportGrid("naca", path).ok());
+  options_.max_deform_revisions = 2;
+  StartServer();
+  const absl::StatusOr<v1::Grid> imported = client_->ImportArchive(path, "copy");
+  ASSERT_TRUE(imported.ok()) << imported.status();
+  auto numbers = [](const v1::Grid& grid) {
+    std::vector<int64_t> out;
+    for (const v1::RevisionInfo& r : grid.revisions()) out.push_back(r.revision());
+    return out;
+  };
+  EXPECT_THAT(numbers(*imported), ::testing::ElementsAre(1, 6, 7));
+  EXPECT_THAT(numbers(client_->Get("copy").value()), ::testing::ElementsAre(1, 6, 7));
+  std::remove(path.c_str());
 }
 
 TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
