@@ -245,23 +245,21 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
             absl::StrCat(result.message(), " [attempt ", attempts,
                          "; each earlier one ended UNAVAILABLE or was reset, and was made again]"));
       }
-      // A TLS server closes a plaintext connection at once; say what that usually means.
-      if (absl::IsUnavailable(result) && !options_.use_tls &&
-          absl::StrContains(result.message(), "Socket closed")) {
-        result = absl::Status(result.code(),
-                              absl::StrCat(result.message(),
-                                           " (the server closed the connection: if it uses TLS, "
-                                           "give its CA: --tls_ca, ClientOptions.tls_root_certs)"));
-      }
-      // A server that asks for client certificates closes a TLS connection without one.
-      if (absl::IsUnavailable(result) && options_.use_tls && options_.tls_cert_chain.empty() &&
-          absl::StrContains(result.message(), "Socket closed")) {
-        result =
-            absl::Status(result.code(),
-                         absl::StrCat(result.message(),
-                                      " (the server closed the connection: if it asks for client "
-                                      "certificates (mTLS), give yours: --tls_cert and --tls_key, "
-                                      "ClientOptions.tls_cert_chain and tls_private_key)"));
+      // A TLS server closes a plaintext connection at once, and a server that asks for client
+      // certificates a TLS connection without one; say what that usually means.
+      if (absl::IsUnavailable(result) && absl::StrContains(result.message(), "Socket closed")) {
+        const char* hint =
+            !options_.use_tls
+                ? "if it uses TLS, give its CA: --tls_ca, ClientOptions.tls_root_certs"
+            : options_.tls_cert_chain.empty()
+                ? "if it asks for client certificates (mTLS), give yours: --tls_cert and "
+                  "--tls_key, ClientOptions.tls_cert_chain and tls_private_key"
+                : nullptr;
+        if (hint != nullptr) {
+          result = absl::Status(
+              result.code(),
+              absl::StrCat(result.message(), " (the server closed the connection: ", hint, ")"));
+        }
       }
       return result;
     }

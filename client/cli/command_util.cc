@@ -79,6 +79,13 @@ absl::StatusOr<std::vector<v1::FaceKind>> ParseFaceFlag(const std::string& text)
   return out;
 }
 
+// The settings of PrepareConnection with --timeout.
+client::ClientOptions CommandOptions() {
+  client::ClientOptions options = ConnectionOptions();
+  options.timeout = absl::GetFlag(FLAGS_timeout);
+  return options;
+}
+
 }  // namespace
 
 absl::Status Usage(const std::string& message) { return absl::InvalidArgumentError(message); }
@@ -92,15 +99,13 @@ std::string ServerAddress() {
 }
 
 std::unique_ptr<client::Client> Connect(const client::RetryPolicy& retry) {
-  client::ClientOptions options = ConnectionOptions();
-  options.timeout = absl::GetFlag(FLAGS_timeout);
+  client::ClientOptions options = CommandOptions();
   options.retry = retry;
   return client::Client::Connect(ServerAddress(), options);
 }
 
 std::unique_ptr<client::Client> ConnectForEvaluation(double output_copies) {
-  client::ClientOptions options = ConnectionOptions();
-  options.timeout = absl::GetFlag(FLAGS_timeout);
+  client::ClientOptions options = CommandOptions();
   if (const int64_t mb = absl::GetFlag(FLAGS_max_memory_mb); mb > 0) {
     options.max_evaluation_bytes = mb << 20;
   }

@@ -228,20 +228,16 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                         translated = SplinegridError(
                             translated.code, f"{translated.message} [attempt {attempts}; each "
                             "earlier one ended UNAVAILABLE or was reset, and was made again]")
-                    if (translated.code == "UNAVAILABLE" and not self._tls
+                    # A TLS server closes a plaintext connection at once, and a server that
+                    # asks for client certificates a TLS connection without one.
+                    hint = ("if it uses TLS, give its CA: tls_ca=" if not self._tls else
+                            "if it asks for client certificates (mTLS), give yours: tls_cert= "
+                            "and tls_key=" if not self._client_cert else None)
+                    if (hint and translated.code == "UNAVAILABLE"
                             and "Socket closed" in translated.message):
-                        # A TLS server closes a plaintext connection at once.
                         translated = SplinegridError(
-                            translated.code, f"{translated.message} (the server closed the "
-                            "connection: if it uses TLS, give its CA: tls_ca=)")
-                    elif (translated.code == "UNAVAILABLE" and self._tls and not self._client_cert
-                            and "Socket closed" in translated.message):
-                        # A server that asks for client certificates closes a TLS connection
-                        # without one.
-                        translated = SplinegridError(
-                            translated.code, f"{translated.message} (the server closed the "
-                            "connection: if it asks for client certificates (mTLS), give yours: "
-                            "tls_cert= and tls_key=)")
+                            translated.code,
+                            f"{translated.message} (the server closed the connection: {hint})")
                     raise translated from error
             self._pause_before_retry(wait)
 
