@@ -13,6 +13,11 @@
 //                                         multigrid's fine work units;
 //                                         tolerance 1e-2, 1e-3 (the default) or 1e-4 of the
 //                                         local spacing per sweep
+//   BM_TrackingControls/<airfoil>       the control functions of the 257 x 129 algebraic grid
+//                                         (elliptic.h TrackingControls: psi by a safeguarded
+//                                         Newton iteration per point); beside it, in the same
+//                                         run, the baseline: one relaxation sweep of the same
+//                                         grid, and sweeps = controls / sweep
 //   BM_GenerateVolume/layers:<n>         the shared ONERA M6 wing's 9 surface blocks (16,001
 //                                         points) marched outward to 5 with a first layer of
 //                                         1e-4 (core/generate/surface_offset.h); beside it, in
@@ -119,6 +124,46 @@ BENCHMARK(BM_EllipticCoarseToFine)
     ->ArgNames({"airfoil", "tolerance_exp"})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
+
+void BM_TrackingControls(benchmark::State& state) {
+  const std::string name = kAirfoils[state.range(0)];
+  absl::StatusOr<AirfoilCoordinates> coordinates = ReadAirfoilFile(AirfoilPath(name));
+  if (!coordinates.ok()) return state.SkipWithError(coordinates.status().ToString().c_str());
+  ProfileGridOptions options;  // 257 x 129, first 1e-5, far 50
+  options.method = LayerMethod::kTransfinite;
+  absl::StatusOr<ProfileGrid> grid = GenerateProfileGrid(coordinates->points, options);
+  if (!grid.ok()) return state.SkipWithError(grid.status().ToString().c_str());
+  const StructuredBlock& algebraic = grid->block;
+  ControlFunctions control;
+  double controls = 1e300;  // the fastest iteration's seconds
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<ControlFunctions> computed = TrackingControls(algebraic, 0);
+    controls = std::min(
+        controls, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!computed.ok()) return state.SkipWithError(computed.status().ToString().c_str());
+    control = *std::move(computed);
+  }
+  // The baseline: one sweep of the line relaxation on the same grid, the best of five.
+  EllipticOptions one;
+  one.max_sweeps = 1;
+  double sweep = 1e300;
+  for (int k = 0; k < 5; ++k) {
+    absl::StatusOr<EllipticResult> relaxed = SmoothElliptic(algebraic, control, 1, one);
+    if (!relaxed.ok()) return state.SkipWithError(relaxed.status().ToString().c_str());
+    sweep = std::min(sweep, relaxed->seconds);
+  }
+  state.SetLabel(name);
+  state.counters["points"] = static_cast<double>(algebraic.num_points());
+  state.counters["controls_ms"] = controls * 1e3;
+  state.counters["sweep_ms"] = sweep * 1e3;
+  state.counters["sweeps"] = controls / sweep;
+  state.counters["us_per_point"] = controls * 1e6 / static_cast<double>(algebraic.num_points());
+}
+BENCHMARK(BM_TrackingControls)
+    ->DenseRange(0, 2)
+    ->ArgName("airfoil")
+    ->Unit(benchmark::kMillisecond);
 
 void BM_GenerateVolume(benchmark::State& state) {
   absl::StatusOr<MultiBlockGrid> m6 = ReadPlot3dFile(SharedDataPath("surfaces/m6_small.fmt"));
