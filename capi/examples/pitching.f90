@@ -19,6 +19,8 @@
 ! Unlike the C++ example it does not recover a step whose answer was lost in a replica's
 ! failover (GetGrid by step is not in the C API): such a step counts as failed.
 !
+! --server defaults to $SPLINEGRID_SERVER, else localhost:50051, as in the C++ example.
+!
 !   splinegrid_pitching_fortran --server localhost:50051 --steps 100 [--amplitude 10]
 !       [--period N] [--dt 0.01] [--level 1] [--check_level 0] [--grid FILE] [--name ID]
 !       [--output FILE] [--keep] [--quiet]
@@ -29,6 +31,10 @@ program pitching
   implicit none
 
   real(c_double), parameter :: pi = 3.14159265358979323846_c_double
+  character(*), parameter :: usage_line = "usage: splinegrid_pitching_fortran " // &
+      "[--server host:port (default: $SPLINEGRID_SERVER, else localhost:50051)] " // &
+      "[--steps N] [--amplitude DEG] [--period N] [--dt T] [--level L] [--check_level L] " // &
+      "[--grid FILE] [--name ID] [--output FILE] [--keep] [--quiet]"
   character(len=1024) :: server, grid_file, name, output, arg
   integer :: steps, period, level, check_level
   real(c_double) :: amplitude, dt
@@ -170,9 +176,10 @@ program pitching
 contains
 
   subroutine parse_arguments()
-    integer :: a, count
+    integer :: a, count, length, env_status
     character(len=1024) :: value
-    server = "localhost:50051"
+    call get_environment_variable("SPLINEGRID_SERVER", server, length, env_status)
+    if (env_status /= 0 .or. length == 0) server = "localhost:50051"
     grid_file = SPLINEGRID_SOURCE_DIR // "/../shared/data/grids/n0012_pitch_257x129.fmt"
     name = "pitching-fortran"
     output = ""
@@ -184,6 +191,9 @@ contains
     do while (a <= count)
       call get_command_argument(a, arg)
       select case (trim(arg))
+      case ("--help", "-h")
+        write (output_unit, '(a)') usage_line
+        stop 0, quiet=.true.
       case ("--keep")
         keep = .true.
       case ("--quiet")
@@ -234,9 +244,7 @@ contains
   subroutine usage(message)
     character(*), intent(in) :: message
     write (error_unit, '(a)') message
-    write (error_unit, '(a)') "usage: splinegrid_pitching_fortran [--server host:port] " // &
-        "[--steps N] [--amplitude DEG] [--period N] [--dt T] [--level L] [--check_level L] " // &
-        "[--grid FILE] [--name ID] [--output FILE] [--keep] [--quiet]"
+    write (error_unit, '(a)') usage_line
     stop 2, quiet=.true.  ! F2018: no "STOP n" line
   end subroutine usage
 

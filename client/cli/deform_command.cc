@@ -157,7 +157,8 @@ absl::Status Deform(const Args& args) {
                               "': give blend or transfinite"));
   }
   v1::RigidMotion* rigid = request.mutable_rigid();
-  rigid->set_angle_degrees(absl::GetFlag(FLAGS_rotate));
+  const std::optional<double> rotate = absl::GetFlag(FLAGS_rotate);
+  rigid->set_angle_degrees(rotate.value_or(0.0));
   if (!std::isfinite(rigid->angle_degrees())) return Usage("--rotate must be finite");
   const struct {
     std::string text;
@@ -175,7 +176,8 @@ absl::Status Deform(const Args& args) {
                         ParseNumbers(v.text, v.flag, v.min, v.max));
     v.into->Assign(values.begin(), values.end());
   }
-  if (rigid->angle_degrees() == 0.0 && rigid->translation().empty()) {
+  // Given, even as 0 (a solver's step at rest: the C and Python clients store it too).
+  if (!rotate.has_value() && rigid->translation().empty()) {
     return Usage(absl::StrCat("give --rotate and/or --translate\n", kDeformUsage));
   }
   auto client = Connect();

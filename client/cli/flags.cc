@@ -100,9 +100,9 @@ ABSL_FLAG(bool, quality, false, "eval: VTK cell field 'scaled_jacobian' (1 ideal
 ABSL_FLAG(bool, deviation, false,
           "eval: VTK point field 'deviation' from the source points (--level 0 only)");
 
-ABSL_FLAG(
-    double, rotate, 0.0,
-    "deform: rotation angle in degrees (2D: counter-clockwise about z) of the moved boundary");
+ABSL_FLAG(std::optional<double>, rotate, std::nullopt,
+          "deform: rotation angle in degrees (2D: counter-clockwise about z) of the moved "
+          "boundary; 0 is a motion too (a step of a solver's series at rest)");
 ABSL_FLAG(std::string, about, "", "deform: centre of the rotation X,Y[,Z] (default: the origin)");
 ABSL_FLAG(std::string, axis, "", "deform: rotation axis X,Y,Z (default: z)");
 ABSL_FLAG(std::string, translate, "",

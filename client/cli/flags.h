@@ -60,7 +60,7 @@ ABSL_DECLARE_FLAG(bool, jacobian);
 ABSL_DECLARE_FLAG(bool, quality);
 ABSL_DECLARE_FLAG(bool, deviation);
 // deform
-ABSL_DECLARE_FLAG(double, rotate);
+ABSL_DECLARE_FLAG(std::optional<double>, rotate);
 ABSL_DECLARE_FLAG(std::string, about);
 ABSL_DECLARE_FLAG(std::string, axis);
 ABSL_DECLARE_FLAG(std::string, translate);

@@ -85,19 +85,27 @@ TEST_F(CApiTest, FortranPitchingExampleMatchesTheCppExample) {
   }
   const std::string grid = SharedDataPath("grids/n0012_pitch_257x129.fmt");
   const std::string common =
-      absl::StrCat(" --server ", Address(), " --steps 8 --amplitude 12 --grid ", grid, " --keep");
-  std::string cpp, fortran;
-  ASSERT_EQ(testing::RunShell(absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching", common,
-                                           " --name pitch-cpp 2>&1"),
+      absl::StrCat(" --steps 8 --amplitude 12 --grid ", grid, " --keep");
+  std::string cpp, fortran, help;
+  ASSERT_EQ(testing::RunShell(absl::StrCat(SPLINEGRID_BINARY_DIR, "/splinegrid_pitching --server ",
+                                           Address(), common, " --name pitch-cpp 2>&1"),
                               &cpp),
             0)
       << cpp;
+  // The server from $SPLINEGRID_SERVER, as the C++ example takes it.
   const std::string points = (dir_ / "fortran-points.txt").string();
-  ASSERT_EQ(testing::RunShell(absl::StrCat(SPLINEGRID_FORTRAN_PITCHING, common,
+  ASSERT_EQ(testing::RunShell(absl::StrCat("SPLINEGRID_SERVER=", Address(), " ",
+                                           SPLINEGRID_FORTRAN_PITCHING, common,
                                            " --name pitch-f --output ", points, " 2>&1"),
                               &fortran),
             0)
       << fortran;
+  ASSERT_EQ(testing::RunShell(absl::StrCat(SPLINEGRID_FORTRAN_PITCHING, " --help 2>&1"), &help), 0);
+  EXPECT_EQ(help.rfind("usage: splinegrid_pitching_fortran [--server host:port (default: "
+                       "$SPLINEGRID_SERVER",
+                       0),
+            0u)
+      << help;
   EXPECT_THAT(fortran, HasSubstr("grids/pitch-f revision 1: 33153 points -> "));
   EXPECT_THAT(fortran, HasSubstr("p50       p90       p99       max"));
   EXPECT_THAT(fortran, HasSubstr("  (server) "));

@@ -658,6 +658,11 @@ TEST_F(EndToEndTest, CliDeformsRefusesAFoldAndGetsTheDeformedRevision) {
   EXPECT_THAT(usage.out, HasSubstr("--about"));
   EXPECT_EQ(Cli("deform naca --rotate=5 --boundary=0:lmin").exit_code, 2);
   EXPECT_EQ(Cli("deform naca").exit_code, 2);
+  // A step at rest is a motion too (a scripted series passes through angle 0), as in the C and
+  // Python clients: stored, not a usage error.
+  const Result rest = Cli("deform naca --rotate=0 --about=0.25,0 --reference=1 --step=5");
+  EXPECT_EQ(rest.exit_code, 0) << rest.out;
+  EXPECT_THAT(rest.out, HasSubstr("grids/naca revision 4: deformed revision 1"));
 }
 
 TEST_F(EndToEndTest, CliWatchPrintsRevisionsUntilTheGridIsDeletedOrInterrupted) {
