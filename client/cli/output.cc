@@ -98,7 +98,8 @@ std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c)
 
 // "wall 0.000137 <= 0.00015 met, interface ..., interior 0.205 (no tolerance)": the largest
 // deviation of each kind over `blocks`, against the tolerance the fit was held to where one was
-// asked (FitReport.tolerances); "met" only there.
+// asked (FitReport.tolerances); "met" only there; then "; first-layer heights at walls changed by
+// up to 22%", the largest over `blocks` (DeviationByKind.first_layer), when measured.
 std::string FormatKindDeviations(
     const v1::FitReport& r, const google::protobuf::RepeatedPtrField<v1::BlockFitSummary>& blocks) {
   struct Kind {
@@ -123,6 +124,12 @@ std::string FormatKindDeviations(
       kinds[k].has = true;
     }
   }
+  double first_layer = -1.0;
+  for (const v1::BlockFitSummary& b : blocks) {
+    if (b.deviation_by_kind().has_first_layer()) {
+      first_layer = std::max(first_layer, b.deviation_by_kind().first_layer());
+    }
+  }
   std::string out;
   for (const Kind& k : kinds) {
     if (!k.has) continue;
@@ -136,6 +143,11 @@ std::string FormatKindDeviations(
       absl::StrAppend(
           &out, absl::StrFormat("%s %.3g%s", k.name, k.deviation, held ? " (no tolerance)" : ""));
     }
+  }
+  // Not held to a tolerance, but what a solver's y+ follows.
+  if (first_layer >= 0.0) {
+    absl::StrAppend(&out, absl::StrFormat("; first-layer heights at walls changed by up to %.3g%%",
+                                          100.0 * first_layer));
   }
   return out;
 }

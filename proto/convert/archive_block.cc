@@ -188,6 +188,7 @@ void EncodeBlockFit(const BlockFit& block, v1::StoredBlockFit* out) {
   deviation->set_interface(block.deviation_by_kind.interface);
   deviation->set_outer(block.deviation_by_kind.outer);
   deviation->set_interior(block.deviation_by_kind.interior);
+  deviation->set_first_layer(block.deviation_by_kind.first_layer);
   EncodeCellQuality(block.quality, out->mutable_quality());
 }
 
@@ -202,7 +203,8 @@ absl::StatusOr<BlockFit> ParseBlockFit(const v1::StoredBlockFit& stored, const s
   block.unmet_reason = stored.unmet_reason();
   const v1::StoredKindDeviation& deviation = stored.deviation_by_kind();
   block.deviation_by_kind = {deviation.wall(), deviation.interface(), deviation.outer(),
-                             deviation.interior()};
+                             deviation.interior(),
+                             deviation.has_first_layer() ? deviation.first_layer() : -1.0};
   SG_ASSIGN_OR_RETURN(block.quality, ParseCellQuality(stored.quality(), field + ".quality"));
   return block;
 }

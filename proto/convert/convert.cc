@@ -344,6 +344,7 @@ void EncodeBlockFit(const BlockFit& block, bool tolerance_mode, v1::BlockFitSumm
   if (d.interface >= 0.0) dev->set_interface(d.interface);
   if (d.outer >= 0.0) dev->set_outer(d.outer);
   if (d.interior >= 0.0) dev->set_interior(d.interior);
+  if (d.first_layer >= 0.0) dev->set_first_layer(d.first_layer);
   const CellQuality& q = block.quality;
   v1::CellQualityReport* quality = out->mutable_quality();
   quality->set_cells_checked(q.cells_checked);

@@ -19,10 +19,14 @@ struct KindDeviation {
   double interface = -1.0;
   double outer = -1.0;
   double interior = -1.0;
+  // The largest relative change of a first-layer height: over the grid edges from a wall point
+  // to an interior neighbour (the edges that set a solver's y+), | |fitted edge| - |data edge| |
+  // / |data edge| at the data parameters. Negative: the block has no such edge.
+  double first_layer = -1.0;
 };
 
 // Largest distance of `fitted` from `block` at the data parameters, per kind of point (`kinds`:
-// the block's BoundaryKinds::point_kinds).
+// the block's BoundaryKinds::point_kinds), and the largest change of a first-layer height.
 absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
                                               const StructuredBlock& block,
                                               const std::vector<uint8_t>& kinds);
