@@ -71,7 +71,11 @@ def _read_bytes(path_or_bytes: PathOrBytes) -> memoryview:
 
 
 def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
-    values = [int(v) for v in values]
+    given = values
+    try:
+        values = [int(v) for v in values]
+    except (TypeError, ValueError):  # a bare number, or something that is not an integer
+        raise ValueError(f"{what} = {given!r}; give 1 to 3 integers (i, j, k)") from None
     if not 1 <= len(values) <= 3:
         raise ValueError(f"{what} = {values}; give 1 to 3 integers (i, j, k)")
     i, j, k = values + [fill] * (3 - len(values))

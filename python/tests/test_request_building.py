@@ -200,6 +200,10 @@ class TestDeform:
             _boundary_selection("symmetry")
         with pytest.raises(ValueError, match=r"boundary\[1\]: j range \[4, 2\] is not"):
             _boundary_selection([(0, "imin", (0, 0), (0, 4)), (0, "imin", (0, 4), (0, 2))])
+        # Bare numbers for begin and end (a trial wrote (0, "jmin", 128, 216)): a ValueError
+        # naming them, not a TypeError from inside.
+        with pytest.raises(ValueError, match=r"boundary\[0\] begin = 128; give 1 to 3 integers"):
+            _boundary_selection((0, "jmin", 128, 216))
 
 
 class TestGridRequests:
