@@ -179,6 +179,7 @@ contains
     integer :: a, count, length, env_status
     character(len=1024) :: value
     call get_environment_variable("SPLINEGRID_SERVER", server, length, env_status)
+    if (env_status == -1) call usage("SPLINEGRID_SERVER is longer than 1024 characters")
     if (env_status /= 0 .or. length == 0) server = "localhost:50051"
     grid_file = SPLINEGRID_SOURCE_DIR // "/../shared/data/grids/n0012_pitch_257x129.fmt"
     name = "pitching-fortran"

@@ -9,7 +9,7 @@ namespace {
 // FitSpec from them.
 #define SG_FIT_SPEC_FLAGS                                                                \
   "tol", "ctl", "order", "max_ctl", "kinds", "ref_length", "wall", "interface", "outer", \
-      "interior", "edge", "face", "fair", "allow_folds"
+      "interior", "edge", "first_layer", "face", "fair", "allow_folds"
 
 std::vector<CommandSpec> MakeCommands() {
   return {

@@ -244,6 +244,7 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
   const bool kinds = absl::GetFlag(FLAGS_kinds) || absl::GetFlag(FLAGS_wall) != 0.0 ||
                      absl::GetFlag(FLAGS_interface) != 0.0 || absl::GetFlag(FLAGS_outer) != 0.0 ||
                      absl::GetFlag(FLAGS_interior) != 0.0 || edge_set ||
+                     absl::GetFlag(FLAGS_first_layer) != 0.0 ||
                      absl::GetFlag(FLAGS_ref_length) != 0.0 || !absl::GetFlag(FLAGS_face).empty();
   if ((tol != 0.0) + !ctl.empty() + kinds > 1) {
     return Usage("give one of --tol, --ctl and the tolerances by kind (--kinds, --wall, ...)");
@@ -265,6 +266,7 @@ absl::StatusOr<v1::FitSpec> SpecFromFlags() {
     t->set_outer(absl::GetFlag(FLAGS_outer));
     t->set_interior(absl::GetFlag(FLAGS_interior));
     if (edge_set) t->set_edge(edge);
+    t->set_first_layer(absl::GetFlag(FLAGS_first_layer));
     spec.set_reference_length(absl::GetFlag(FLAGS_ref_length));
     spec.set_max_controls_per_direction(absl::GetFlag(FLAGS_max_ctl));
   } else if (!ctl.empty()) {

@@ -54,6 +54,10 @@ ABSL_FLAG(double, interior, 0.0, "fit: tolerance inside blocks (implies --kinds;
 ABSL_FLAG(double, edge, -1.0,
           "fit: relative accuracy of grid edges inside blocks, in (0, 1]: the error of an edge "
           "vector over its length (implies --kinds; 0: off; <0: default 0.5)");
+ABSL_FLAG(double, first_layer, 0.0,
+          "fit: relative accuracy of the first layer at the walls, in (0, 1], e.g. 0.05: every "
+          "first-layer height (what a solver's y+ follows) within 5% of the grid's (implies "
+          "--kinds; 0: off, the fit report still gives the change; costs controls)");
 ABSL_FLAG(std::string, fair, "",
           "fit/fair: fairing: 'tol' (largest weight within the tolerances) or a weight lambda");
 ABSL_FLAG(std::string, face, "",

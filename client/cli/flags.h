@@ -37,6 +37,7 @@ ABSL_DECLARE_FLAG(double, interface);
 ABSL_DECLARE_FLAG(double, outer);
 ABSL_DECLARE_FLAG(double, interior);
 ABSL_DECLARE_FLAG(double, edge);
+ABSL_DECLARE_FLAG(double, first_layer);
 ABSL_DECLARE_FLAG(std::string, fair);
 ABSL_DECLARE_FLAG(double, ref_length);
 ABSL_DECLARE_FLAG(std::string, face);

@@ -99,7 +99,8 @@ std::string FormatCurvatureLine(const char* label, const v1::CurvatureReport& c)
 // "wall 0.000137 <= 0.00015 met, interface ..., interior 0.205 (no tolerance)": the largest
 // deviation of each kind over `blocks`, against the tolerance the fit was held to where one was
 // asked (FitReport.tolerances); "met" only there; then "; first-layer heights at walls changed by
-// up to 22%", the largest over `blocks` (DeviationByKind.first_layer), when measured.
+// up to 22%", the largest over `blocks` (DeviationByKind.first_layer), when measured, against
+// the tolerances' first_layer when one was asked.
 std::string FormatKindDeviations(
     const v1::FitReport& r, const google::protobuf::RepeatedPtrField<v1::BlockFitSummary>& blocks) {
   struct Kind {
@@ -144,10 +145,15 @@ std::string FormatKindDeviations(
           &out, absl::StrFormat("%s %.3g%s", k.name, k.deviation, held ? " (no tolerance)" : ""));
     }
   }
-  // Not held to a tolerance, but what a solver's y+ follows.
+  // What a solver's y+ follows: held to BoundaryTolerances.first_layer where one was asked.
   if (first_layer >= 0.0) {
     absl::StrAppend(&out, absl::StrFormat("; first-layer heights at walls changed by up to %.3g%%",
                                           100.0 * first_layer));
+    if (held && t.first_layer() > 0.0) {
+      const bool met = first_layer <= t.first_layer();
+      absl::StrAppend(&out, absl::StrFormat(" %s %.3g%% %s", met ? "<=" : ">",
+                                            100.0 * t.first_layer(), met ? "met" : "NOT MET"));
+    }
   }
   return out;
 }

@@ -71,8 +71,10 @@ double BernoulliSlope(double z) {
 // The root in [-kMaxControl, kMaxControl] of f(psi) = B(-psi) up + B(psi) down + r0, which
 // increases monotonically (up > 0 > down), or the end of the interval nearer to it: Newton's
 // method kept inside a bracket that every step narrows, a bisection step wherever Newton's would
-// leave it (W. H. Press et al., "Numerical Recipes", 3rd ed., sec. 9.4, rtsafe). Quadratic near
-// the root, so about 5 evaluations where a plain bisection to the same width took 50.
+// leave it (after W. H. Press et al., "Numerical Recipes", 3rd ed., sec. 9.4, rtsafe, without
+// its switch to bisection on slow steps: f is smooth and monotone). Quadratic near the root:
+// about 7 evaluations with the two at the ends, where a plain bisection to the same width took
+// 50.
 double TrackingPsi(double up, double down, double r0) {
   const auto f = [&](double psi) { return Bernoulli(-psi) * up + Bernoulli(psi) * down + r0; };
   double lo = -kMaxControl, hi = kMaxControl;
@@ -84,10 +86,10 @@ double TrackingPsi(double up, double down, double r0) {
     if (value == 0.0) return psi;
     (value < 0.0 ? lo : hi) = psi;
     const double slope = -BernoulliSlope(-psi) * up + BernoulliSlope(psi) * down;
-    double next = psi - value / slope;
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const double next = psi - value / slope;
+    // Converged first: a step that rounds to nothing at a bracket end is not one to bisect.
     if (std::abs(next - psi) <= 1e-15 * (1.0 + std::abs(psi))) return next;
-    psi = next;
+    psi = next > lo && next < hi ? next : 0.5 * (lo + hi);
   }
   return psi;
 }

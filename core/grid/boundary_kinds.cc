@@ -470,6 +470,10 @@ absl::Status BoundaryTolerances::Validate() const {
     return absl::InvalidArgumentError(
         absl::StrCat("tolerances.edge = ", edge, " is outside [0, 1]"));
   }
+  if (!(first_layer >= 0.0 && first_layer <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("tolerances.first_layer = ", first_layer, " is outside [0, 1]"));
+  }
   return absl::OkStatus();
 }
 
@@ -489,9 +493,16 @@ std::vector<double> PointTolerances(const BoundaryKinds& kinds, int b,
   return tol;
 }
 
-std::vector<double> PointEdgeTolerances(const BoundaryKinds& kinds, int b,
-                                        const BoundaryTolerances& tolerances) {
-  return std::vector<double>(kinds.point_kinds[b].size(), tolerances.edge);
+std::vector<double> PointEdgeTolerances(const StructuredBlock& block, const BoundaryKinds& kinds,
+                                        int b, const BoundaryTolerances& tolerances) {
+  const std::vector<uint8_t>& point_kinds = kinds.point_kinds[b];
+  std::vector<double> tol(point_kinds.size(), tolerances.edge);
+  if (!(tolerances.first_layer > 0.0)) return tol;
+  const double tight = tolerances.edge > 0.0
+                           ? std::min(tolerances.edge, tolerances.first_layer)
+                           : tolerances.first_layer;
+  ForEachFirstLayerEdge(block, point_kinds, [&](int64_t p, int64_t q) { tol[p] = tol[q] = tight; });
+  return tol;
 }
 
 }  // namespace splinegrid

@@ -82,9 +82,15 @@ struct BoundaryTolerances {
   double outer = 8e-3;
   double interior = std::numeric_limits<double>::infinity();
   double edge = 0.5;
+  // The first layer at the walls, whose height a solver's y+ follows: the edge criterion above
+  // with this relative accuracy on the first-layer edges (ForEachFirstLayerEdge below) and,
+  // since an edge's limit is the looser of its ends', on the edges among their ends: along the
+  // wall and along the first layer. 0: off, those edges have `edge` like the rest. Held, it
+  // bounds the relative change of every first-layer height (fit_deviation.h first_layer).
+  double first_layer = 0.0;
 
   // INVALID_ARGUMENT naming the field: wall, interface and outer must be positive and finite,
-  // interior positive (infinity allowed), edge in [0, 1].
+  // interior positive (infinity allowed), edge and first_layer in [0, 1].
   absl::Status Validate() const;
   // The tightest tolerance of the kinds in `mask` (interior for 0).
   double For(uint8_t mask) const;
@@ -94,9 +100,43 @@ struct BoundaryTolerances {
 std::vector<double> PointTolerances(const BoundaryKinds& kinds, int b,
                                     const BoundaryTolerances& tolerances);
 
-// Per-point edge tolerances of block b (`edge` everywhere; refinement tightens them locally).
-std::vector<double> PointEdgeTolerances(const BoundaryKinds& kinds, int b,
-                                        const BoundaryTolerances& tolerances);
+// The first-layer edges of `block` (its points' kinds `point_kinds`): from every wall point on a
+// face of the block to its neighbour one step inward across that face, unless that neighbour
+// is a wall point too (a block two points thick between walls). Their lengths are the heights
+// a solver's y+ follows; the inner end may lie on another boundary (an O-grid's seam, an
+// interface to the next block). Calls visit(p, q) with the point indices of wall point and
+// neighbour; an edge from a point on two faces is visited for each.
+template <typename Visit>
+void ForEachFirstLayerEdge(const StructuredBlock& block, const std::vector<uint8_t>& point_kinds,
+                           Visit visit) {
+  const uint8_t wall = static_cast<uint8_t>(BoundaryKind::kWall);
+  for (int k = 0; k < block.extent(2); ++k) {
+    for (int j = 0; j < block.extent(1); ++j) {
+      for (int i = 0; i < block.extent(0); ++i) {
+        const int64_t p = block.Index(i, j, k);
+        if (!(point_kinds[p] & wall)) continue;
+        const Extents at = {i, j, k};
+        for (int d = 0; d < 3; ++d) {
+          const int n = block.extent(d);
+          if (n < 2) continue;
+          for (const int face : {0, n - 1}) {
+            if (at[d] != face) continue;
+            Extents in = at;
+            in[d] += face == 0 ? 1 : -1;
+            const int64_t q = block.Index(in[0], in[1], in[2]);
+            if (!(point_kinds[q] & wall)) visit(p, q);
+          }
+        }
+      }
+    }
+  }
+}
+
+// Per-point edge tolerances of `block`, block b of `kinds`: `edge` everywhere, and
+// first_layer (where it is tighter, or `edge` is off) at both ends of the first-layer edges;
+// refinement tightens them locally.
+std::vector<double> PointEdgeTolerances(const StructuredBlock& block, const BoundaryKinds& kinds,
+                                        int b, const BoundaryTolerances& tolerances);
 
 }  // namespace splinegrid
 

@@ -74,6 +74,7 @@ void EncodeFitReport(const GridFitReport& report, v1::StoredFitReport* out) {
     stored->set_outer(t.outer);
     stored->set_interior(t.interior);
     stored->set_edge(t.edge);
+    stored->set_first_layer(t.first_layer);
   }
 }
 
@@ -113,8 +114,8 @@ absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
   }
   if (stored.has_tolerances()) {
     const v1::StoredBoundaryTolerances& t = stored.tolerances();
-    report.tolerances = BoundaryTolerances{t.wall(), t.interface(), t.outer(), t.interior(),
-                                           t.edge()};
+    report.tolerances = BoundaryTolerances{t.wall(),     t.interface(), t.outer(),
+                                           t.interior(), t.edge(),      t.first_layer()};
   }
   SG_RETURN_IF_ERROR(CheckNonNegative(report.num_points, field + ".num_points"));
   SG_RETURN_IF_ERROR(CheckNonNegative(report.num_control_points, field + ".num_control_points"));
@@ -195,6 +196,7 @@ void EncodeGridFitOptions(const GridFitOptions& options, v1::StoredFitOptions* o
     stored->set_outer(t.outer);
     stored->set_interior(t.interior);
     stored->set_edge(t.edge);
+    stored->set_first_layer(t.first_layer);
   }
   EncodeExtents(options.control_counts, out->mutable_control_counts());
   for (const auto& [block, counts] : options.block_control_counts) {
@@ -243,7 +245,8 @@ absl::StatusOr<GridFitOptions> ParseGridFitOptions(const v1::StoredFitOptions& s
   }
   if (stored.has_boundary_tolerances()) {
     const v1::StoredBoundaryTolerances& t = stored.boundary_tolerances();
-    const BoundaryTolerances tolerances{t.wall(), t.interface(), t.outer(), t.interior(), t.edge()};
+    const BoundaryTolerances tolerances{t.wall(),     t.interface(), t.outer(),
+                                        t.interior(), t.edge(),      t.first_layer()};
     if (absl::Status s = tolerances.Validate(); !s.ok()) {
       return Annotate(s, field + ".boundary_tolerances");
     }

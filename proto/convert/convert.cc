@@ -94,6 +94,7 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
       take(given.interior(), t.interior, kRelativeInterior);
       options.relative_kinds = relative;
       if (given.has_edge()) t.edge = given.edge();
+      t.first_layer = given.first_layer();
       if (absl::Status s = t.Validate(); !s.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("spec.boundary_tolerances: ", s.message()));
       }
@@ -301,6 +302,7 @@ void EncodeFitSpec(const GridFitOptions& options, v1::FitSpec* out) {
     given->set_outer(put(t.outer, kRelativeOuter));
     given->set_interior(put(t.interior, kRelativeInterior));
     given->set_edge(t.edge);
+    given->set_first_layer(t.first_layer);
   } else {
     EncodeExtents(options.control_counts, out->mutable_control_counts());
   }
@@ -410,6 +412,7 @@ void EncodeFitReport(const GridFitReport& report, const std::vector<BlockFit>& b
     held->set_outer(t.outer);
     held->set_interior(std::isfinite(t.interior) ? t.interior : 0.0);
     held->set_edge(t.edge);
+    held->set_first_layer(t.first_layer);
   }
   double min_ratio = std::numeric_limits<double>::infinity(), size_ratio = 0.0;
   int64_t folded = 0, bad = 0;

@@ -73,7 +73,11 @@ def _read_bytes(path_or_bytes: PathOrBytes) -> memoryview:
 def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
     given = values
     try:
+        if isinstance(values, (str, bytes)):
+            raise TypeError  # "128" would be (1, 2, 8)
         values = [int(v) for v in values]
+        if any(isinstance(v, (str, bytes)) or v != int(v) for v in given):
+            raise ValueError  # "3", 1.5
     except (TypeError, ValueError):  # a bare number, or something that is not an integer
         raise ValueError(f"{what} = {given!r}; give 1 to 3 integers (i, j, k)") from None
     if not 1 <= len(values) <= 3:
@@ -94,7 +98,8 @@ def _fit_spec(control_counts: Optional[Triple], tolerance: Optional[float], orde
     if tolerance is not None:
         spec.tolerance = tolerance
     elif boundary_tolerances is not None:
-        unknown = set(boundary_tolerances) - {"wall", "interface", "outer", "interior", "edge"}
+        unknown = set(boundary_tolerances) - {"wall", "interface", "outer", "interior", "edge",
+                                              "first_layer"}
         if unknown:
             raise ValueError(f"boundary_tolerances: unknown kinds {sorted(unknown)}")
         spec.boundary_tolerances.SetInParent()

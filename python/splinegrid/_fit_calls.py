@@ -71,9 +71,12 @@ class _FitCalls(_Calls):
         direction i, j, k for every block; 0 or a missing entry: as many as points), a
         ``tolerance`` (largest deviation of every point, in the grid's length unit) or
         ``boundary_tolerances``, a dict with any of ``wall``, ``interface``, ``outer``,
-        ``interior`` and ``edge`` (missing: the paper's 0.15e-3, 2e-3, 8e-3, no interior
-        tolerance, edge 0.5; ``{}`` takes all defaults). The values given are lengths in the
-        grid's unit; the defaults are fractions of the grid's reference length: ``ref_length``
+        ``interior``, ``edge`` and ``first_layer`` (missing: the paper's 0.15e-3, 2e-3, 8e-3, no
+        interior tolerance, edge 0.5, first layer off; ``{}`` takes all defaults). ``edge`` and
+        ``first_layer`` are relative (``first_layer=0.05``: every first-layer height at the
+        walls, what a solver's y+ follows, within 5%; the report's
+        ``deviation_by_kind.first_layer`` gives the change either way); the other values given
+        are lengths in the grid's unit; the defaults are fractions of the grid's reference length: ``ref_length``
         (implies ``boundary_tolerances={}`` when none is given; refused with ``tolerance`` or
         ``control_counts``, which are absolute), else detected by the server as the largest
         extent of a wall (an airfoil's chord; the bounding-box diagonal without walls), so a

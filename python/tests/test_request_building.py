@@ -40,8 +40,10 @@ class TestFit:
         assert spec.fairing.mode == grid_pb2.FAIRING_MODE_TO_TOLERANCE
 
     def test_given_tolerances_by_kind_are_kept(self):
-        spec = fit(boundary_tolerances={"wall": 1e-4, "edge": 0.25}, fairing=0.5).spec
+        spec = fit(boundary_tolerances={"wall": 1e-4, "edge": 0.25, "first_layer": 0.05},
+                   fairing=0.5).spec
         assert (spec.boundary_tolerances.wall, spec.boundary_tolerances.edge) == (1e-4, 0.25)
+        assert spec.boundary_tolerances.first_layer == 0.05
         assert (spec.fairing.mode, spec.fairing.weight) == (grid_pb2.FAIRING_MODE_WEIGHT, 0.5)
 
     @pytest.mark.parametrize("kwargs, message", [
@@ -204,6 +206,10 @@ class TestDeform:
         # naming them, not a TypeError from inside.
         with pytest.raises(ValueError, match=r"boundary\[0\] begin = 128; give 1 to 3 integers"):
             _boundary_selection((0, "jmin", 128, 216))
+        with pytest.raises(ValueError, match=r"boundary\[0\] begin = '128'; give 1 to 3"):
+            _boundary_selection((0, "jmin", "128", (216, 0)))
+        with pytest.raises(ValueError, match=r"boundary\[0\] end = \(1.5, 0\); give 1 to 3"):
+            _boundary_selection((0, "jmin", (1, 0), (1.5, 0)))
 
 
 class TestGridRequests:

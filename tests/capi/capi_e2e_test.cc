@@ -100,6 +100,14 @@ TEST_F(CApiTest, FortranPitchingExampleMatchesTheCppExample) {
                               &fortran),
             0)
       << fortran;
+  // --server wins over the variable.
+  std::string given;
+  ASSERT_EQ(testing::RunShell(absl::StrCat("SPLINEGRID_SERVER=127.0.0.1:1 ",
+                                           SPLINEGRID_FORTRAN_PITCHING, " --server ", Address(),
+                                           " --steps 1 --grid ", grid, " --name pitch-g 2>&1"),
+                              &given),
+            0)
+      << given;
   ASSERT_EQ(testing::RunShell(absl::StrCat(SPLINEGRID_FORTRAN_PITCHING, " --help 2>&1"), &help), 0);
   EXPECT_EQ(help.rfind("usage: splinegrid_pitching_fortran [--server host:port (default: "
                        "$SPLINEGRID_SERVER",

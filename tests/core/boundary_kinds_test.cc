@@ -184,7 +184,10 @@ TEST(BoundaryKindsTest, ToleranceValidationNamesTheField) {
                         Case{&BoundaryTolerances::interior, nan, "tolerances.interior"},
                         Case{&BoundaryTolerances::edge, 1.5, "tolerances.edge"},
                         Case{&BoundaryTolerances::edge, -0.1, "tolerances.edge"},
-                        Case{&BoundaryTolerances::edge, nan, "tolerances.edge"}}) {
+                        Case{&BoundaryTolerances::edge, nan, "tolerances.edge"},
+                        Case{&BoundaryTolerances::first_layer, 1.5, "tolerances.first_layer"},
+                        Case{&BoundaryTolerances::first_layer, -0.1, "tolerances.first_layer"},
+                        Case{&BoundaryTolerances::first_layer, nan, "tolerances.first_layer"}}) {
     BoundaryTolerances t;
     t.*c.field = c.value;
     const absl::Status status = t.Validate();
@@ -223,6 +226,43 @@ TEST(BoundaryKindsTest, TheTightestKindDecides) {
   kinds.point_kinds = {{0, kWall}, {kOuter, kInterface | kWall, kInterface}};
   EXPECT_THAT(PointTolerances(kinds, 1, t), ElementsAre(0.5, 1.0, 2.0));
   EXPECT_THAT(PointTolerances(kinds, 0, t), ElementsAre(4.0, 1.0));
+}
+
+// The first-layer edges go from each wall point one step into the block across its face:
+// on an O-grid also at the seam, whose inner end is an interface point (the trailing edge of a
+// generated grid), never along the wall, and none between two walls two points apart.
+TEST(BoundaryKindsTest, FirstLayerEdgesLeaveEveryWallPointInward) {
+  constexpr double kPi = 3.14159265358979323846;
+  const int ni = 33, nj = 9;  // an annulus, its inner circle a wall, the first line repeated
+  MultiBlockGrid ring;
+  ring.blocks.emplace_back(Extents{ni, nj, 1}, 2);
+  StructuredBlock& block = ring.blocks[0];
+  for (int j = 0; j < nj; ++j) {
+    const double r = 1.0 + 1e-3 * (std::pow(2.0, j) - 1.0);
+    for (int i = 0; i < ni; ++i) {
+      const double a = -2.0 * kPi * (i % (ni - 1)) / (ni - 1);  // clockwise
+      block.Point(i, j, 0)[0] = r * std::cos(a);
+      block.Point(i, j, 0)[1] = r * std::sin(a);
+    }
+  }
+  const std::vector<FaceKindOverride> inner_wall = {{{0, 1, false}, BoundaryKind::kWall}};
+  const BoundaryKinds kinds =
+      ClassifyBoundaries(ring, FindConnectivity(ring).value(), inner_wall).value();
+  ASSERT_EQ(KindAt(ring, kinds, 0, 0, 0), kWall | kInterface);
+  ASSERT_EQ(KindAt(ring, kinds, 0, 0, 1), kInterface);  // the seam, inside the block
+  std::vector<std::pair<int64_t, int64_t>> edges;
+  ForEachFirstLayerEdge(block, kinds.point_kinds[0],
+                        [&](int64_t p, int64_t q) { edges.emplace_back(p, q); });
+  ASSERT_EQ(edges.size(), static_cast<size_t>(ni));
+  for (int i = 0; i < ni; ++i) {
+    EXPECT_EQ(edges[i], std::make_pair(block.Index(i, 0, 0), block.Index(i, 1, 0))) << i;
+  }
+  // Two walls two points apart: no first layer to keep.
+  StructuredBlock thin(Extents{5, 2, 1}, 2);
+  const std::vector<uint8_t> walls(thin.num_points(), kWall);
+  int visits = 0;
+  ForEachFirstLayerEdge(thin, walls, [&](int64_t, int64_t) { ++visits; });
+  EXPECT_EQ(visits, 0);
 }
 
 // ----- Shared grids ----------------------------------------------------------------------------

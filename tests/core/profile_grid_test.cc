@@ -330,7 +330,8 @@ TEST(EllipticTest, TrackingControlsPollsTheCancelCheckEveryLayer) {
 
 // psi is defined by the algebraic grid satisfying the component of the discrete equations
 // along its layer normal (elliptic.h): checked here with the discretisation written out again,
-// at every point whose psi is not clipped at +-3, on a grid clustered to 1e-5 at the wall.
+// at every point whose psi is not clipped at +-3, on a grid clustered to 1e-5 at the wall; where
+// it is clipped, the root lies beyond the clip (the residual's sign says on which side).
 TEST(EllipticTest, TrackingControlsMakeTheAlgebraicGridSolveTheNormalEquation) {
   ProfileGridOptions options;
   options.method = LayerMethod::kTransfinite;
@@ -353,10 +354,6 @@ TEST(EllipticTest, TrackingControlsMakeTheAlgebraicGridSolveTheNormalEquation) {
                  se = at(i + 1, j - 1), sw = at(i - 1, j - 1);
       const int64_t p = grid.Index(i, j, 0);
       const double phi = control.phi[p], psi = control.psi[p];
-      if (std::abs(psi) >= 3.0 - 1e-9) {
-        ++clipped;
-        continue;
-      }
       double xi[2], eta[2], residual[2];
       for (int c = 0; c < 2; ++c) {
         xi[c] = 0.5 * (e[c] - w[c]);
@@ -371,11 +368,22 @@ TEST(EllipticTest, TrackingControlsMakeTheAlgebraicGridSolveTheNormalEquation) {
             0.5 * beta * (ne[c] - se[c] - nw[c] + sw[c]) +
             gamma * (bernoulli(-psi) * (n[c] - x[c]) + bernoulli(psi) * (s[c] - x[c]));
       }
-      const double normal[2] = {-xi[1] / std::sqrt(gamma), xi[0] / std::sqrt(gamma)};
-      const double along = std::abs(residual[0] * normal[0] + residual[1] * normal[1]);
+      // The layer normal towards the next layer: gamma f(psi) is the residual along it, f
+      // increasing with psi.
+      double normal[2] = {-xi[1] / std::sqrt(gamma), xi[0] / std::sqrt(gamma)};
+      if (normal[0] * eta[0] + normal[1] * eta[1] < 0.0) {
+        normal[0] = -normal[0];
+        normal[1] = -normal[1];
+      }
+      const double along = residual[0] * normal[0] + residual[1] * normal[1];
+      if (std::abs(psi) >= 3.0 - 1e-9) {
+        ++clipped;
+        EXPECT_LE(psi > 0.0 ? along : -along, 0.0) << "(" << i << ", " << j << ") psi " << psi;
+        continue;
+      }
       const double scale = gamma * (std::hypot(n[0] - x[0], n[1] - x[1]) +
                                     std::hypot(s[0] - x[0], s[1] - x[1]));
-      worst = std::max(worst, along / scale);
+      worst = std::max(worst, std::abs(along) / scale);
       ++checked;
     }
   }

@@ -363,9 +363,20 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
   EXPECT_THAT(fit.out, HasSubstr("reference length 1 (the largest extent of 1 wall"));
   EXPECT_THAT(fit.out, ::testing::MatchesRegex("(.|\n)*deviation: wall [0-9.e-]+ <= 0.00015 met, "
                                                "interface [0-9.e-]+ <= 0.002 met, outer [0-9.e-]+ "
-                                               "<= 0.008 met, interior [0-9.e-]+ \\(no tolerance\\)"
-                                               "(.|\n)*"));
+                                               "<= 0.008 met, interior [0-9.e-]+ \\(no tolerance\\); "
+                                               "first-layer heights at walls changed by up to "
+                                               "[0-9.e-]+%\n(.|\n)*"));
   EXPECT_THAT(fit.out, HasSubstr("connectivity: 1 matches"));
+  // Held (--first_layer): against its tolerance, and within it.
+  const Result held = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
+                                       " --name=held --first_layer=0.1"));
+  ASSERT_EQ(held.exit_code, 0) << held.out;
+  EXPECT_THAT(held.out, HasSubstr("tolerances: met"));
+  EXPECT_THAT(held.out, ::testing::MatchesRegex("(.|\n)*first-layer heights at walls changed by "
+                                                "up to [0-9.e-]+% <= 10% met\n(.|\n)*"));
+  const Result bad = Cli("fit held --first_layer=2");
+  EXPECT_EQ(bad.exit_code, 2);  // INVALID_ARGUMENT, named by the server
+  EXPECT_THAT(bad.out, HasSubstr("tolerances.first_layer = 2 is outside [0, 1]"));
   // The block table's "max size" is the summary's largest size ratio (either way, shrunk cells
   // too), not growth alone: one block, so the same figure.
   const std::string summary = "largest size ratio ";

@@ -77,6 +77,7 @@ void ExpectSameBlock(const BlockFit& a, const BlockFit& b) {
   EXPECT_SAME_BITS(a.deviation_by_kind.interface, b.deviation_by_kind.interface);
   EXPECT_SAME_BITS(a.deviation_by_kind.outer, b.deviation_by_kind.outer);
   EXPECT_SAME_BITS(a.deviation_by_kind.interior, b.deviation_by_kind.interior);
+  EXPECT_SAME_BITS(a.deviation_by_kind.first_layer, b.deviation_by_kind.first_layer);
   ExpectSameCellQuality(a.quality, b.quality);
   // The mapping itself: evaluation at refinement level 1 gives the same bits.
   Resolution level1;
@@ -101,6 +102,7 @@ void ExpectSameOptions(const GridFitOptions& a, const GridFitOptions& b) {
     EXPECT_SAME_BITS(ta.outer, tb.outer);
     EXPECT_SAME_BITS(ta.interior, tb.interior);
     EXPECT_SAME_BITS(ta.edge, tb.edge);
+    EXPECT_SAME_BITS(ta.first_layer, tb.first_layer);
   }
   EXPECT_EQ(a.control_counts, b.control_counts);
   EXPECT_EQ(a.block_control_counts, b.block_control_counts);
@@ -214,6 +216,7 @@ class ArchiveCodecTest : public ::testing::Test {
     tolerances.wall = 1e-3;
     tolerances.interface = 1e-2;
     tolerances.outer = 5e-2;
+    tolerances.first_layer = 0.3;  // held, so that the tolerances' field is stored too
     options_->boundary_tolerances = tolerances;
     options_->max_controls_per_direction = 120;
     fit_ = new GridFit(FitGrid(*grid_, *options_).value());
@@ -247,6 +250,18 @@ TEST_F(ArchiveCodecTest, FittedRevisionRoundTripsBitwise) {
   ASSERT_TRUE(parsed.ok()) << parsed.status();
   ExpectSameRevision(revision, *parsed);
   EXPECT_TRUE(CheckRevisionMatchesSource(*parsed, *grid_).ok());
+  EXPECT_GT(parsed->blocks[0].deviation_by_kind.first_layer, 0.0);
+  EXPECT_EQ(parsed->fit_options.boundary_tolerances->first_layer, 0.3);
+  // An archive from before the first layer was measured or held: not measured (-1), not held.
+  v1::StoredRevision old = Stored();
+  for (v1::StoredBlockFit& block : *old.mutable_blocks()) {
+    block.mutable_deviation_by_kind()->clear_first_layer();
+  }
+  old.mutable_fit_options()->mutable_boundary_tolerances()->clear_first_layer();
+  absl::StatusOr<GridRevision> before = ParseRevision(old);
+  ASSERT_TRUE(before.ok()) << before.status();
+  EXPECT_EQ(before->blocks[0].deviation_by_kind.first_layer, -1.0);
+  EXPECT_EQ(before->fit_options.boundary_tolerances->first_layer, 0.0);
 }
 
 // A deformed revision: parent, time, step, the gate's summary with an infinite decay radius,

@@ -224,7 +224,7 @@ PointTargets TargetsAndFeatures(const MultiBlockGrid& grid, const BoundaryKinds&
   targets.features.resize(nb);
   for (int b = 0; b < nb; ++b) {
     targets.tolerances[b] = PointTolerances(kinds, b, tolerances);
-    targets.edge_tolerances[b] = PointEdgeTolerances(kinds, b, tolerances);
+    targets.edge_tolerances[b] = PointEdgeTolerances(grid.blocks[b], kinds, b, tolerances);
     for (int d = 0; d < 3; ++d)
       targets.features[b][d] = DetectFeatures(grid.blocks[b], d, features);
   }

@@ -31,35 +31,30 @@ absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
       dev.interface = std::max(dev.interface, d);
     if (k & static_cast<uint8_t>(BoundaryKind::kOuter)) dev.outer = std::max(dev.outer, d);
   }
-  // First-layer heights: every edge from a wall point to an interior neighbour.
-  const uint8_t wall = static_cast<uint8_t>(BoundaryKind::kWall);
-  for (int k = 0; k < block.extent(2); ++k) {
-    for (int j = 0; j < block.extent(1); ++j) {
-      for (int i = 0; i < block.extent(0); ++i) {
-        const int64_t p = block.Index(i, j, k);
-        if (!(kinds[p] & wall)) continue;
-        for (int d = 0; d < 3; ++d) {
-          for (const int side : {-1, 1}) {
-            Extents at = {i, j, k};
-            at[d] += side;
-            if (at[d] < 0 || at[d] >= block.extent(d)) continue;
-            const int64_t q = block.Index(at[0], at[1], at[2]);
-            if (kinds[q] != 0) continue;
-            double data = 0.0, fit = 0.0;
-            for (int c = 0; c < s; ++c) {
-              const double a = block.coords()[s * q + c] - block.coords()[s * p + c];
-              const double b = eval.coords()[s * q + c] - eval.coords()[s * p + c];
-              data += a * a;
-              fit += b * b;
-            }
-            if (!(data > 0.0)) continue;  // a collapsed edge has no height to keep
-            dev.first_layer =
-                std::max(dev.first_layer, std::abs(std::sqrt(fit) - std::sqrt(data)) / std::sqrt(data));
-          }
-        }
-      }
+  // First-layer heights. A collapsed edge (a pole, a tip cap; below rounding of the block's
+  // size) has no height to keep: relative to it any error would be unbounded.
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int64_t p = 0; p < block.num_points(); ++p) {
+    for (int c = 0; c < s; ++c) {
+      lo[c] = std::min(lo[c], block.coords()[s * p + c]);
+      hi[c] = std::max(hi[c], block.coords()[s * p + c]);
     }
   }
+  double diagonal2 = 0.0;
+  for (int c = 0; c < s; ++c) diagonal2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+  const double collapsed2 = 1e-24 * diagonal2;  // (1e-12 of the diagonal)^2
+  ForEachFirstLayerEdge(block, kinds, [&](int64_t p, int64_t q) {
+    double data = 0.0, fit = 0.0;
+    for (int c = 0; c < s; ++c) {
+      const double a = block.coords()[s * q + c] - block.coords()[s * p + c];
+      const double b = eval.coords()[s * q + c] - eval.coords()[s * p + c];
+      data += a * a;
+      fit += b * b;
+    }
+    if (!(data > collapsed2)) return;
+    const double height = std::sqrt(data);
+    dev.first_layer = std::max(dev.first_layer, std::abs(std::sqrt(fit) - height) / height);
+  });
   return dev;
 }
 

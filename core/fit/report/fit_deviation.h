@@ -19,9 +19,10 @@ struct KindDeviation {
   double interface = -1.0;
   double outer = -1.0;
   double interior = -1.0;
-  // The largest relative change of a first-layer height: over the grid edges from a wall point
-  // to an interior neighbour (the edges that set a solver's y+), | |fitted edge| - |data edge| |
-  // / |data edge| at the data parameters. Negative: the block has no such edge.
+  // The largest relative change of a first-layer height: over the first-layer edges
+  // (boundary_kinds.h ForEachFirstLayerEdge; the heights a solver's y+ follows) longer than
+  // 1e-12 of the block's diagonal, | |fitted edge| - |data edge| | / |data edge| at the data
+  // parameters. Negative: the block has no such edge.
   double first_layer = -1.0;
 };
 

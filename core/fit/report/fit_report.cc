@@ -72,16 +72,25 @@ absl::Status ReportFit(const MultiBlockGrid& grid, const CellQualityOptions& qua
   std::vector<FittedBlock> fitted;
   for (int b = 0; b < static_cast<int>(fit.blocks.size()); ++b) {
     BlockFit& block = fit.blocks[b];
+    SG_ASSIGN_OR_RETURN(block.deviation_by_kind,
+                        DeviationByKind(block.fitted, grid.blocks[b], fit.kinds.point_kinds[b]));
     if (tolerances) {
       SG_RETURN_IF_ERROR(
           MeasureAgainstTolerances(grid, *tolerances, fit.kinds, quality.cancel, b, block));
+      // A held first layer is a tolerance too (a cap on the controls can leave it unmet).
+      const double first_layer = block.deviation_by_kind.first_layer;
+      if (block.tolerance_met && tolerances->first_layer > 0.0 &&
+          first_layer > tolerances->first_layer) {
+        block.tolerance_met = false;
+        block.unmet_reason =
+            absl::StrCat("block ", b, ": a first-layer height at a wall changed by ", first_layer,
+                         ", more than first_layer = ", tolerances->first_layer);
+      }
       if (!block.tolerance_met && report.tolerance_met) {
         report.tolerance_met = false;
         report.unmet_reason = block.unmet_reason;
       }
     }
-    SG_ASSIGN_OR_RETURN(block.deviation_by_kind,
-                        DeviationByKind(block.fitted, grid.blocks[b], fit.kinds.point_kinds[b]));
     SG_ASSIGN_OR_RETURN(block.quality, CheckCellQuality(block.fitted, grid.blocks[b], quality),
                         "block ", b, ": ");
     report.quality_met = report.quality_met && block.quality.ok() && block.quality.measured();
