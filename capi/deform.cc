@@ -12,10 +12,9 @@ namespace {
 namespace client = splinegrid::client;
 namespace v1 = splinegrid::v1;
 
-// The request's stamp and checks from `options` (NULL: all zero).
+// The request's stamp, checks and moved boundary from `options` (NULL: all zero).
 absl::StatusOr<v1::DeformGridRequest> BaseRequest(const char* grid,
-                                                  const sg_deform_options* options,
-                                                  bool with_kind) {
+                                                  const sg_deform_options* options) {
   SG_RETURN_IF_ERROR(splinegrid::capi::RequireString(grid, "grid"));
   const sg_deform_options o = options == nullptr ? sg_deform_options{} : *options;
   v1::DeformGridRequest request;
@@ -25,7 +24,7 @@ absl::StatusOr<v1::DeformGridRequest> BaseRequest(const char* grid,
   request.set_time(o.time);
   request.set_step(o.step);
   request.set_check_level(o.check_level);
-  if (with_kind && o.boundary_kind != 0) {
+  if (o.boundary_kind != 0) {
     if (!v1::BoundaryKind_IsValid(o.boundary_kind)) {
       return absl::InvalidArgumentError(absl::StrCat("options.boundary_kind: ", o.boundary_kind,
                                                      " (0 or 1 walls, 2 interfaces, 3 outer)"));
@@ -56,7 +55,7 @@ sg_status sg_deform_rigid(sg_client* c, const char* grid, const sg_deform_option
                           sg_deform_result* result) {
   if (c == nullptr) return SG_INVALID_ARGUMENT;
   return splinegrid::capi::Guard(c->state.get(), [&]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(v1::DeformGridRequest request, BaseRequest(grid, options, true));
+    SG_ASSIGN_OR_RETURN(v1::DeformGridRequest request, BaseRequest(grid, options));
     v1::RigidMotion* rigid = request.mutable_rigid();
     rigid->set_angle_degrees(angle_degrees);  // the server names a non-finite angle
     for (int d = 0; center != nullptr && d < 3; ++d) rigid->add_center(center[d]);
@@ -71,7 +70,7 @@ sg_status sg_deform_points(sg_client* c, const char* grid, const sg_deform_optio
                            int32_t displacements, sg_deform_result* result) {
   if (c == nullptr) return SG_INVALID_ARGUMENT;
   return splinegrid::capi::Guard(c->state.get(), [&]() -> absl::Status {
-    SG_ASSIGN_OR_RETURN(v1::DeformGridRequest request, BaseRequest(grid, options, false));
+    SG_ASSIGN_OR_RETURN(v1::DeformGridRequest request, BaseRequest(grid, options));
     if (face < SG_FACE_I_MIN || face > SG_FACE_K_MAX) {
       return absl::InvalidArgumentError(absl::StrCat("face: ", face, " (SG_FACE_*: 1 to 6)"));
     }

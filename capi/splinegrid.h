@@ -206,8 +206,9 @@ SG_API sg_status sg_deform_rigid(sg_client* client, const char* grid,
 /* Moves the boundary points of one face range of `block` (face SG_FACE_*, begin[3] .. end[3]
  * inclusive in original grid indices) to `points` (or by them, with displacements != 0): the
  * range's points at refinement `level` in point order (i fastest), spatial_dim values each,
- * `count` values; the server fits them with the stored basis. options->boundary_kind is
- * ignored. */
+ * `count` values; the server fits them with the stored basis. The range must lie on the
+ * boundary options->boundary_kind selects (0: the walls; SG_BOUNDARY_OUTER to move far-field
+ * points), whose other points stay. */
 SG_API sg_status sg_deform_points(sg_client* client, const char* grid,
                                   const sg_deform_options* options, int32_t block, int32_t face,
                                   const int32_t begin[3], const int32_t end[3], int32_t level,

@@ -119,9 +119,10 @@ def run(client: Client, args: argparse.Namespace, name: str) -> list[str]:
             continue
         gap = float(np.abs(fine.points[::step, ::step, ::step] - p0).max())
         check(gap <= RELATIVE_MATCH * scale,
-              f"block {b}: every original point reappears at index (i*{step}, j*{step}), "
-              f"largest difference {gap:.1e} (fit max deviation from the file's points "
-              f"{fit.blocks[b].max_deviation:.3e})", failures)
+              f"block {b}: every level-0 point (the spline at the file's indices, not the "
+              f"file's points) reappears at level {args.level} at index (i*{step}, j*{step}), "
+              f"largest difference {gap:.1e}; the spline's largest deviation from the file's "
+              f"points is {fit.blocks[b].max_deviation:.3e}", failures)
         # The parameters of the first and last grid index are 0 and 1 in every direction.
         corners = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0 if p0.shape[0] > 1 else 0.0]])
         at = client.evaluate_points(name, corners, blocks=b).points

@@ -3,6 +3,9 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <numbers>
+#include <string>
+#include <variant>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -56,14 +59,29 @@ absl::Status Validate(const DeformRequest& request) {
   return absl::OkStatus();
 }
 
-// The refusal of a deformation that folds cells.
-absl::Status Folds(const DeformationCheck& check) {
+// The refusal of a deformation that folds cells, with what may avoid it. Motions are relative
+// to the reference revision, so "less" is less than that, not than the last step. A rotation
+// of more than half a turn is its own case: the free controls turn by a fraction of the whole
+// angle (rigid_motion.h), so the interior winds around the body (a rotor cannot pass 180
+// degrees in one deforming block).
+absl::Status Folds(const DeformationCheck& check, const DeformMotion& motion) {
   const Extents& c = check.worst_cell;
+  std::string advice =
+      "move less relative to the reference revision (or deform relative to a revision nearer "
+      "the target), or widen decay_radius";
+  if (const auto* rigid = std::get_if<RigidMotion>(&motion);
+      rigid != nullptr && std::abs(rigid->angle) > std::numbers::pi) {
+    advice = absl::StrCat(
+        "a rotation by ", rigid->angle * 180.0 / std::numbers::pi,
+        " degrees winds the interior around the body, which turns by a fraction of the whole "
+        "angle: the same wall position is reached by the angle reduced into [-180, 180], with "
+        "the interior unwound");
+  }
   return absl::FailedPreconditionError(
       absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",
                    check.level, "; the worst in block ", check.worst_block, " at cell (", c[0],
                    ", ", c[1], ", ", c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
-                   "; nothing was stored (move less per step, or widen decay_radius)"));
+                   "; nothing was stored (", advice, ")"));
 }
 
 // The deformed revision: the reference's blocks with the moved splines, stamped.
@@ -161,7 +179,7 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationGate> gate,
                       kept->Gate(request.check_level, context.budget, cancel));
   SG_ASSIGN_OR_RETURN(const DeformationCheck check, gate->Check(moved, cancel));
-  if (!check.ok()) return Folds(check);
+  if (!check.ok()) return Folds(check, request.motion);
   GridRevision revision = DeformedRevision(*reference, deformer, std::move(moved), check, request);
   revision.deform.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

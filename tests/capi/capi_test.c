@@ -294,6 +294,23 @@ static void Airfoil(sg_client* client, const char* grid_file) {
   sg_watch_close(watch);
   CHECK_ERROR(client, sg_watch_open(client, "c-naca", -5, &watch), SG_INVALID_ARGUMENT,
               "after_revision: -5");
+
+  /* Far-field points (j = 32) move only when the options select the outer boundary; the
+   * refusal names the point by its indices. */
+  const int32_t far_begin[3] = {50, 32, 0};
+  const int32_t far_end[3] = {60, 32, 0};
+  double still[22] = {0.0};
+  options.base_revision = 0;
+  options.step = 4;
+  options.boundary_kind = 0; /* the walls */
+  CHECK_ERROR(client,
+              sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MAX, far_begin, far_end,
+                               0, still, 22, 1, &moved),
+              SG_INVALID_ARGUMENT, "point (50, 32, 0) of block 0 is not on the moved boundary");
+  options.boundary_kind = SG_BOUNDARY_OUTER;
+  CHECK_OK(client, sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MAX, far_begin,
+                                    far_end, 0, still, 22, 1, &moved));
+  CHECK(moved.revision == 4 && moved.min_jacobian_ratio > 0.0);
   CHECK_OK(client, sg_delete(client, "c-naca"));
 }
 

@@ -369,7 +369,8 @@ TEST(DeformerTest, BadInputIsAnErrorNamingIt) {
   off.range = FaceRange{Face{0, 1, true}, {0, 32, 0}, {10, 32, 0}};
   off.coordinates.assign(22, 0.0);
   EXPECT_THAT(deformer.MoveBoundaryPoints({&off, 1}).status().message(),
-              HasSubstr("not on the moved boundary"));
+              HasSubstr("boundary points 0: point (0, 32, 0) of block 0 is not on the moved "
+                        "boundary (what the request's boundary selects: the walls unless"));
   BoundaryPoints wrong_count;
   wrong_count.range = FaceRange{Face{0, 1, false}, {50, 0, 0}, {60, 0, 0}};
   wrong_count.coordinates.assign(7, 0.0);

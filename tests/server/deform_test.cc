@@ -268,6 +268,16 @@ TEST_F(DeformErrorsTest, StaleBaseIsAbortedAndAFoldIsRefused) {
   EXPECT_THAT(Deform(fold), StatusIs(absl::StatusCode::kFailedPrecondition, "folds"));
   EXPECT_THAT(Deform(fold), StatusIs(absl::StatusCode::kFailedPrecondition, "at cell ("));
   EXPECT_THAT(Deform(fold), StatusIs(absl::StatusCode::kFailedPrecondition, "nothing was stored"));
+  // Motions are relative to the reference revision: the advice says so.
+  EXPECT_THAT(Deform(fold), StatusIs(absl::StatusCode::kFailedPrecondition,
+                                     "move less relative to the reference revision"));
+  // A whole turn leaves the wall where it was but winds the interior around it (a trial's
+  // accumulating rotor angle): the advice names the reduced angle.
+  EXPECT_THAT(Deform(Pitch("naca", 360.0, 1)),
+              StatusIs(absl::StatusCode::kFailedPrecondition,
+                       "a rotation by 360 degrees winds the interior around the body"));
+  EXPECT_THAT(Deform(Pitch("naca", 360.0, 1)),
+              StatusIs(absl::StatusCode::kFailedPrecondition, "reduced into [-180, 180]"));
 }
 
 TEST_F(DeformTest, ConcurrentWritersOnOneBaseOneWinsTheOtherIsAborted) {
