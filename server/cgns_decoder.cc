@@ -15,6 +15,7 @@
 #include <cerrno>
 #include <filesystem>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
@@ -299,10 +300,12 @@ absl::StatusOr<ImportedGrid> Judge(int status, std::string output, const std::st
   if (code == 2) {
     // The decoder's message names the temporary file: never shown to the client. Replaced in
     // the whole output (already charged to the budget), so no cut can leave a part of the name,
-    // then quoted (escaped, and cut at kMaxMessage characters with the length noted).
+    // then escaped (control characters, non-ASCII bytes: one line that forges nothing) and cut
+    // at kMaxMessage characters with the length noted. Not quoted: the decoder quotes what it
+    // names from the file itself, and a second quoting turned its 'blk' into \'blk\'.
     const std::string message = absl::StrReplaceAll(output, {{upload, "the upload"}});
-    return absl::InvalidArgumentError(
-        absl::StrCat("cgns: ", QuoteClientString(message, kMaxMessage)));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "cgns: ", EscapeForLog(absl::StripTrailingAsciiWhitespace(message), kMaxMessage)));
   }
   if (code == kLimitsFailed) {
     return absl::InternalError(absl::StrCat(

@@ -242,19 +242,21 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   absl::StrAppend(
       &out, FormatReport(fit.report(), fit.num_control_points() == fit.num_points(), cells > 0));
   absl::StrAppend(
-      &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %8s %8s %6s\n", "block",
-                            "points", "controls", "ratio", "max dev", "wall", "interface", "outer",
-                            "interior", "min jac", "max size", "bad"));
+      &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %9s %8s %8s %6s\n",
+                            "block", "points", "controls", "ratio", "max dev", "wall", "interface",
+                            "outer", "interior", "1st layer", "min jac", "max size", "bad"));
   for (int b = 0; b < fit.blocks_size(); ++b) {
     const v1::BlockFitSummary& s = fit.blocks(b);
     const v1::DeviationByKind& k = s.deviation_by_kind();
     const v1::CellQualityReport& q = s.quality();
     absl::StrAppend(
         &out, absl::StrFormat(
-                  "%6d %10d %9d %7.1f %10.3g %10s %10s %10s %10s %8s %8s %6d%s\n", b,
+                  "%6d %10d %9d %7.1f %10.3g %10s %10s %10s %10s %9s %8s %8s %6d%s\n", b,
                   s.num_points(), s.num_control_points(), s.compression_ratio(), s.max_deviation(),
                   Optional(k.has_wall(), k.wall()), Optional(k.has_interface(), k.interface()),
                   Optional(k.has_outer(), k.outer()), Optional(k.has_interior(), k.interior()),
+                  // relative, as a percentage (the deviation line's figure, block by block)
+                  k.has_first_layer() ? absl::StrFormat("%.3g%%", 100.0 * k.first_layer()) : "-",
                   CellFigure(q, q.min_ratio()), CellFigure(q, SizeRatio(q)), q.num_bad_cells(),
                   s.has_tolerance_met() && !s.tolerance_met()
                       ? absl::StrCat("  TOLERANCE NOT MET: ", s.unmet_reason())

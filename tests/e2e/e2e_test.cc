@@ -367,6 +367,9 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
                                                "first-layer heights at walls changed by up to "
                                                "[0-9.e-]+%\n(.|\n)*"));
   EXPECT_THAT(fit.out, HasSubstr("connectivity: 1 matches"));
+  // Block by block in the table too (a percentage).
+  EXPECT_THAT(fit.out, HasSubstr("interior 1st layer  min jac"));
+  EXPECT_THAT(fit.out, ::testing::ContainsRegex("\n     0 [^\n]* [0-9.e-]+% "));
   // Held (--first_layer): against its tolerance, and within it.
   const Result held = Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"),
                                        " --name=held --first_layer=0.1"));
