@@ -157,10 +157,12 @@ std::string DescribeValue(const Attempt& a, int64_t value) {
                                                           located.index_in_block)));
 }
 
-// The error message for failed attempt `a` (without the prefix).
-std::string FailureMessage(const Attempt& a, const FortranList& list, std::string_view text) {
+// The error message for failed attempt `a` (without the prefix), its layout named after
+// `label` ("best-matching layout").
+std::string FailureMessage(const Attempt& a, const FortranList& list, std::string_view text,
+                           const char* label = "best-matching layout") {
   const std::string layout =
-      absl::StrCat(" (best-matching layout: ", a.hypothesis.spatial_dim, "D, ",
+      absl::StrCat(" (", label, ": ", a.hypothesis.spatial_dim, "D, ",
                    a.hypothesis.has_block_count ? "block-count line" : "no block-count line", ", ",
                    a.hypothesis.has_iblank ? "iblank" : "no iblank", ")");
   // The header value at fault (meaningful for kNotInteger and kOutOfRange only).
@@ -239,19 +241,32 @@ absl::StatusOr<MultiBlockGrid> ParsePlot3dText(std::string_view text, std::strin
   const Plot3dLayout layout = options.layout.value_or(Plot3dLayout::kWhole);
   const FortranList list = TokenizeFortranList(text, 1 + 3 * kMaxBlocks);
   std::optional<Attempt> match;
-  std::optional<Attempt> best;
+  // The failed attempt that got furthest, with and without a block-count line.
+  std::optional<Attempt> best_by_count[2];
+  const auto better = [](const Attempt& a, const std::optional<Attempt>& than) {
+    return !than.has_value() || a.stage > than->stage ||
+           (a.stage == than->stage && a.stage == Stage::kHeader && a.progress > than->progress);
+  };
+  // The attempt with a block-count line that failed in its header at the latest block.
+  std::optional<Attempt> counted_header;
   for (const Hypothesis& hypothesis : kHypotheses) {
     Attempt attempt = Evaluate(list, hypothesis, layout);
     if (attempt.stage == Stage::kMatch) {
       match = std::move(attempt);
       break;
     }
-    if (!best.has_value() || attempt.stage > best->stage ||
-        (attempt.stage == best->stage && attempt.stage == Stage::kHeader &&
-         attempt.progress > best->progress)) {
-      best = std::move(attempt);
+    if (hypothesis.has_block_count && attempt.stage == Stage::kHeader &&
+        (!counted_header.has_value() || attempt.block > counted_header->block)) {
+      counted_header = attempt;
     }
+    std::optional<Attempt>& best = best_by_count[hypothesis.has_block_count];
+    if (better(attempt, best)) best = std::move(attempt);
   }
+  // Ties go to the earlier hypothesis, as the order of kHypotheses has it: a block-count line.
+  const bool counted_is_best =
+      best_by_count[1].has_value() &&
+      (!best_by_count[0].has_value() || !better(*best_by_count[0], best_by_count[1]));
+  const std::optional<Attempt>& best = best_by_count[counted_is_best ? 1 : 0];
   if (list.first_bad.has_value()) {
     const BadToken& bad = *list.first_bad;
     const Attempt* layout = match.has_value() ? &*match : &*best;
@@ -263,8 +278,16 @@ absl::StatusOr<MultiBlockGrid> ParsePlot3dText(std::string_view text, std::strin
         ErrorPrefix(source), where, DescribeOffset(text, bad.offset), ": ", bad.problem));
   }
   if (!match.has_value()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(ErrorPrefix(source), FailureMessage(*best, list, text)));
+    std::string message = FailureMessage(*best, list, text);
+    // A file that starts like a block-count line and the blocks' dimensions, but fails in that
+    // header after the first block's (a block's dimensions line missing: coordinates read as
+    // dimensions), is best read without one, which then misses values. Both readings say what
+    // is wrong.
+    if (!counted_is_best && counted_header.has_value() && counted_header->block >= 1) {
+      absl::StrAppend(&message, "; read with a block-count line instead: ",
+                      FailureMessage(*counted_header, list, text, "layout"));
+    }
+    return absl::InvalidArgumentError(absl::StrCat(ErrorPrefix(source), message));
   }
   const Attempt& a = *match;
   const int dim = a.hypothesis.spatial_dim;

@@ -17,6 +17,7 @@ namespace splinegrid {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 constexpr char kSource[] = "bad.fmt";
 
@@ -64,6 +65,21 @@ TEST(Plot3dMalformedTextTest, TruncatedSharedFileSaysExpectedAndFound) {
   EXPECT_THAT(message,
               HasSubstr("expected 2*113*33 = 7458 coordinates after the header, found 7457"));
   EXPECT_THAT(message, HasSubstr("the file ends before block 0, y of point (112, 32, 0)"));
+}
+
+// A header that declares two blocks but gives one block's dimensions (a trial's file): read
+// without a block-count line it misses values, read with one the second block's dimensions are
+// coordinates. The message gives both readings, so the missing line shows.
+TEST(Plot3dMalformedTextTest, AMissingDimensionsLineShowsInBothReadings) {
+  const std::string message =
+      ParseError("2\n3 3\n0 1 2 0 1 2 0 1 2\n0 0 0 1 1 1 2 2 2\n");
+  EXPECT_THAT(message, HasSubstr("(best-matching layout: 3D, no block-count line, no iblank)"));
+  EXPECT_THAT(message, HasSubstr("; read with a block-count line instead: block 1: ni = 0 at "
+                                 "line 3, column 1 must be from 1 to"));
+  EXPECT_THAT(message, HasSubstr("(layout: 2D, block-count line, no iblank)"));
+  // A truncated file without a block-count line gets no second reading (its first coordinate
+  // is no dimension).
+  EXPECT_THAT(ParseError("3 2\n0.5 1 2 0 1 2\n0 0 0 1 1\n"), Not(HasSubstr("instead")));
 }
 
 TEST(Plot3dMalformedTextTest, EveryCutOfSmallTextFilesFails) {
