@@ -102,7 +102,7 @@ typedef struct sg_deform_options {
   double time;                /* solver time stamped on the new revision */
   int64_t step;               /* solver time step stamped on the new revision */
   int32_t check_level;        /* refinement level of the server's fold check, 0 to 4 */
-  int32_t boundary_kind;      /* SG_BOUNDARY_*: which boundary a rigid motion moves; 0: walls */
+  int32_t boundary_kind;      /* SG_BOUNDARY_*: the moved boundary (rigid and point motions); 0: walls */
 } sg_deform_options;
 
 /* What a deformation stored (DeformGridResponse and its DeformReport). */

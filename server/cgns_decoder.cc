@@ -300,9 +300,10 @@ absl::StatusOr<ImportedGrid> Judge(int status, std::string output, const std::st
   if (code == 2) {
     // The decoder's message names the temporary file: never shown to the client. Replaced in
     // the whole output (already charged to the budget), so no cut can leave a part of the name,
-    // then escaped (control characters, non-ASCII bytes: one line that forges nothing) and cut
-    // at kMaxMessage characters with the length noted. Not quoted: the decoder quotes what it
-    // names from the file itself, and a second quoting turned its 'blk' into \'blk\'.
+    // then escaped (control characters and non-ASCII bytes: one printable line) and cut at
+    // kMaxMessage characters with the length noted. Not quoted as a whole: the decoder puts
+    // what it names from the file in quotes itself, and a second quoting turned its 'blk' into
+    // \'blk\'.
     const std::string message = absl::StrReplaceAll(output, {{upload, "the upload"}});
     return absl::InvalidArgumentError(absl::StrCat(
         "cgns: ", EscapeForLog(absl::StripTrailingAsciiWhitespace(message), kMaxMessage)));

@@ -543,8 +543,8 @@ absl::StatusOr<std::shared_ptr<const Deformer::BoundaryFit>> Deformer::CheckedFi
       const int64_t ni = extents[b][0], nj = extents[b][1], at = static_cast<int64_t>(p);
       return absl::InvalidArgumentError(absl::StrCat(
           name, ": point (", at % ni, ", ", (at / ni) % nj, ", ", at / (ni * nj), ") of block ",
-          b, " is not on the moved boundary (what the request's boundary selects: the walls "
-             "unless it names kinds or face ranges)"));
+          b, " is not on the moved boundary (DeformOptions.moved, a request's boundary: the "
+             "walls unless it names kinds or face ranges)"));
     }
   }
   if (given.level < 0 || given.level > kMaxRefinementLevel) {

@@ -71,8 +71,8 @@ struct ControlFunctions {
 
 // The control functions of the file comment from the algebraic grid `grid` (ni x nj x 1,
 // spatial_dim 2, i periodic: the first line repeated as the last), phi blended from layer
-// `inner` (the innermost free layer's neighbour below) to the outer loop. About 0.17 us a
-// point (a safeguarded Newton iteration per point; BM_TrackingControls): `cancel` is polled
+// `inner` (the innermost free layer's neighbour below) to the outer loop. About 0.15-0.17 us
+// a point (a safeguarded Newton iteration per point; BM_TrackingControls): `cancel` is polled
 // every layer. Errors: CANCELLED.
 absl::StatusOr<ControlFunctions> TrackingControls(const StructuredBlock& grid, int inner,
                                                   const CancelCheck& cancel = {});

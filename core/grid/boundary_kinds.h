@@ -86,7 +86,8 @@ struct BoundaryTolerances {
   // with this relative accuracy on the first-layer edges (ForEachFirstLayerEdge below) and,
   // since an edge's limit is the looser of its ends', on the edges among their ends: along the
   // wall and along the first layer. 0: off, those edges have `edge` like the rest. Held, it
-  // bounds the relative change of every first-layer height (fit_deviation.h first_layer).
+  // bounds the relative change of every first-layer height (fit_deviation.h first_layer), but
+  // not at poles, where the fit switches the edge criterion off to keep them collapsed.
   double first_layer = 0.0;
 
   // INVALID_ARGUMENT naming the field: wall, interface and outer must be positive and finite,

@@ -18,11 +18,20 @@ struct Hypothesis {
   bool has_iblank;       // every block ends with iblank values
 };
 
-// All candidates, in order of preference (see plot3d.h).
+// All candidates, in order of preference (see plot3d.h). Those with a block-count line come
+// first: ParsePlot3dText keeps the best of each group and gives ties to this group.
 constexpr Hypothesis kHypotheses[] = {
     {true, 3, false},  {true, 3, true},  {true, 2, false},  {true, 2, true},
     {false, 3, false}, {false, 3, true}, {false, 2, false}, {false, 2, true},
 };
+static_assert([] {
+  bool counted = true;
+  for (const Hypothesis& h : kHypotheses) {
+    if (h.has_block_count && !counted) return false;
+    counted = h.has_block_count;
+  }
+  return true;
+}());
 
 // How far a hypothesis got; later stages are better candidates for the error message.
 enum class Stage { kHeader = 0, kSize = 1, kContent = 2, kMatch = 3 };

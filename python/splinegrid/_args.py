@@ -75,10 +75,13 @@ def _extents(values: Triple, what: str, fill: int) -> grid_pb2.Extents:
     try:
         if isinstance(values, (str, bytes)):
             raise TypeError  # "128" would be (1, 2, 8)
-        values = [int(v) for v in values]
-        if any(isinstance(v, (str, bytes)) or v != int(v) for v in given):
-            raise ValueError  # "3", 1.5
-    except (TypeError, ValueError):  # a bare number, or something that is not an integer
+        items = list(values)  # an iterator is read once
+        if any(isinstance(v, (str, bytes)) for v in items):
+            raise TypeError  # ("3", 4)
+        values = [int(v) for v in items]
+        if any(v != int(v) for v in items):
+            raise ValueError  # 1.5
+    except (TypeError, ValueError, OverflowError):  # a bare number, inf, not an integer
         raise ValueError(f"{what} = {given!r}; give 1 to 3 integers (i, j, k)") from None
     if not 1 <= len(values) <= 3:
         raise ValueError(f"{what} = {values}; give 1 to 3 integers (i, j, k)")

@@ -76,9 +76,9 @@ class _FitCalls(_Calls):
         ``first_layer`` are relative (``first_layer=0.05``: every first-layer height at the
         walls, what a solver's y+ follows, within 5%; the report's
         ``deviation_by_kind.first_layer`` gives the change either way); the other values given
-        are lengths in the grid's unit; the defaults are fractions of the grid's reference length: ``ref_length``
-        (implies ``boundary_tolerances={}`` when none is given; refused with ``tolerance`` or
-        ``control_counts``, which are absolute), else detected by the server as the largest
+        are lengths in the grid's unit; the defaults are fractions of the grid's reference
+        length: ``ref_length`` (implies ``boundary_tolerances={}`` when none is given; refused
+        with ``tolerance`` or ``control_counts``, which are absolute), else detected by the server as the largest
         extent of a wall (an airfoil's chord; the bounding-box diagonal without walls), so a
         grid in chords, millimetres or inches is fitted alike. The report states it
         (``reference_length``, ``reference_length_description``) and the tolerances held

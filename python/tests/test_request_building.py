@@ -210,6 +210,8 @@ class TestDeform:
             _boundary_selection((0, "jmin", "128", (216, 0)))
         with pytest.raises(ValueError, match=r"boundary\[0\] end = \(1.5, 0\); give 1 to 3"):
             _boundary_selection((0, "jmin", (1, 0), (1.5, 0)))
+        with pytest.raises(ValueError, match=r"boundary\[0\] end = \(inf, 0\); give 1 to 3"):
+            _boundary_selection((0, "jmin", (1, 0), (float("inf"), 0)))
 
 
 class TestGridRequests:

@@ -74,8 +74,9 @@ absl::Status Folds(const DeformationCheck& check, const DeformMotion& motion) {
     advice = absl::StrCat(
         "a rotation by ", rigid->angle * 180.0 / std::numbers::pi,
         " degrees winds the interior around the body, which turns by a fraction of the whole "
-        "angle: the same wall position is reached by the angle reduced into [-180, 180], with "
-        "the interior unwound");
+        "angle: the angle reduced into [-180, 180] reaches the same wall with the interior "
+        "unwound, but a series passing 180 degrees then jumps a turn inside between steps (a "
+        "rotor needs a block that rotates with it)");
   }
   return absl::FailedPreconditionError(
       absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",

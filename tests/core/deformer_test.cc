@@ -370,7 +370,7 @@ TEST(DeformerTest, BadInputIsAnErrorNamingIt) {
   off.coordinates.assign(22, 0.0);
   EXPECT_THAT(deformer.MoveBoundaryPoints({&off, 1}).status().message(),
               HasSubstr("boundary points 0: point (0, 32, 0) of block 0 is not on the moved "
-                        "boundary (what the request's boundary selects: the walls unless"));
+                        "boundary (DeformOptions.moved, a request's boundary: the walls unless"));
   BoundaryPoints wrong_count;
   wrong_count.range = FaceRange{Face{0, 1, false}, {50, 0, 0}, {60, 0, 0}};
   wrong_count.coordinates.assign(7, 0.0);

@@ -258,10 +258,13 @@ TEST_F(ArchiveCodecTest, FittedRevisionRoundTripsBitwise) {
     block.mutable_deviation_by_kind()->clear_first_layer();
   }
   old.mutable_fit_options()->mutable_boundary_tolerances()->clear_first_layer();
+  old.mutable_report()->mutable_tolerances()->clear_first_layer();
   absl::StatusOr<GridRevision> before = ParseRevision(old);
   ASSERT_TRUE(before.ok()) << before.status();
   EXPECT_EQ(before->blocks[0].deviation_by_kind.first_layer, -1.0);
   EXPECT_EQ(before->fit_options.boundary_tolerances->first_layer, 0.0);
+  EXPECT_EQ(before->report.tolerances->first_layer, 0.0);
+  EXPECT_EQ(parsed->report.tolerances->first_layer, 0.3);
 }
 
 // A deformed revision: parent, time, step, the gate's summary with an infinite decay radius,

@@ -11,7 +11,8 @@ namespace splinegrid {
 
 absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
                                               const StructuredBlock& block,
-                                              const std::vector<uint8_t>& kinds) {
+                                              const std::vector<uint8_t>& kinds,
+                                              std::span<const uint8_t> on_pole, double collapsed) {
   std::array<std::vector<double>, 3> params;
   for (int d = 0; d < 3; ++d) params[d] = fitted.distribution.params(d);
   const StructuredBlock eval = EvaluateGrid(fitted.spline, params);
@@ -31,19 +32,11 @@ absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
       dev.interface = std::max(dev.interface, d);
     if (k & static_cast<uint8_t>(BoundaryKind::kOuter)) dev.outer = std::max(dev.outer, d);
   }
-  // First-layer heights. A collapsed edge (a pole, a tip cap; below rounding of the block's
-  // size) has no height to keep: relative to it any error would be unbounded.
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int64_t p = 0; p < block.num_points(); ++p) {
-    for (int c = 0; c < s; ++c) {
-      lo[c] = std::min(lo[c], block.coords()[s * p + c]);
-      hi[c] = std::max(hi[c], block.coords()[s * p + c]);
-    }
-  }
-  double diagonal2 = 0.0;
-  for (int c = 0; c < s; ++c) diagonal2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-  const double collapsed2 = 1e-24 * diagonal2;  // (1e-12 of the diagonal)^2
+  // First-layer heights. A collapsed edge has no height to keep (relative to it any error
+  // would be unbounded), and an edge from a pole is not held by the fit.
+  const double collapsed2 = collapsed * collapsed;
   ForEachFirstLayerEdge(block, kinds, [&](int64_t p, int64_t q) {
+    if (!on_pole.empty() && (on_pole[p] || on_pole[q])) return;
     double data = 0.0, fit = 0.0;
     for (int c = 0; c < s; ++c) {
       const double a = block.coords()[s * q + c] - block.coords()[s * p + c];
@@ -51,9 +44,15 @@ absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
       data += a * a;
       fit += b * b;
     }
-    if (!(data > collapsed2)) return;
+    if (!(data > collapsed2)) return;  // also exactly 0 when `collapsed` is
     const double height = std::sqrt(data);
-    dev.first_layer = std::max(dev.first_layer, std::abs(std::sqrt(fit) - height) / height);
+    const double change = std::abs(std::sqrt(fit) - height) / height;
+    if (change > dev.first_layer) {
+      dev.first_layer = change;
+      const int64_t ni = block.extent(0), nj = block.extent(1);
+      dev.first_layer_at = {static_cast<int>(p % ni), static_cast<int>((p / ni) % nj),
+                            static_cast<int>(p / (ni * nj))};
+    }
   });
   return dev;
 }

@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/fit/report/fit_deviation.h"
 #include "core/fit/report/wall_curvature.h"
+#include "core/grid/poles.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid::internal {
@@ -70,10 +71,24 @@ absl::Status ReportFit(const MultiBlockGrid& grid, const CellQualityOptions& qua
                    "max_deviation";
   report.quality_met = true;
   std::vector<FittedBlock> fitted;
+  // The points on poles, whose first-layer edges no fit holds (fit_deviation.h).
+  const double pole_tolerance = PoleTolerance(grid);
+  std::vector<std::vector<uint8_t>> on_pole(grid.blocks.size());
+  for (const Pole& pole : FindPoles(grid, pole_tolerance)) {
+    const StructuredBlock& block = grid.blocks[pole.block];
+    std::vector<uint8_t>& mask = on_pole[pole.block];
+    mask.resize(static_cast<size_t>(block.num_points()), 0);
+    for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
+      for (int j = pole.lo[1]; j <= pole.hi[1]; ++j) {
+        for (int i = pole.lo[0]; i <= pole.hi[0]; ++i) mask[block.Index(i, j, k)] = 1;
+      }
+    }
+  }
   for (int b = 0; b < static_cast<int>(fit.blocks.size()); ++b) {
     BlockFit& block = fit.blocks[b];
     SG_ASSIGN_OR_RETURN(block.deviation_by_kind,
-                        DeviationByKind(block.fitted, grid.blocks[b], fit.kinds.point_kinds[b]));
+                        DeviationByKind(block.fitted, grid.blocks[b], fit.kinds.point_kinds[b],
+                                        on_pole[b], pole_tolerance));
     if (tolerances) {
       SG_RETURN_IF_ERROR(
           MeasureAgainstTolerances(grid, *tolerances, fit.kinds, quality.cancel, b, block));
@@ -82,9 +97,10 @@ absl::Status ReportFit(const MultiBlockGrid& grid, const CellQualityOptions& qua
       if (block.tolerance_met && tolerances->first_layer > 0.0 &&
           first_layer > tolerances->first_layer) {
         block.tolerance_met = false;
-        block.unmet_reason =
-            absl::StrCat("block ", b, ": a first-layer height at a wall changed by ", first_layer,
-                         ", more than first_layer = ", tolerances->first_layer);
+        const Extents& at = block.deviation_by_kind.first_layer_at;
+        block.unmet_reason = absl::StrCat("block ", b, " first-layer height at wall point (", at[0],
+                                          ", ", at[1], ", ", at[2], ") changed by ", first_layer,
+                                          ", more than first_layer = ", tolerances->first_layer);
       }
       if (!block.tolerance_met && report.tolerance_met) {
         report.tolerance_met = false;
