@@ -49,7 +49,8 @@ grpc::ServerUnaryReactor* SplineGridService::DeformGrid(grpc::CallbackServerCont
     SG_RETURN_IF_ERROR(parsed->status());
     return ops::DeformIsSmall(Ops(caller), **parsed);
   };
-  return RunSizedOnPool(context, log, Role::kWrite, std::move(small), std::move(deform));
+  return RunSizedOnPool(context, log, Role::kWrite, WorkKind::kSlice, std::move(small),
+                        std::move(deform));
 }
 
 }  // namespace splinegrid::server

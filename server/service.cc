@@ -118,13 +118,6 @@ grpc::ServerUnaryReactor* SplineGridService::RunOnPool(grpc::CallbackServerConte
 }
 
 grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServerContext* context,
-                                                            CallLog log, Role needed,
-                                                            SizeUp size_up, Work work) {
-  return RunSizedOnPool(context, std::move(log), needed, WorkKind::kSlice, std::move(size_up),
-                        std::move(work));
-}
-
-grpc::ServerUnaryReactor* SplineGridService::RunSizedOnPool(grpc::CallbackServerContext* context,
                                                             CallLog log, Role needed, WorkKind kind,
                                                             SizeUp size_up, Work work) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();

@@ -156,13 +156,11 @@ class SplineGridService final : public v1::SplineGrid::CallbackService {
   grpc::ServerUnaryReactor* RunOnPool(grpc::CallbackServerContext* context, CallLog log,
                                       Role needed, WorkKind kind, Work work);
   // The same for work whose cost is known only once the grid is read: `size_up` runs first as
-  // a slice (any worker, turns across principals); when it answers true (small) or fails,
-  // `work` runs in that slice (failing early with its own answer), otherwise it is queued for
-  // the long workers, counted as the caller's long call like one admitted as long work.
+  // `kind` (a slice: any worker, turns across principals); when it answers true (small) or
+  // fails, `work` runs in that task (failing early with its own answer), otherwise it is queued
+  // for the long workers, counted as the caller's long call like one admitted as long work.
+  // Without `size_up` (null), `work` runs in the first task: RunOnPool.
   using SizeUp = std::function<absl::StatusOr<bool>(const Caller&)>;
-  grpc::ServerUnaryReactor* RunSizedOnPool(grpc::CallbackServerContext* context, CallLog log,
-                                           Role needed, SizeUp size_up, Work work);
-  // Both: the first task runs as `kind`; without `size_up` (null) `work` runs in it.
   grpc::ServerUnaryReactor* RunSizedOnPool(grpc::CallbackServerContext* context, CallLog log,
                                            Role needed, WorkKind kind, SizeUp size_up, Work work);
   // Admits the call and runs cheap, non-numeric `work` right here and finishes the call.

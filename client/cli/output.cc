@@ -115,6 +115,7 @@ std::string FormatKindDeviations(
                    {"interface", false, 0.0, held ? t.interface() : 0.0},
                    {"outer", false, 0.0, held ? t.outer() : 0.0},
                    {"interior", false, 0.0, held ? t.interior() : 0.0}};
+  double first_layer = -1.0;  // not a deviation: a relative change (none measured: < 0)
   for (const v1::BlockFitSummary& b : blocks) {
     const v1::DeviationByKind& d = b.deviation_by_kind();
     const bool has[4] = {d.has_wall(), d.has_interface(), d.has_outer(), d.has_interior()};
@@ -124,12 +125,7 @@ std::string FormatKindDeviations(
       kinds[k].deviation = kinds[k].has ? std::max(kinds[k].deviation, value[k]) : value[k];
       kinds[k].has = true;
     }
-  }
-  double first_layer = -1.0;
-  for (const v1::BlockFitSummary& b : blocks) {
-    if (b.deviation_by_kind().has_first_layer()) {
-      first_layer = std::max(first_layer, b.deviation_by_kind().first_layer());
-    }
+    if (d.has_first_layer()) first_layer = std::max(first_layer, d.first_layer());
   }
   std::string out;
   for (const Kind& k : kinds) {

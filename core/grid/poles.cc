@@ -116,4 +116,20 @@ std::vector<Pole> FindPoles(const MultiBlockGrid& grid, double tolerance) {
   return poles;
 }
 
+std::vector<std::vector<uint8_t>> PointsOnPoles(const MultiBlockGrid& grid,
+                                                const std::vector<Pole>& poles) {
+  std::vector<std::vector<uint8_t>> on_pole(grid.blocks.size());
+  for (const Pole& pole : poles) {
+    const StructuredBlock& block = grid.blocks[pole.block];
+    std::vector<uint8_t>& mask = on_pole[pole.block];
+    mask.resize(static_cast<size_t>(block.num_points()), 0);
+    for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
+      for (int j = pole.lo[1]; j <= pole.hi[1]; ++j) {
+        for (int i = pole.lo[0]; i <= pole.hi[0]; ++i) mask[block.Index(i, j, k)] = 1;
+      }
+    }
+  }
+  return on_pole;
+}
+
 }  // namespace splinegrid

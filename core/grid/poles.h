@@ -18,6 +18,7 @@
 #ifndef SPLINEGRID_CORE_GRID_POLES_H_
 #define SPLINEGRID_CORE_GRID_POLES_H_
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,11 @@ bool BoxCollapsed(const StructuredBlock& block, const Extents& lo, const Extents
 // two boundary lines along d that is. A line may be listed more than once (it bounds two faces).
 // Cost O(boundary points).
 std::vector<Pole> FindPoles(const MultiBlockGrid& grid, double tolerance);
+
+// Per block of `grid`, 1 at the points of `poles` and 0 elsewhere (empty for a block without
+// one). Cost O(points of the blocks with poles).
+std::vector<std::vector<uint8_t>> PointsOnPoles(const MultiBlockGrid& grid,
+                                                const std::vector<Pole>& poles);
 
 }  // namespace splinegrid
 

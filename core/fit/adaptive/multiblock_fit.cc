@@ -239,15 +239,11 @@ PointTargets TargetsAndFeatures(const MultiBlockGrid& grid, const BoundaryKinds&
 // edges still bind it.
 void SwitchOffPoleEdges(const MultiBlockGrid& grid, const std::vector<Pole>& poles,
                         std::vector<std::vector<double>>& edge_tolerances) {
-  for (const Pole& pole : poles) {
-    const StructuredBlock& block = grid.blocks[pole.block];
-    if (edge_tolerances[pole.block].size() != static_cast<size_t>(block.num_points())) continue;
-    for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
-      for (int j = pole.lo[1]; j <= pole.hi[1]; ++j) {
-        for (int i = pole.lo[0]; i <= pole.hi[0]; ++i) {
-          edge_tolerances[pole.block][block.Index(i, j, k)] = 0.0;
-        }
-      }
+  const std::vector<std::vector<uint8_t>> on_pole = PointsOnPoles(grid, poles);
+  for (size_t b = 0; b < on_pole.size(); ++b) {
+    if (edge_tolerances[b].size() != on_pole[b].size()) continue;  // none, or one for all
+    for (size_t p = 0; p < on_pole[b].size(); ++p) {
+      if (on_pole[b][p]) edge_tolerances[b][p] = 0.0;
     }
   }
 }

@@ -73,17 +73,8 @@ absl::Status ReportFit(const MultiBlockGrid& grid, const CellQualityOptions& qua
   std::vector<FittedBlock> fitted;
   // The points on poles, whose first-layer edges no fit holds (fit_deviation.h).
   const double pole_tolerance = PoleTolerance(grid);
-  std::vector<std::vector<uint8_t>> on_pole(grid.blocks.size());
-  for (const Pole& pole : FindPoles(grid, pole_tolerance)) {
-    const StructuredBlock& block = grid.blocks[pole.block];
-    std::vector<uint8_t>& mask = on_pole[pole.block];
-    mask.resize(static_cast<size_t>(block.num_points()), 0);
-    for (int k = pole.lo[2]; k <= pole.hi[2]; ++k) {
-      for (int j = pole.lo[1]; j <= pole.hi[1]; ++j) {
-        for (int i = pole.lo[0]; i <= pole.hi[0]; ++i) mask[block.Index(i, j, k)] = 1;
-      }
-    }
-  }
+  const std::vector<std::vector<uint8_t>> on_pole =
+      PointsOnPoles(grid, FindPoles(grid, pole_tolerance));
   for (int b = 0; b < static_cast<int>(fit.blocks.size()); ++b) {
     BlockFit& block = fit.blocks[b];
     SG_ASSIGN_OR_RETURN(block.deviation_by_kind,
