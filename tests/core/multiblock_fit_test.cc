@@ -280,6 +280,24 @@ TEST(MultiBlockFitTest, DataErrors) {
   EXPECT_THAT(fit.status().message(), HasSubstr("block 2"));
 }
 
+// A first layer to hold on a grid without walls would hold nothing, and the report would read
+// as if it were held: it is refused, naming the field and how walls are named. With a wall
+// named, the same request is a fit.
+TEST(MultiBlockFitTest, AFirstLayerAskedOfAGridWithoutWallsIsRefused) {
+  const MultiBlockGrid grid = SideBySide(9, 0.5);
+  GridFitOptions options = SyntheticOptions();
+  options.boundary_tolerances->first_layer = 0.05;
+  const absl::StatusOr<GridFit> refused = FitGrid(grid, options);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.status().message(), HasSubstr("tolerances.first_layer = 0.05 holds nothing"));
+  EXPECT_THAT(refused.status().message(), HasSubstr("face_kinds"));
+  options.face_kinds = {{{0, 1, false}, BoundaryKind::kWall}};
+  const GridFit fit = Fit(grid, options);
+  EXPECT_TRUE(fit.report.tolerance_met) << fit.report.unmet_reason;
+  EXPECT_GE(fit.blocks[0].deviation_by_kind.first_layer, 0.0);
+  EXPECT_LE(fit.blocks[0].deviation_by_kind.first_layer, 0.05);
+}
+
 TEST(MultiBlockFitTest, CancellationIsHonouredBetweenWorkUnits) {
   const MultiBlockGrid grid = SideBySide(17, 0.5);
   const GridFitOptions options = SyntheticOptions();

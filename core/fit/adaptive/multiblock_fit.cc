@@ -9,9 +9,11 @@
 #include <tuple>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "core/fit/adaptive/adaptive_engine.h"
 #include "core/fit/adaptive/segment_model.h"
 #include "core/fit/report/fit_report.h"
+#include "core/grid/boundary_kinds.h"
 #include "core/util/status_macros.h"
 #include "core/util/union_find.h"
 
@@ -332,6 +334,16 @@ bool Better(const GridFit& a, const GridFit& b) {
   return key(a) < key(b);
 }
 
+// Whether some block of `grid` has a first-layer edge (boundary_kinds.h) under `kinds`.
+bool HasFirstLayerEdges(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
+  bool any = false;
+  for (size_t b = 0; b < grid.blocks.size() && !any; ++b) {
+    ForEachFirstLayerEdge(grid.blocks[b], kinds.point_kinds[b],
+                          [&any](int64_t, int64_t) { any = true; });
+  }
+  return any;
+}
+
 }  // namespace
 
 absl::StatusOr<MultiBlockRun> FitMultiBlock(const MultiBlockGrid& grid,
@@ -341,6 +353,14 @@ absl::StatusOr<MultiBlockRun> FitMultiBlock(const MultiBlockGrid& grid,
                                             const BoundaryTolerances& tolerances,
                                             const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
+  // A first layer asked for on a grid without walls would be met by nothing, and the report
+  // would read as if it were held.
+  if (tolerances.first_layer > 0.0 && !HasFirstLayerEdges(grid, kinds)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "tolerances.first_layer = ", tolerances.first_layer,
+        " holds nothing: no wall of the grid has a first layer (walls are the faces towards "
+        "which the grid is clustered; name them by FitSpec.face_kinds, CLI --face 0:jmin=wall)"));
+  }
   CellQualityOptions quality = options.quality;
   quality.cancel = cancel;
   MultiBlockRun result;
