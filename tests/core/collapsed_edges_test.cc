@@ -6,6 +6,8 @@
 // evaluated points, not by the quality code), matched boundaries coincide at levels 0-2, and the
 // pole stays one point at every level, bitwise shared by the blocks that meet there. The fits go
 // through FitGrid (grid_fit.h); the poles are found here as the fit finds them (FindPoles).
+// Volumes around a polar axis and off the nose of a body of revolution check the same in 3D,
+// and that a held first layer leaves the pole out (the fit keeps it collapsed instead).
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -17,6 +19,7 @@
 #include "core/fit/grid_fit.h"
 #include "core/grid/poles.h"
 #include "core/io/plot3d.h"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/multiblock_checks.h"
 #include "tests/core/synthetic_grids.h"
@@ -63,8 +66,8 @@ GridFitOptions DiskOptions(int blocks) {
   return options;
 }
 
-Point3 At(const StructuredBlock& block, int i, int j) {
-  const double* p = block.Point(i, j, 0);
+Point3 At(const StructuredBlock& block, int i, int j, int k = 0) {
+  const double* p = block.Point(i, j, k);
   return {p[0], p[1], block.spatial_dim() == 3 ? p[2] : 0.0};
 }
 
@@ -490,6 +493,75 @@ TEST(CollapsedEdgeFitTest, VolumeAroundAPolarAxis) {
   std::cout << "[figures] axis volume 9 x 33 x 9: " << n[0] << " x " << n[1] << " x " << n[2]
             << " controls, outer " << fit->blocks[0].deviation_by_kind.outer << ", interface "
             << fit->blocks[0].deviation_by_kind.interface << "\n";
+}
+
+// A volume off the nose of a body of revolution: i along the body from the nose (polar angle
+// from the axis), j once around it (a periodic seam), k outwards from the wall (k = 0), the
+// layers geometric from a first height of 1e-3. The face i = 0 is collapsed along j to the axis
+// ahead of the nose, so the wall's first-layer edges from the nose point lie on a pole.
+MultiBlockGrid NoseVolume(int ni, int nj, int nk) {
+  MultiBlockGrid grid;
+  const std::vector<double> heights = GeometricSpacing(nk, 1e-3, 1.3);
+  grid.blocks.push_back(SpaceBlock(ni, nj, nk, [=](int i, int j, int k) {
+    const double theta = 0.6 * std::numbers::pi * i / (ni - 1);
+    const double phi = 2.0 * std::numbers::pi * (j % (nj - 1)) / (nj - 1);
+    const double rho = 0.5 * (1.0 + 0.1 * std::sin(theta) * std::cos(2.0 * phi)) + heights[k];
+    return std::array<double, 3>{rho * std::sin(theta) * std::cos(phi),
+                                 rho * std::sin(theta) * std::sin(phi), -rho * std::cos(theta)};
+  }));
+  return grid;
+}
+
+// The first layer of a wall with a pole in 3D: held to 5% everywhere but on the pole (the fit
+// keeps the pole collapsed instead), and the report's figure is the largest change over the
+// other first-layer edges, measured here from the evaluated spline.
+TEST(CollapsedEdgeFitTest, AHeldFirstLayerLeavesOutThePoleOfAVolume) {
+  const MultiBlockGrid grid = NoseVolume(17, 25, 9);
+  const StructuredBlock& data = grid.blocks[0];
+  BoundaryTolerances tolerances;
+  tolerances.wall = 1e-4;
+  tolerances.interface = 1e-3;
+  tolerances.outer = 1e-3;
+  tolerances.first_layer = 0.05;
+  GridFitOptions options = KindToleranceOptions(tolerances);
+  options.face_kinds = {{{0, 2, false}, BoundaryKind::kWall}};
+  const absl::StatusOr<GridFit> fit = FitGrid(grid, options);
+  ASSERT_TRUE(fit.ok()) << fit.status();
+  ASSERT_FALSE(GridPoles(grid).empty());
+  EXPECT_TRUE(fit->report.tolerance_met) << fit->report.unmet_reason;
+  ExpectPolesCollapsed(grid, *fit);
+  const FittedBlock& fitted = fit->blocks[0].fitted;
+  std::array<std::vector<double>, 3> params;
+  for (int d = 0; d < 3; ++d) params[d] = fitted.distribution.Refined(d, 0, data.extent(d) - 1, 0);
+  const StructuredBlock eval = EvaluateGrid(fitted.spline, params);
+  double largest = 0.0;
+  for (int j = 0; j < data.extent(1); ++j) {
+    for (int i = 1; i < data.extent(0); ++i) {  // i = 0: the pole
+      const Point3 a = At(data, i, j, 0), b = At(data, i, j, 1);
+      const Point3 fa = At(eval, i, j, 0), fb = At(eval, i, j, 1);
+      const double height = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+      const double fitted_height = std::hypot(fb[0] - fa[0], fb[1] - fa[1], fb[2] - fa[2]);
+      largest = std::max(largest, std::abs(fitted_height - height) / height);
+    }
+  }
+  const KindDeviation& dev = fit->blocks[0].deviation_by_kind;
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LE(largest, tolerances.first_layer);
+  EXPECT_NEAR(dev.first_layer, largest, 1e-12);
+  EXPECT_GE(dev.first_layer_at[0], 1);
+  EXPECT_EQ(dev.first_layer_at[2], 0);
+}
+
+// A wall that is all pole (the axis of AxisVolume named a wall: a wire) has no first layer the
+// fit holds, so holding one is refused rather than reported as held.
+TEST(CollapsedEdgeFitTest, AFirstLayerOnAWallThatIsAllPoleIsRefused) {
+  BoundaryTolerances tolerances;
+  tolerances.first_layer = 0.05;
+  GridFitOptions options = KindToleranceOptions(tolerances);
+  options.face_kinds = {{{0, 2, false}, BoundaryKind::kWall}};
+  const absl::StatusOr<GridFit> fit = FitGrid(AxisVolume(9, 33, 9), options);
+  EXPECT_EQ(fit.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(fit.status().message(), ::testing::HasSubstr("first layer off a pole"));
 }
 
 }  // namespace

@@ -334,12 +334,16 @@ bool Better(const GridFit& a, const GridFit& b) {
   return key(a) < key(b);
 }
 
-// Whether some block of `grid` has a first-layer edge (boundary_kinds.h) under `kinds`.
-bool HasFirstLayerEdges(const MultiBlockGrid& grid, const BoundaryKinds& kinds) {
+// Whether some block of `grid` has a first-layer edge (boundary_kinds.h) under `kinds` with
+// neither end on a pole (those the fit does not hold: SwitchOffPoleEdges).
+bool HasFirstLayerEdgesOffPoles(const MultiBlockGrid& grid, const BoundaryKinds& kinds,
+                                const std::vector<Pole>& poles) {
+  const std::vector<std::vector<uint8_t>> on_pole = PointsOnPoles(grid, poles);
   bool any = false;
   for (size_t b = 0; b < grid.blocks.size() && !any; ++b) {
-    ForEachFirstLayerEdge(grid.blocks[b], kinds.point_kinds[b],
-                          [&any](int64_t, int64_t) { any = true; });
+    ForEachFirstLayerEdge(grid.blocks[b], kinds.point_kinds[b], [&](int64_t p, int64_t q) {
+      any = any || on_pole[b].empty() || !(on_pole[b][p] || on_pole[b][q]);
+    });
   }
   return any;
 }
@@ -353,20 +357,21 @@ absl::StatusOr<MultiBlockRun> FitMultiBlock(const MultiBlockGrid& grid,
                                             const BoundaryTolerances& tolerances,
                                             const CancelCheck& cancel) {
   const auto start = std::chrono::steady_clock::now();
-  // A first layer asked for on a grid without walls would be met by nothing, and the report
-  // would read as if it were held.
-  if (tolerances.first_layer > 0.0 && !HasFirstLayerEdges(grid, kinds)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "tolerances.first_layer = ", tolerances.first_layer,
-        " holds nothing: no wall of the grid has a first layer (walls are the faces towards "
-        "which the grid is clustered; name them by FitSpec.face_kinds, CLI --face 0:jmin=wall)"));
-  }
   CellQualityOptions quality = options.quality;
   quality.cancel = cancel;
   MultiBlockRun result;
   result.fit.connectivity = connectivity;
   result.fit.report.tolerances = tolerances;
   result.poles = FindPoles(grid, PoleTolerance(grid));
+  // A first layer asked for on a grid without walls (or whose walls are all poles) would be met
+  // by nothing, and the report would read as if it were held.
+  if (tolerances.first_layer > 0.0 && !HasFirstLayerEdgesOffPoles(grid, kinds, result.poles)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "tolerances.first_layer = ", tolerances.first_layer,
+        " holds nothing: no wall of the grid has a first layer off a pole (walls are the faces "
+        "towards which the grid is clustered; name them by FitSpec.face_kinds, CLI --face "
+        "0:jmin=wall)"));
+  }
   result.fit.kinds = kinds;
   bool any_wall = false;
   const bool walls_first = options.wall_parameters != WallParametrization::kAverage;

@@ -45,7 +45,7 @@ struct MultiBlockRun {
 // Fits `grid`, whose `connectivity` is FindConnectivity's and `kinds` ClassifyBoundaries' (with
 // options.face_kinds), to `tolerances` (in the grid's unit) with `options` (valid for `grid`:
 // GridFitOptions::Validate). Not meeting a tolerance is reported, not an error. Errors:
-// INVALID_ARGUMENT for a first_layer to hold on a grid with no first-layer edge (no wall);
+// INVALID_ARGUMENT for a first_layer to hold on a grid with no first-layer edge off a pole;
 // FAILED_PRECONDITION for blocks that touch inconsistently (naming the match), CANCELLED.
 absl::StatusOr<MultiBlockRun> FitMultiBlock(
     const MultiBlockGrid& grid, const Connectivity& connectivity, const BoundaryKinds& kinds,
