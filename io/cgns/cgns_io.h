@@ -43,7 +43,9 @@ struct CgnsWriteOptions {
   // source index (empty: conditions and matches are not written).
   std::vector<int> source_blocks;
   std::vector<Extents> source_extents;
-  std::vector<std::string> block_names;    // by source index; empty: "block_<index>"
+  // By source index; empty: "block_<index>", the index zero-padded to the widest (block_07 of
+  // 12), so that the zones, which libcgns lists by name, come back in the same order.
+  std::vector<std::string> block_names;
   std::vector<SourceBoundary> conditions;  // at source indices
   std::vector<BoundaryMatch> matches;      // at source indices, written as 1-to-1 both ways
   bool single_precision = false;           // RealSingle coordinates

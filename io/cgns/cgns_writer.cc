@@ -115,7 +115,21 @@ class Writer {
         !options_.block_names[source].empty()) {
       return options_.block_names[source];
     }
-    return absl::StrCat("block_", source);
+    // Zero-padded to the widest index: libcgns lists a file's zones by name, so "block_10"
+    // would come back before "block_2".
+    const std::string index = absl::StrCat(source);
+    const size_t width = absl::StrCat(SourceBlockCount() - 1).size();
+    return absl::StrCat("block_", std::string(width > index.size() ? width - index.size() : 0, '0'),
+                        index);
+  }
+
+  // How many blocks the source grid has, as far as the options tell (at least the written ones).
+  int SourceBlockCount() const {
+    size_t count = std::max({grid_.blocks.size(), options_.source_extents.size(),
+                             options_.block_names.size()});
+    for (const int source : options_.source_blocks)
+      count = std::max(count, static_cast<size_t>(source) + 1);
+    return static_cast<int>(std::max<size_t>(count, 1));
   }
 
   absl::Status WriteZone(const StructuredBlock& block, const std::string& name) {

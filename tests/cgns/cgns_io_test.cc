@@ -379,5 +379,31 @@ TEST(CgnsWriterTest, SurfacePatchesAsCellDimensionTwoInSingleOrDoublePrecision) 
   }
 }
 
+// libcgns lists a file's zones by name: unnamed blocks are written as block_00 .. block_11, so a
+// grid of 12 blocks comes back in its order (block_10 used to come back third).
+TEST(CgnsWriterTest, TwelveUnnamedBlocksComeBackInTheirOrder) {
+  TempDir dir("cgns-io");
+  MultiBlockGrid grid;
+  for (int b = 0; b < 12; ++b) {
+    StructuredBlock block({5 + b, 4, 1}, 2);
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 5 + b; ++i) {
+        block.Point(i, j, 0)[0] = 10.0 * b + i;
+        block.Point(i, j, 0)[1] = j;
+      }
+    }
+    grid.blocks.push_back(std::move(block));
+  }
+  const std::string path = dir.File("twelve.cgns");
+  ASSERT_TRUE(WriteCgnsFile(path, grid, CgnsWriteOptions(), nullptr).ok());
+  absl::StatusOr<ImportedGrid> back = ReadCgnsFile(path);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->grid.blocks.size(), 12u);
+  EXPECT_EQ(testing::MaxDifference(back->grid, grid), 0.0);
+  ASSERT_EQ(back->boundaries.block_names.size(), 12u);
+  EXPECT_EQ(back->boundaries.block_names[2], "block_02");
+  EXPECT_EQ(back->boundaries.block_names[11], "block_11");
+}
+
 }  // namespace
 }  // namespace splinegrid
