@@ -72,14 +72,16 @@ std::vector<FaceKindOverride> FaceKindsOf(const std::vector<SourceBoundary>& con
                                           const std::vector<std::string>& block_names,
                                           std::vector<std::string>* notes) {
   std::map<std::pair<int, int>, std::vector<const SourceBoundary*>> by_face;
-  for (const SourceBoundary& c : conditions) by_face[FaceKey(c.range.face)].push_back(&c);
+  for (const SourceBoundary& c : conditions) {
+    if (c.kind) by_face[FaceKey(c.range.face)].push_back(&c);  // untyped ones set no kind
+  }
   std::vector<FaceKindOverride> kinds;
   for (const auto& [key, list] : by_face) {
-    BoundaryKind tightest = list.front()->kind;
+    BoundaryKind tightest = *list.front()->kind;
     bool mixed = false;
     for (const SourceBoundary* c : list) {
-      if (c->kind != tightest) mixed = true;
-      if (KindTightness(c->kind) < KindTightness(tightest)) tightest = c->kind;
+      if (*c->kind != tightest) mixed = true;
+      if (KindTightness(*c->kind) < KindTightness(tightest)) tightest = *c->kind;
     }
     const Face face = list.front()->range.face;
     kinds.push_back({face, tightest});
@@ -87,7 +89,7 @@ std::vector<FaceKindOverride> FaceKindsOf(const std::vector<SourceBoundary>& con
       std::vector<std::string> parts;
       for (const SourceBoundary* c : list) {
         parts.push_back(absl::StrCat("'", c->name, "' ", c->bc_type, " (",
-                                     std::string(BoundaryKindName(c->kind)), ")"));
+                                     std::string(BoundaryKindName(*c->kind)), ")"));
       }
       FaceRange whole{face, {0, 0, 0}, {0, 0, 0}};
       std::string where = DescribeFaceRange(whole, block_names);

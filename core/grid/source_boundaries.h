@@ -7,6 +7,7 @@
 
 #include <array>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -18,7 +19,9 @@ namespace splinegrid {
 // One boundary condition: a rectangle of a block face (0-based, inclusive) and its kind.
 struct SourceBoundary {
   FaceRange range;
-  BoundaryKind kind = BoundaryKind::kOuter;
+  // Unset for a condition whose type says nothing about the kind (BCTypeUserDefined,
+  // BCTypeNull): it is kept, and written back, but its points keep the detected kind.
+  std::optional<BoundaryKind> kind = BoundaryKind::kOuter;
   std::string name;     // the file's name of the condition, e.g. "wall"
   std::string bc_type;  // e.g. "BCWallViscous" (a family's type when it came from one)
   std::string family;   // the family it came from; empty when given directly

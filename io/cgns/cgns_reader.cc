@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/util/status_macros.h"
 #include "io/cgns/cgns_file.h"
 #include "io/cgns/cgns_io.h"
@@ -219,7 +220,8 @@ class Reader {
       const std::string what = absl::StrCat("BC '", name, "' of zone '", zone, "'");
       if (set_type != CGNS_ENUMV(PointRange) || npnts != 2) {
         Note(absl::StrCat(what, " is a ", cg_PointSetTypeName(set_type),
-                          "; only point ranges are read, its points keep the detected kind"));
+                          "; only point ranges are read: it is not kept, and its points keep the "
+                          "detected kind"));
         continue;
       }
       CGNS_ENUMT(GridLocation_t) location = CGNS_ENUMV(Vertex);
@@ -238,10 +240,20 @@ class Reader {
       }
       const std::optional<FaceRange> range = RangeOnFace(z - 1, extents, begin, end);
       if (!range) {
-        Note(absl::StrCat(what, " (", begin[0], ":", end[0], ", ", begin[1], ":", end[1], ", ",
-                          begin[2], ":", end[2],
-                          ") does not cover a rectangle of one face; it "
-                          "is not read"));
+        // In the file's own (1-based) indices, over the zone's index dimensions.
+        std::vector<std::string> parts, sizes;
+        bool outside = false;
+        for (int d = 0; d < cell_dim_; ++d) {
+          parts.push_back(absl::StrCat(begin[d], ":", end[d]));
+          sizes.push_back(absl::StrCat(extents[d]));
+          outside = outside || std::min(begin[d], end[d]) < 1 ||
+                    std::max(begin[d], end[d]) > extents[d];
+        }
+        Note(absl::StrCat(what, " (", absl::StrJoin(parts, ", "), ", 1-based) ",
+                          outside ? absl::StrCat("lies outside the zone's ",
+                                                 absl::StrJoin(sizes, " x "), " points")
+                                  : "does not cover a rectangle of one face",
+                          "; it is not kept"));
         continue;
       }
       SourceBoundary condition;
@@ -265,14 +277,13 @@ class Reader {
         condition.bc_type = it->second;
       }
       const std::optional<BoundaryKind> kind = KindOfBcType(condition.bc_type);
+      condition.kind = kind;
       if (!kind) {
-        Note(
-            absl::StrCat(what, " has type ", condition.bc_type,
-                         ", which says nothing about the kind; its points keep the detected kind"));
-        continue;
+        Note(absl::StrCat(what, " has type ", condition.bc_type,
+                          ", which says nothing about the kind; it is kept (and written with the "
+                          "grid), and its points keep the detected kind"));
       }
-      condition.kind = *kind;
-      if (*kind == BoundaryKind::kInterface && !symmetry_noted_) {
+      if (kind == BoundaryKind::kInterface && !symmetry_noted_) {
         symmetry_noted_ = true;
         Note(absl::StrCat(what, " is ", condition.bc_type,
                           ": symmetry conditions are fitted to the interface tolerance (a "

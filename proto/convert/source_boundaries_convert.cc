@@ -27,7 +27,8 @@ void EncodeSourceBoundaries(const SourceBoundaries& boundaries, v1::SourceBounda
   for (const SourceBoundary& c : boundaries.conditions) {
     v1::SourceBoundary* entry = out->add_conditions();
     EncodeFaceRange(c.range, entry->mutable_range());
-    entry->set_kind(EncodeBoundaryKind(c.kind));
+    // UNSPECIFIED: a condition whose type says nothing about the kind (SourceBoundary::kind).
+    if (c.kind) entry->set_kind(EncodeBoundaryKind(*c.kind));
     entry->set_name(c.name);
     entry->set_bc_type(c.bc_type);
     entry->set_family(c.family);
@@ -54,12 +55,18 @@ absl::StatusOr<SourceBoundaries> ParseSourceBoundaries(const v1::SourceBoundarie
     const std::string at = absl::StrCat(field, ".conditions[", q, "]");
     SourceBoundary c;
     SG_ASSIGN_OR_RETURN(c.range, ParseFaceRange(entry.range(), at + ".range"));
-    const std::optional<BoundaryKind> kind = ParseBoundaryKind(entry.kind());
-    if (!kind) {
-      return absl::InvalidArgumentError(absl::StrCat(at, ".kind = ", static_cast<int>(entry.kind()),
-                                                     " is not WALL, INTERFACE or OUTER"));
+    if (entry.kind() == v1::BOUNDARY_KIND_UNSPECIFIED) {
+      c.kind = std::nullopt;
+    } else {
+      const std::optional<BoundaryKind> kind = ParseBoundaryKind(entry.kind());
+      if (!kind) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(at, ".kind = ", static_cast<int>(entry.kind()),
+                         " is not UNSPECIFIED (a condition that sets no kind), WALL, INTERFACE or "
+                         "OUTER"));
+      }
+      c.kind = *kind;
     }
-    c.kind = *kind;
     SG_RETURN_IF_ERROR(CheckName(entry.name(), at + ".name"));
     SG_RETURN_IF_ERROR(CheckName(entry.bc_type(), at + ".bc_type"));
     SG_RETURN_IF_ERROR(CheckName(entry.family(), at + ".family"));

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "absl/strings/match.h"
+#include "absl/strings/str_join.h"
 #include "core/io/file_util.h"
 #include "core/io/plot3d.h"
 #include "gmock/gmock.h"
@@ -403,6 +404,65 @@ TEST(CgnsWriterTest, TwelveUnnamedBlocksComeBackInTheirOrder) {
   ASSERT_EQ(back->boundaries.block_names.size(), 12u);
   EXPECT_EQ(back->boundaries.block_names[2], "block_02");
   EXPECT_EQ(back->boundaries.block_names[11], "block_11");
+}
+
+// A condition whose type says nothing about the kind (BCTypeUserDefined: solver-specific BCs on
+// proper face ranges) is kept and written back, setting no kind; one whose range lies outside
+// its zone is named as such, in the file's 1-based indices over the zone's dimensions.
+TEST(CgnsReaderTest, AUserDefinedConditionIsKeptAndAnOutOfRangeOneNamed) {
+  TempDir dir("cgns-io");
+  MultiBlockGrid grid;
+  StructuredBlock block({5, 4, 1}, 2);
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      block.Point(i, j, 0)[0] = i;
+      block.Point(i, j, 0)[1] = j * (1.0 + 0.1 * i);
+    }
+  }
+  grid.blocks.push_back(block);
+  CgnsWriteOptions options;
+  options.source_extents = {block.extents()};
+  SourceBoundary wall;
+  wall.range = {{0, 1, false}, {0, 0, 0}, {4, 0, 0}};
+  wall.kind = BoundaryKind::kWall;
+  wall.name = "wall";
+  wall.bc_type = "BCWall";
+  SourceBoundary porous = wall;
+  porous.range = {{0, 1, true}, {0, 3, 0}, {4, 3, 0}};
+  porous.kind = std::nullopt;
+  porous.name = "porous";
+  porous.bc_type = "UserDefined";  // CGNS names BCTypeUserDefined so
+  options.conditions = {wall, porous};
+  const std::string path = dir.File("ud.cgns");
+  ASSERT_TRUE(WriteCgnsFile(path, grid, options, nullptr).ok());
+  {  // and a far field beyond the zone's 5 points in i
+    int fn = 0, bc = 0;
+    ASSERT_EQ(cg_open(path.c_str(), CG_MODE_MODIFY, &fn), CG_OK);
+    const cgsize_t range[4] = {1, 1, 300, 1};
+    ASSERT_EQ(cg_boco_write(fn, 1, 1, "far", CGNS_ENUMV(BCFarfield), CGNS_ENUMV(PointRange), 2,
+                            range, &bc),
+              CG_OK);
+    ASSERT_EQ(cg_close(fn), CG_OK);
+  }
+  absl::StatusOr<ImportedGrid> back = ReadCgnsFile(path);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->boundaries.conditions.size(), 2u);
+  EXPECT_EQ(back->boundaries.conditions[1].name, "porous");
+  EXPECT_EQ(back->boundaries.conditions[1].kind, std::nullopt);
+  ASSERT_EQ(back->boundaries.face_kinds.size(), 1u);  // the wall's face only
+  EXPECT_EQ(back->boundaries.face_kinds[0].kind, BoundaryKind::kWall);
+  const std::string notes = absl::StrJoin(back->boundaries.notes, "\n");
+  EXPECT_THAT(notes, HasSubstr("BC 'porous' of zone 'block_0' has type UserDefined, which "
+                               "says nothing about the kind; it is kept"));
+  EXPECT_THAT(notes, HasSubstr("BC 'far' of zone 'block_0' (1:300, 1:1, 1-based) lies outside "
+                               "the zone's 5 x 4 points; it is not kept"));
+  // Written again, it is still there.
+  options.conditions = back->boundaries.conditions;
+  ASSERT_TRUE(WriteCgnsFile(dir.File("again.cgns"), back->grid, options, nullptr).ok());
+  absl::StatusOr<ImportedGrid> again = ReadCgnsFile(dir.File("again.cgns"));
+  ASSERT_TRUE(again.ok()) << again.status();
+  ASSERT_EQ(again->boundaries.conditions.size(), 2u);
+  EXPECT_EQ(again->boundaries.conditions[1].bc_type, "UserDefined");
 }
 
 }  // namespace
