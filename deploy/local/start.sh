@@ -17,7 +17,10 @@
 #   STORE         redis (default) or memory: memory starts the replicas without Redis state
 #                 sharing (each has its own grids; only for checking the plumbing)
 #   SHUTDOWN_GRACE  --shutdown_grace of the replicas (default 8s); stop.sh waits for it
-#   SERVE_ARGS    more serve flags, e.g. "--threads=1 --memory_budget_mb=1024"
+#   SERVE_ARGS    more serve flags, e.g. "--threads=1 --memory_budget_mb=1024" (the same for every
+#                 replica: give per-replica ports below, not in here)
+#   METRICS_PORT  first metrics port: replica i serves Prometheus metrics on 127.0.0.1:METRICS_PORT+i
+#                 (--metrics_address; one scrape target per replica). Default: none
 #   START_TIMEOUT seconds to wait for each process to become ready (default 30)
 #   REDIS_SERVER, NGINX  the binaries (default: redis-server, nginx from PATH, /usr/sbin)
 #
@@ -48,6 +51,7 @@ SPLINEGRID=${SPLINEGRID:-$repo/build/splinegrid}
 STORE=${STORE:-redis}
 SHUTDOWN_GRACE=${SHUTDOWN_GRACE:-8s}
 SERVE_ARGS=${SERVE_ARGS:-}
+METRICS_PORT=${METRICS_PORT:-}
 START_TIMEOUT=${START_TIMEOUT:-30}
 PATH=$PATH:/usr/sbin:/sbin
 REDIS_SERVER=${REDIS_SERVER:-$(command -v redis-server || true)}
@@ -99,7 +103,7 @@ SPLINEGRID=$(absolute "$SPLINEGRID") NGINX=$(absolute "$NGINX")
 read -r -a serve_args <<<"$SERVE_ARGS"
 
 # ---------------------------------------------------------------- ports
-for v in NGINX_PORT REPLICA_PORT REDIS_PORT; do
+for v in NGINX_PORT REPLICA_PORT REDIS_PORT ${METRICS_PORT:+METRICS_PORT}; do
   if ! [[ ${!v} =~ ^[0-9]+$ ]] || ((${!v} < 1 || ${!v} > 65535)); then
     echo "start.sh: $v=${!v} is not a port number" >&2; exit 2
   fi
@@ -113,6 +117,18 @@ for ((i = 0; i < REPLICAS; i++)); do
   names+=("splinegrid-$i"); ports+=($((REPLICA_PORT + i))); vars+=("REPLICA_PORT+$i")
 done
 names+=(nginx); ports+=("$NGINX_PORT"); vars+=(NGINX_PORT)
+# Metrics listeners: checked for clashes and for being free like the others (not for readiness).
+metric_ports=()
+if [[ -n $METRICS_PORT ]]; then
+  ((METRICS_PORT + REPLICAS - 1 <= 65535)) || { echo "start.sh: METRICS_PORT + REPLICAS - 1 > 65535" >&2; exit 2; }
+  for ((i = 0; i < REPLICAS; i++)); do
+    metric_ports+=($((METRICS_PORT + i)))
+    for ((d = 0; d < ${#names[@]}; d++)); do
+      [[ $((METRICS_PORT + i)) != "${ports[$d]}" ]] ||
+          { echo "start.sh: ${vars[$d]} and METRICS_PORT+$i are both port $((METRICS_PORT + i))" >&2; exit 2; }
+    done
+  done
+fi
 for ((c = 0; c < ${#names[@]}; c++)); do
   for ((d = 0; d < c; d++)); do
     [[ ${ports[$c]} != "${ports[$d]}" ]] ||
@@ -141,6 +157,11 @@ for ((c = 0; c < ${#names[@]}; c++)); do
     *) hint="set ${vars[$c]} to a free port" ;;
   esac
   echo "start.sh: port $port (${vars[$c]}, for ${names[$c]}) is in use on 127.0.0.1 by $(port_users "$port"); $hint, or stop that process" >&2
+  busy=1
+done
+for port in "${metric_ports[@]}"; do
+  port_listening "$port" || continue
+  echo "start.sh: port $port (metrics) is in use on 127.0.0.1 by $(port_users "$port"); set METRICS_PORT so that METRICS_PORT..METRICS_PORT+$((REPLICAS - 1)) are free, or stop that process" >&2
   busy=1
 done
 ((busy == 0)) || { echo "start.sh: nothing started" >&2; exit 1; }
@@ -254,8 +275,10 @@ upstreams=()
 for ((i = 0; i < REPLICAS; i++)); do
   port=$((REPLICA_PORT + i))
   upstreams+=(--upstream "127.0.0.1:$port")
+  metrics_flag=()
+  [[ -z $METRICS_PORT ]] || metrics_flag=(--metrics_address="127.0.0.1:$((METRICS_PORT + i))")
   start_process "splinegrid-$i" "$port" "$SPLINEGRID" serve --address="127.0.0.1:$port" \
-      "${store_flag[@]}" --shutdown_grace="$SHUTDOWN_GRACE" "${serve_args[@]}"
+      "${store_flag[@]}" "${metrics_flag[@]}" --shutdown_grace="$SHUTDOWN_GRACE" "${serve_args[@]}"
 done
 log "$REPLICAS splinegrid replicas on 127.0.0.1:$REPLICA_PORT..$((REPLICA_PORT + REPLICAS - 1)) (store: ${store_flag[*]:-memory})"
 for ((i = 0; i < REPLICAS; i++)); do
