@@ -25,6 +25,7 @@ class _Calls:
     stub: service_grpc.SplineGridStub
     timeout: float
     retry: RetryPolicy
+    max_evaluation_bytes: Optional[int]  # evaluate's cap on assembled bytes (None: none)
     # The bulk methods on hand-encoded bytes (see Client.__init__): grpc multi-callables.
     _import_grid: Any  # ImportGrid: requests as bytes or messages -> Grid
     _evaluate_grid: Any  # EvaluateGrid -> EvaluationHeader and _evaluation._Chunk

@@ -9,7 +9,7 @@ from typing import Iterable, NamedTuple, Optional, Union
 import numpy as np
 
 from splinegrid import _wire
-from splinegrid.errors import _data_loss
+from splinegrid.errors import SplinegridError, _data_loss
 from splinegrid.results import EvaluatedBlock, EvaluatedGrid, EvaluatedPoints
 from splinegrid.v1 import splinegrid_service_pb2 as service_pb2
 
@@ -63,8 +63,10 @@ def _decode_chunk(data: memoryview) -> _Chunk:
 
 
 def _assemble(messages: Iterable[Union[service_pb2.EvaluationHeader, _Chunk]],
-              dtype: _wire.Dtype) -> EvaluatedGrid:
-    """Reassembles an EvaluateGrid stream into preallocated arrays."""
+              dtype: _wire.Dtype, max_bytes: Optional[int] = None) -> EvaluatedGrid:
+    """Reassembles an EvaluateGrid stream into preallocated arrays. With ``max_bytes``, an
+    evaluation whose arrays would take more is refused (RESOURCE_EXHAUSTED) when its header
+    arrives, before anything is allocated."""
     result: Optional[EvaluatedGrid] = None
     targets: dict[tuple[int, int], _wire.Array] = {}  # (block, field) -> flat view
     missing = 0  # values announced but not received yet
@@ -73,8 +75,10 @@ def _assemble(messages: Iterable[Union[service_pb2.EvaluationHeader, _Chunk]],
             if result is not None:
                 raise _data_loss("a second header")
             s = part.spatial_dim
-            result = EvaluatedGrid(part.revision, s)
             fields = list(_FIELD_NAMES.items())[:4 if part.derivatives else 1]
+            if max_bytes is not None:
+                _check_size(part, len(fields), np.dtype(dtype).itemsize, max_bytes)
+            result = EvaluatedGrid(part.revision, s)
             for announced in part.blocks:
                 if (announced.block, service_pb2.FIELD_POINTS) in targets:
                     raise _data_loss(f"block {announced.block} announced twice")
@@ -101,6 +105,22 @@ def _assemble(messages: Iterable[Union[service_pb2.EvaluationHeader, _Chunk]],
     if missing != 0:
         raise _data_loss(f"{missing} announced values did not arrive")
     return result
+
+
+def _check_size(header: service_pb2.EvaluationHeader, fields: int, itemsize: int,
+                max_bytes: int) -> None:
+    """RESOURCE_EXHAUSTED unless the arrays the header announces fit in ``max_bytes``."""
+    values = sum(max(b.extents.i, 1) * max(b.extents.j, 1) * max(b.extents.k, 1)
+                 for b in header.blocks) * max(header.spatial_dim, 1) * fields
+    if values * itemsize <= max_bytes:
+        return
+    gib = float(1 << 30)
+    raise SplinegridError(
+        "RESOURCE_EXHAUSTED",
+        f"the evaluation holds {header.total_points} points ({values * itemsize / gib:.2f} GiB "
+        f"of values) but this client may hold {max_bytes / gib:.2f} GiB "
+        "(Client(max_evaluation_bytes=...)): ask for fewer points (counts, index_box, a lower "
+        "level, or blocks)")
 
 
 def _decode_points_response(data: bytes) -> EvaluatedPoints:

@@ -151,7 +151,7 @@ class _EvaluationCalls(_Calls):
         def attempt(a: _Attempt) -> EvaluatedGrid:
             call = self._evaluate_grid(request, timeout=a.timeout, metadata=a.metadata)
             try:
-                return _assemble(call, out_dtype)
+                return _assemble(call, out_dtype, self.max_evaluation_bytes)
             except SplinegridError:
                 call.cancel()
                 raise

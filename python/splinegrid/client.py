@@ -122,15 +122,27 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
     for the system's roots, makes the channel TLS; ``tls_cert`` and ``tls_key`` (PEM files)
     are this client's certificate for a server that requires one (mTLS); ``tls_server_name``
     is the name the server's certificate must carry when it is not the target's host.
+
+    ``max_evaluation_bytes``: the most bytes of arrays one :meth:`evaluate` may assemble in this
+    process (None, the default: no limit, as ``ClientOptions::max_evaluation_bytes`` of the C++
+    client). A larger evaluation is refused with RESOURCE_EXHAUSTED as soon as its header
+    arrives, before anything is allocated, instead of growing the process until the machine
+    runs out of memory.
     """
 
     def __init__(self, target: Optional[str] = None, timeout: float = 120.0,
                  retry: Optional[RetryPolicy] = None, *, token: Optional[str] = None,
                  tls: bool = False, tls_ca: Optional[str] = None,
                  tls_cert: Optional[str] = None, tls_key: Optional[str] = None,
-                 tls_server_name: Optional[str] = None) -> None:
+                 tls_server_name: Optional[str] = None,
+                 max_evaluation_bytes: Optional[int] = None) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout = {timeout}; must be positive")
+        if max_evaluation_bytes is not None and not (
+                isinstance(max_evaluation_bytes, int) and max_evaluation_bytes > 0):
+            raise ValueError(f"max_evaluation_bytes = {max_evaluation_bytes!r}; must be a positive "
+                             "int (None: no limit)")
+        self.max_evaluation_bytes = max_evaluation_bytes
         if target is None:
             target = os.environ.get("SPLINEGRID_SERVER") or "localhost:50051"
         if token is None:

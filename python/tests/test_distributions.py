@@ -85,3 +85,20 @@ def test_real_server_new_wall_spacing(server):
         with pytest.raises(SplinegridError, match="both measured"):
             client.evaluate("rae", level=0, distributions={"i": "uniform_arc_length",
                                                            "j": Distribution.geometric(1e-6)})
+
+
+def test_an_evaluation_over_max_evaluation_bytes_is_refused_when_its_header_arrives(server):
+    # As the C++ client's ClientOptions::max_evaluation_bytes: refused before anything is
+    # allocated, naming the sizes; within the cap, or without one, it is assembled.
+    with Client(server) as client:
+        client.import_file(DATA / "grids" / "n0012_113-33.p2dfmt", grid_id="small")
+        client.fit("small", boundary_tolerances={})
+    one_level = 225 * 65 * 2 * 8  # level 1 of the 113 x 33 grid, 2 doubles a point
+    with Client(server, max_evaluation_bytes=one_level - 1) as client:
+        with pytest.raises(SplinegridError, match=r"RESOURCE_EXHAUSTED.*holds 14625 points"):
+            client.evaluate("small", level=1)
+        assert client.evaluate("small", level=1, dtype=np.float32)[0].points.shape == (1, 65, 225, 2)
+    with Client(server, max_evaluation_bytes=one_level) as client:
+        assert client.evaluate("small", level=1)[0].points.shape == (1, 65, 225, 2)
+    with pytest.raises(ValueError, match="max_evaluation_bytes = 0"):
+        Client(server, max_evaluation_bytes=0)
