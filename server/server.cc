@@ -67,6 +67,9 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
     absl::StatusOr<int> tokens = server->state_->authenticator.LoadTokens(options.tokens_file);
     if (!tokens.ok()) return tokens.status();
   }
+  absl::StatusOr<TrustedProxies> proxies = TrustedProxies::Parse(options.trusted_proxies);
+  if (!proxies.ok()) return proxies.status();
+  server->state_->authenticator.SetTrustedProxies(*std::move(proxies));
   absl::StatusOr<std::unique_ptr<GridStore>> store = OpenStore(options, &server->state_->budget);
   if (!store.ok()) return store.status();
   server->state_->store = *std::move(store);

@@ -80,6 +80,9 @@ struct ServerOptions {
   // The tokens file (server/auth/token_file.h): calls need `authorization: Bearer TOKEN` and
   // the token's role. Empty: no tokens, every caller is an admin. Reloaded on SIGHUP.
   std::string tokens_file;
+  // Proxies whose `x-client-address` metadata names the caller when there are no tokens
+  // (auth/trusted_proxies.h: comma-separated addresses or CIDR ranges); empty: none.
+  std::string trusted_proxies;
 
   // ---- Metrics (server/metrics_endpoint.h) ----
   // HOST:PORT of the Prometheus endpoint (GET /metrics, plaintext HTTP); empty: none. A host

@@ -38,6 +38,7 @@ std::vector<CommandSpec> MakeCommands() {
         "tls_client_ca",
         "insecure",
         "tokens",
+        "trusted_proxies",
         "metrics_address",
         "metrics_insecure",
         "cgns_decoder",

@@ -30,6 +30,12 @@ ABSL_FLAG(std::string, tokens, "",
           "serve: tokens file, lines 'TOKEN PRINCIPAL ROLE' (ROLE read, write or admin; # "
           "comments); calls then need a token; SIGHUP reloads it");
 
+ABSL_FLAG(std::string, trusted_proxies, "",
+          "serve: proxies (addresses or CIDR ranges, comma-separated, e.g. 127.0.0.1 or "
+          "10.0.0.0/8) whose 'x-client-address' metadata names the caller when there are no "
+          "tokens: behind nginx every call arrives on one of its connections, and fair turns "
+          "and per-caller limits need the client's (deploy/nginx sets it)");
+
 ABSL_FLAG(std::string, name, "",
           "fit/offset: id of the new grid (default: from the file name); import: (default: the "
           "archive's)");

@@ -23,6 +23,7 @@ ABSL_DECLARE_FLAG(std::string, tls_server_name);
 ABSL_DECLARE_FLAG(std::string, tls_client_ca);
 ABSL_DECLARE_FLAG(bool, insecure);
 ABSL_DECLARE_FLAG(std::string, tokens);
+ABSL_DECLARE_FLAG(std::string, trusted_proxies);
 // fit
 ABSL_DECLARE_FLAG(std::string, name);
 ABSL_DECLARE_FLAG(double, tol);

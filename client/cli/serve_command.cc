@@ -35,6 +35,7 @@ absl::Status Serve(const Args& args) {
   options.tls_client_ca_file = absl::GetFlag(FLAGS_tls_client_ca);
   options.insecure = absl::GetFlag(FLAGS_insecure);
   options.tokens_file = absl::GetFlag(FLAGS_tokens);
+  options.trusted_proxies = absl::GetFlag(FLAGS_trusted_proxies);
   // Fair scheduling and per-principal limits.
   options.max_running_long_tasks = absl::GetFlag(FLAGS_max_running_long_tasks);
   options.max_queued_long_calls_per_principal =

@@ -277,8 +277,10 @@ for ((i = 0; i < REPLICAS; i++)); do
   upstreams+=(--upstream "127.0.0.1:$port")
   metrics_flag=()
   [[ -z $METRICS_PORT ]] || metrics_flag=(--metrics_address="127.0.0.1:$((METRICS_PORT + i))")
+  # nginx runs on loopback and names each client's connection (x-client-address): without
+  # tokens that is the caller, for fair turns and per-caller limits.
   start_process "splinegrid-$i" "$port" "$SPLINEGRID" serve --address="127.0.0.1:$port" \
-      "${store_flag[@]}" "${metrics_flag[@]}" --shutdown_grace="$SHUTDOWN_GRACE" "${serve_args[@]}"
+      --trusted_proxies=127.0.0.1 "${store_flag[@]}" "${metrics_flag[@]}" --shutdown_grace="$SHUTDOWN_GRACE" "${serve_args[@]}"
 done
 log "$REPLICAS splinegrid replicas on 127.0.0.1:$REPLICA_PORT..$((REPLICA_PORT + REPLICAS - 1)) (store: ${store_flag[*]:-memory})"
 for ((i = 0; i < REPLICAS; i++)); do

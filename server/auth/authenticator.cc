@@ -73,7 +73,11 @@ absl::StatusOr<Caller> Authenticator::Authenticate(
   if (const auto it = metadata.find(kAuthorizationHeader); it != metadata.end()) {
     authorization = absl::string_view(it->second.data(), it->second.size());
   }
-  return Authenticate(authorization, context.peer());
+  std::optional<absl::string_view> client;
+  if (const auto it = metadata.find(kClientAddressHeader); it != metadata.end()) {
+    client = absl::string_view(it->second.data(), it->second.size());
+  }
+  return Authenticate(authorization, trusted_proxies_.CallerName(context.peer(), client));
 }
 
 absl::StatusOr<Caller> Authenticator::Authenticate(std::optional<absl::string_view> authorization,

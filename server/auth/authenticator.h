@@ -1,6 +1,7 @@
 // Turns a call's credentials into a Caller.
 //
-// Without tokens every caller is an admin named by its peer address. With a tokens file
+// Without tokens every caller is an admin named by its peer address (or, behind a trusted
+// proxy, by the client connection the proxy names: trusted_proxies.h). With a tokens file
 // (token_file.h) a call must carry the metadata `authorization: Bearer TOKEN`; the token's line
 // gives the principal and the role. The table can be reloaded while calls run (SIGHUP): readers
 // take a snapshot (shared_ptr) under a mutex, a reload swaps it; a bad file keeps the old table.
@@ -22,6 +23,7 @@
 #include "grpcpp/grpcpp.h"
 #include "server/auth/caller.h"
 #include "server/auth/token_file.h"
+#include "server/auth/trusted_proxies.h"
 
 namespace splinegrid::server {
 
@@ -52,7 +54,12 @@ class Authenticator {
   // again (a reload may have removed it or lowered its role).
   int64_t generation() const { return generation_.load(); }
 
-  // The caller of `context`, or UNAUTHENTICATED.
+  // Proxies whose `x-client-address` names the caller when there are no tokens
+  // (trusted_proxies.h). Set before serving; none by default.
+  void SetTrustedProxies(TrustedProxies proxies) { trusted_proxies_ = std::move(proxies); }
+
+  // The caller of `context`, or UNAUTHENTICATED. Without tokens, the peer, or the client a
+  // trusted proxy names.
   absl::StatusOr<Caller> Authenticate(const grpc::CallbackServerContext& context) const;
 
   // The caller with the `authorization` metadata value `authorization` (nullopt: none sent)
@@ -69,6 +76,7 @@ class Authenticator {
   std::shared_ptr<const Table> table_ ABSL_GUARDED_BY(mu_);  // null: no tokens
   std::string path_ ABSL_GUARDED_BY(mu_);
   std::atomic<int64_t> generation_{0};
+  TrustedProxies trusted_proxies_;  // immutable while serving
 };
 
 }  // namespace splinegrid::server

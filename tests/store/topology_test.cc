@@ -341,6 +341,55 @@ TEST_F(TopologyTest, NginxWithoutAReplicaAnswersUnavailable) {
               ::testing::HasSubstr("no splinegrid replica could be reached"));
 }
 
+// Without tokens a caller is its connection. Through nginx every call arrives on one of nginx's
+// connections, so each was a caller of its own and the turns and per-caller limits did
+// nothing (a trial). nginx names the client's connection (x-client-address) and a replica
+// that trusts it (serve --trusted_proxies) takes that as the caller: one client's calls share
+// a principal, another client's differ, and neither is nginx's upstream connection.
+TEST_F(TopologyTest, BehindNginxTheCallerIsTheClientsConnection) {
+  if (MissingPrograms(/*need_nginx=*/true)) {
+    GTEST_SKIP() << "redis-server or nginx is not installed (.ci/setup installs them: "
+                    "redis-server nginx-light)";
+  }
+  replica_ports_ = {FreePort()};
+  replicas_.push_back(
+      Serve("replica-0", replica_ports_[0], "--store=memory", "--trusted_proxies=127.0.0.1"));
+  ASSERT_TRUE(WaitServing(replica_ports_[0], absl::Seconds(20))) << ReplicaLog(0);
+  ASSERT_NO_FATAL_FAILURE(StartNginx());
+  auto first = DirectClient(nginx_port_, absl::Seconds(5));
+  for (const char* grid : {"grids/first-a", "grids/first-b"})
+    EXPECT_EQ(first->Get(grid).status().code(), absl::StatusCode::kNotFound);
+  // Another process: its own connection to nginx (clients in one process with the same channel
+  // arguments share one).
+  std::string out;
+  EXPECT_EQ(RunShell(absl::StrCat(kBinary, " get second --server=", Address(nginx_port_),
+                                  " --timeout=5s"),
+                     &out),
+            1)
+      << out;
+  // The log line of a call: "TIME METHOD GRID STATUS MS ms by PRINCIPAL[: MESSAGE]".
+  auto principal_of = [&](const std::string& grid) -> std::string {
+    for (absl::string_view line : absl::StrSplit(ReplicaLog(0), '\n')) {
+      if (!absl::StrContains(line, absl::StrCat(" ", grid, " "))) continue;
+      const size_t by = line.find(" by ");
+      if (by == absl::string_view::npos) continue;
+      const absl::string_view rest = line.substr(by + 4);
+      return std::string(rest.substr(0, rest.find(": ")));
+    }
+    return "";
+  };
+  const std::string a = principal_of("grids/first-a"), b = principal_of("grids/first-b"),
+                    c = principal_of("grids/second");
+  EXPECT_THAT(a, ::testing::StartsWith("ipv4:127.0.0.1:")) << ReplicaLog(0);
+  EXPECT_EQ(a, b) << ReplicaLog(0);
+  EXPECT_NE(a, c) << ReplicaLog(0);
+  // A client's port, not nginx's upstream connection: the first client's own connection.
+  auto direct = DirectClient(replica_ports_[0], absl::Seconds(5));
+  EXPECT_EQ(direct->Get("grids/direct").status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(principal_of("grids/direct"), ::testing::StartsWith("ipv4:127.0.0.1:"));
+  EXPECT_NE(principal_of("grids/direct"), a);
+}
+
 TEST_F(TopologyTest, PitchingRunSurvivesKillingTheServingReplica) {
   if (MissingPrograms(/*need_nginx=*/true)) {
     GTEST_SKIP() << "redis-server or nginx is not installed (.ci/setup installs them: "
