@@ -285,11 +285,16 @@ absl::StatusOr<ImportedGrid> Judge(int status, std::string output, const std::st
     const std::string memory = absl::StrCat(memory_bytes >> 20, " MiB");
     // SIGXCPU is RLIMIT_CPU's soft limit; SIGKILL, which the server did not send, is its hard
     // limit or the kernel's out-of-memory killer.
-    const std::string why = signal == SIGXCPU ? absl::StrCat("reached its CPU limit of ", cpu)
-                            : signal == SIGKILL
-                                ? absl::StrCat("was killed at its CPU limit (", cpu,
-                                               ") or its memory limit (", memory, ")")
-                                : "crashed";
+    // SIGABRT: an allocation refused at RLIMIT_AS ends in std::terminate or an HDF5 abort,
+    // which is how reaching the memory limit shows (a trial's valid 44 MB file at 64 MiB).
+    const std::string why =
+        signal == SIGXCPU   ? absl::StrCat("reached its CPU limit of ", cpu)
+        : signal == SIGKILL ? absl::StrCat("was killed at its CPU limit (", cpu,
+                                           ") or its memory limit (", memory, ")")
+        : signal == SIGABRT
+            ? absl::StrCat("aborted, as it does when an allocation fails at its memory limit (",
+                           memory, ")")
+            : "crashed";
     return absl::InvalidArgumentError(absl::StrCat(
         "cgns: the decoder ", why, " (signal ", SignalName(signal),
         ") reading the upload: the file is damaged, or its content is beyond what libcgns "
