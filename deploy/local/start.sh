@@ -104,7 +104,7 @@ read -r -a serve_args <<<"$SERVE_ARGS"
 
 # ---------------------------------------------------------------- ports
 for v in NGINX_PORT REPLICA_PORT REDIS_PORT ${METRICS_PORT:+METRICS_PORT}; do
-  if ! [[ ${!v} =~ ^[0-9]+$ ]] || ((${!v} < 1 || ${!v} > 65535)); then
+  if ! [[ ${!v} =~ ^[1-9][0-9]*$ ]] || ((${!v} > 65535)); then
     echo "start.sh: $v=${!v} is not a port number" >&2; exit 2
   fi
 done

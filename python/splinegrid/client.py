@@ -68,6 +68,7 @@ Modules
 from __future__ import annotations
 
 import contextlib
+import operator
 import os
 import threading
 import time
@@ -138,11 +139,16 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                  max_evaluation_bytes: Optional[int] = None) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout = {timeout}; must be positive")
-        if max_evaluation_bytes is not None and not (
-                isinstance(max_evaluation_bytes, int) and max_evaluation_bytes > 0):
-            raise ValueError(f"max_evaluation_bytes = {max_evaluation_bytes!r}; must be a positive "
-                             "int (None: no limit)")
-        self.max_evaluation_bytes = max_evaluation_bytes
+        self.max_evaluation_bytes: Optional[int] = None
+        if max_evaluation_bytes is not None:
+            try:  # an int or NumPy integer; not a float, str or bool
+                cap = operator.index(max_evaluation_bytes)
+            except TypeError:
+                cap = 0
+            if isinstance(max_evaluation_bytes, bool) or cap <= 0:
+                raise ValueError(f"max_evaluation_bytes = {max_evaluation_bytes!r}; must be a "
+                                 "positive int (None: no limit)")
+            self.max_evaluation_bytes = cap
         if target is None:
             target = os.environ.get("SPLINEGRID_SERVER") or "localhost:50051"
         if token is None:

@@ -43,7 +43,14 @@ std::optional<std::pair<Address, int>> ParseAddressAndPort(absl::string_view tex
     return std::nullopt;
   }
   absl::string_view host = text.substr(0, colon);
-  if (absl::ConsumePrefix(&host, "[") && !absl::ConsumeSuffix(&host, "]")) return std::nullopt;
+  // gRPC writes an IPv6 peer as a URI, its brackets escaped: ipv6:%5B::1%5D:40312.
+  if (absl::ConsumePrefix(&host, "[")) {
+    if (!absl::ConsumeSuffix(&host, "]")) return std::nullopt;
+  } else if (absl::ConsumePrefix(&host, "%5B") || absl::ConsumePrefix(&host, "%5b")) {
+    if (!absl::ConsumeSuffix(&host, "%5D") && !absl::ConsumeSuffix(&host, "%5d")) {
+      return std::nullopt;
+    }
+  }
   const std::optional<Address> address = ParseAddress(host);
   if (!address) return std::nullopt;
   return std::make_pair(*address, port);
@@ -64,20 +71,23 @@ absl::StatusOr<TrustedProxies> TrustedProxies::Parse(absl::string_view list) {
   for (absl::string_view entry : absl::StrSplit(list, ',')) {
     entry = absl::StripAsciiWhitespace(entry);
     absl::string_view host = entry;
-    int bits = -1;
+    std::optional<int> bits;  // none: the whole address
+    bool bits_ok = true;
     if (const size_t slash = entry.find('/'); slash != absl::string_view::npos) {
       host = entry.substr(0, slash);
-      if (!absl::SimpleAtoi(entry.substr(slash + 1), &bits)) bits = -2;
+      int parsed = 0;
+      bits_ok = absl::SimpleAtoi(entry.substr(slash + 1), &parsed) && parsed >= 0;
+      bits = parsed;
     }
     const std::optional<Address> address = ParseAddress(host);
     const int max_bits = address && address->family == AF_INET ? 32 : 128;
-    if (!address || bits < -1 || bits > max_bits) {
+    if (!address || !bits_ok || (bits && *bits > max_bits)) {
       return absl::InvalidArgumentError(absl::StrCat(
           "trusted_proxies: '", entry,
           "' is not an IPv4 or IPv6 address or ADDRESS/BITS range (e.g. 127.0.0.1, 10.0.0.0/8, "
           "::1, fd00::/8)"));
     }
-    proxies.ranges_.push_back({address->family, address->bytes, bits < 0 ? max_bits : bits});
+    proxies.ranges_.push_back({address->family, address->bytes, bits.value_or(max_bits)});
   }
   return proxies;
 }
@@ -102,7 +112,7 @@ std::string TrustedProxies::CallerName(const std::string& peer,
   if (!absl::ConsumePrefix(&from, "ipv4:") && !absl::ConsumePrefix(&from, "ipv6:")) return peer;
   auto proxy = ParseAddressAndPort(from);
   if (!proxy) return peer;
-  // An IPv4 proxy seen on a dual-stack listener: ::ffff:a.b.c.d.
+  // An IPv4 proxy written as ::ffff:a.b.c.d (gRPC 1.51 itself writes those as ipv4:).
   Address& a = proxy->first;
   static constexpr uint8_t kMapped[12] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff};
   if (a.family == AF_INET6 && std::equal(kMapped, kMapped + 12, a.bytes.begin())) {

@@ -3,7 +3,8 @@
 // a caller of its own and the turns and per-caller limits would do nothing. A trusted proxy
 // names the client's connection in the metadata `x-client-address: ADDRESS:PORT` (nginx:
 // `grpc_set_header x-client-address $remote_addr:$remote_port;`), and the call's caller is that
-// connection. The metadata of any other peer is ignored: a client cannot choose its principal.
+// connection. The metadata of any other peer is ignored: a peer outside the trusted ranges
+// cannot choose its principal (one inside them can: trust only what only the proxy reaches).
 // With tokens the token names the caller and this plays no part.
 #ifndef SPLINEGRID_SERVER_AUTH_TRUSTED_PROXIES_H_
 #define SPLINEGRID_SERVER_AUTH_TRUSTED_PROXIES_H_
@@ -35,7 +36,7 @@ class TrustedProxies {
   bool empty() const { return ranges_.empty(); }
 
   // The caller's name for a call from gRPC peer `peer` ("ipv4:127.0.0.1:40312",
-  // "ipv6:[::1]:40312") whose `x-client-address` metadata is `client` (nullopt: none): the
+  // "ipv6:%5B::1%5D:40312" as gRPC writes it, or with plain brackets) whose `x-client-address` metadata is `client` (nullopt: none): the
   // client's connection in the same form ("ipv4:192.0.2.7:51234") when the peer is a trusted
   // proxy and `client` is a valid ADDRESS:PORT (IPv6 with or without brackets), else `peer`.
   std::string CallerName(const std::string& peer, std::optional<absl::string_view> client) const;

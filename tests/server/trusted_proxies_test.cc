@@ -21,6 +21,10 @@ TEST(TrustedProxiesTest, ATrustedProxyNamesTheClientsConnection) {
   EXPECT_EQ(proxies->CallerName("ipv4:10.1.2.3:4000", "[2001:db8::5]:443"),
             "ipv6:[2001:db8::5]:443");
   EXPECT_EQ(proxies->CallerName("ipv6:[fd12::1]:4000", "192.0.2.7:1"), "ipv4:192.0.2.7:1");
+  // As gRPC 1.51 writes an IPv6 peer: a URI, its brackets escaped.
+  EXPECT_EQ(proxies->CallerName("ipv6:%5Bfd12::1%5D:4000", "192.0.2.7:1"), "ipv4:192.0.2.7:1");
+  EXPECT_EQ(proxies->CallerName("ipv6:%5Bfe80::1%5D:4000", "192.0.2.7:1"),
+            "ipv6:%5Bfe80::1%5D:4000");  // not in fd00::/8
   // An IPv4 proxy on a dual-stack listener.
   EXPECT_EQ(proxies->CallerName("ipv6:[::ffff:127.0.0.1]:4000", "192.0.2.7:1"),
             "ipv4:192.0.2.7:1");
@@ -44,7 +48,8 @@ TEST(TrustedProxiesTest, OtherPeersAndBadNamesKeepThePeer) {
 }
 
 TEST(TrustedProxiesTest, BadEntriesAreNamed) {
-  for (const char* bad : {"localhost", "10.0.0.0/33", "::/129", "10.0.0.0/x", "1.2.3.4,,"}) {
+  for (const char* bad :
+       {"localhost", "10.0.0.0/33", "::/129", "10.0.0.0/x", "10.0.0.0/-1", "1.2.3.4,,"}) {
     const absl::StatusOr<TrustedProxies> proxies = TrustedProxies::Parse(bad);
     EXPECT_EQ(proxies.status().code(), absl::StatusCode::kInvalidArgument) << bad;
     EXPECT_THAT(proxies.status().message(), HasSubstr("trusted_proxies: '")) << bad;
