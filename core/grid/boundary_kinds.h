@@ -133,6 +133,18 @@ void ForEachFirstLayerEdge(const StructuredBlock& block, const std::vector<uint8
   }
 }
 
+// The first-layer edges a fit holds: those of ForEachFirstLayerEdge with neither end on a pole
+// (`on_pole`, per point, poles.h PointsOnPoles; empty: no pole), where the fit switches the
+// edge criterion off to keep the pole collapsed.
+template <typename Visit>
+void ForEachHeldFirstLayerEdge(const StructuredBlock& block,
+                               const std::vector<uint8_t>& point_kinds,
+                               std::span<const uint8_t> on_pole, Visit visit) {
+  ForEachFirstLayerEdge(block, point_kinds, [&](int64_t p, int64_t q) {
+    if (on_pole.empty() || !(on_pole[p] || on_pole[q])) visit(p, q);
+  });
+}
+
 // Per-point edge tolerances of `block`, block b of `kinds`: `edge` everywhere, and
 // first_layer (where it is tighter, or `edge` is off) at both ends of the first-layer edges;
 // refinement tightens them locally.

@@ -334,16 +334,15 @@ bool Better(const GridFit& a, const GridFit& b) {
   return key(a) < key(b);
 }
 
-// Whether some block of `grid` has a first-layer edge (boundary_kinds.h) under `kinds` with
-// neither end on a pole (those the fit does not hold: SwitchOffPoleEdges).
+// Whether some block of `grid` has a first-layer edge the fit holds under `kinds`
+// (boundary_kinds.h ForEachHeldFirstLayerEdge).
 bool HasFirstLayerEdgesOffPoles(const MultiBlockGrid& grid, const BoundaryKinds& kinds,
                                 const std::vector<Pole>& poles) {
   const std::vector<std::vector<uint8_t>> on_pole = PointsOnPoles(grid, poles);
   bool any = false;
   for (size_t b = 0; b < grid.blocks.size() && !any; ++b) {
-    ForEachFirstLayerEdge(grid.blocks[b], kinds.point_kinds[b], [&](int64_t p, int64_t q) {
-      any = any || on_pole[b].empty() || !(on_pole[b][p] || on_pole[b][q]);
-    });
+    ForEachHeldFirstLayerEdge(grid.blocks[b], kinds.point_kinds[b], on_pole[b],
+                              [&any](int64_t, int64_t) { any = true; });
   }
   return any;
 }

@@ -35,8 +35,7 @@ absl::StatusOr<KindDeviation> DeviationByKind(const FittedBlock& fitted,
   // First-layer heights. A collapsed edge has no height to keep (relative to it any error
   // would be unbounded), and an edge from a pole is not held by the fit.
   const double collapsed2 = collapsed * collapsed;
-  ForEachFirstLayerEdge(block, kinds, [&](int64_t p, int64_t q) {
-    if (!on_pole.empty() && (on_pole[p] || on_pole[q])) return;
+  ForEachHeldFirstLayerEdge(block, kinds, on_pole, [&](int64_t p, int64_t q) {
     double data = 0.0, fit = 0.0;
     for (int c = 0; c < s; ++c) {
       const double a = block.coords()[s * q + c] - block.coords()[s * p + c];
