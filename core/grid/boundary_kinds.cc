@@ -458,21 +458,21 @@ absl::Status BoundaryTolerances::Validate() const {
       {"wall", wall}, {"interface", interface}, {"outer", outer}};
   for (const auto& [name, value] : fields) {
     if (!(value > 0.0) || !std::isfinite(value)) {
-      return absl::InvalidArgumentError(absl::StrCat("tolerances.", name, " = ", value,
+      return absl::InvalidArgumentError(absl::StrCat("boundary_tolerances.", name, " = ", value,
                                                      "; tolerances must be positive and finite"));
     }
   }
   if (!(interior > 0.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("tolerances.interior = ", interior, "; must be positive (or infinite)"));
+    return absl::InvalidArgumentError(absl::StrCat("boundary_tolerances.interior = ", interior,
+                                                   "; must be positive (or infinite)"));
   }
   if (!(edge >= 0.0 && edge <= 1.0)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("tolerances.edge = ", edge, " is outside [0, 1]"));
+        absl::StrCat("boundary_tolerances.edge = ", edge, " is outside [0, 1]"));
   }
   if (!(first_layer >= 0.0 && first_layer <= 1.0)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("tolerances.first_layer = ", first_layer, " is outside [0, 1]"));
+        absl::StrCat("boundary_tolerances.first_layer = ", first_layer, " is outside [0, 1]"));
   }
   return absl::OkStatus();
 }
@@ -498,9 +498,8 @@ std::vector<double> PointEdgeTolerances(const StructuredBlock& block, const Boun
   const std::vector<uint8_t>& point_kinds = kinds.point_kinds[b];
   std::vector<double> tol(point_kinds.size(), tolerances.edge);
   if (!(tolerances.first_layer > 0.0)) return tol;
-  const double tight = tolerances.edge > 0.0
-                           ? std::min(tolerances.edge, tolerances.first_layer)
-                           : tolerances.first_layer;
+  const double tight = tolerances.edge > 0.0 ? std::min(tolerances.edge, tolerances.first_layer)
+                                             : tolerances.first_layer;
   ForEachFirstLayerEdge(block, point_kinds, [&](int64_t p, int64_t q) { tol[p] = tol[q] = tight; });
   return tol;
 }

@@ -96,7 +96,7 @@ absl::StatusOr<GridFitOptions> ParseFitSpec(const v1::FitSpec& spec) {
       if (given.has_edge()) t.edge = given.edge();
       t.first_layer = given.first_layer();
       if (absl::Status s = t.Validate(); !s.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("spec.boundary_tolerances: ", s.message()));
+        return absl::InvalidArgumentError(absl::StrCat("spec.", s.message()));
       }
       options.boundary_tolerances = t;
       break;

@@ -97,6 +97,18 @@ absl::StatusOr<GridRevision> FitRevision(const OpsContext& context, const Source
     return absl::FailedPreconditionError(
         absl::StrCat(fitted.status().message(), "; nothing was stored"));
   }
+  if (fitted.status().code() == absl::StatusCode::kInvalidArgument) {
+    // Options that only the grid's walls and points refuse (a first layer to hold where no
+    // wall is, a tolerance below double precision); the kernel names GridFitOptions' field.
+    // A refaired revision's spec cannot be changed by FairGrid: say how to get past it.
+    return absl::InvalidArgumentError(absl::StrCat(
+        SpecField(origin, parent), fitted.status().message(),
+        origin == RevisionOrigin::kFair
+            ? absl::StrCat("; FairGrid keeps revision ", parent,
+                           "'s spec: fit the grid again with a spec that holds (FitGrid) and fair "
+                           "that revision")
+            : std::string()));
+  }
   SG_ASSIGN_OR_RETURN(GridFit fit, std::move(fitted));
   GridRevision revision;
   revision.create_time = absl::Now();

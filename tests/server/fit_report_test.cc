@@ -138,11 +138,11 @@ TEST_F(FitReportTest, BadRequestsNameTheFieldAndValue) {
   v1::FitSpec spec;
   spec.mutable_boundary_tolerances()->set_wall(-1.0);
   EXPECT_THAT(client_->Fit("naca", spec).status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, "tolerances.wall = -1"));
+              StatusIs(absl::StatusCode::kInvalidArgument, "spec.boundary_tolerances.wall = -1"));
   spec.mutable_boundary_tolerances()->set_wall(0.0);
   spec.mutable_boundary_tolerances()->set_edge(2.0);
   EXPECT_THAT(client_->Fit("naca", spec).status(),
-              StatusIs(absl::StatusCode::kInvalidArgument, "tolerances.edge = 2"));
+              StatusIs(absl::StatusCode::kInvalidArgument, "spec.boundary_tolerances.edge = 2"));
   v1::FitSpec fairing;
   fairing.mutable_fairing()->set_mode(v1::FAIRING_MODE_WEIGHT);
   EXPECT_THAT(client_->Fit("naca", fairing).status(),
@@ -213,9 +213,10 @@ TEST_F(FitReportTest, AnUnresolvableToleranceIsRefused) {
   v1::FitSpec relative;
   relative.mutable_boundary_tolerances();
   relative.set_reference_length(1e-300);
-  EXPECT_THAT(client_->Fit("naca", relative).status(),
-              StatusIs(absl::StatusCode::kInvalidArgument,
-                       "boundary_tolerances.wall = 1.5e-304 (with the reference length 1e-300)"));
+  EXPECT_THAT(
+      client_->Fit("naca", relative).status(),
+      StatusIs(absl::StatusCode::kInvalidArgument,
+               "spec.boundary_tolerances.wall = 1.5e-304 (with the reference length 1e-300)"));
   EXPECT_EQ(client_->Get("naca").value().latest_revision(), 0);  // nothing stored
 }
 

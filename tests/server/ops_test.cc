@@ -17,6 +17,7 @@
 #include "server/ops/evaluate_points.h"
 #include "server/ops/fit.h"
 #include "server/ops/wall_curvature.h"
+#include "tests/core/synthetic_grids.h"
 #include "tests/server/ops_fixture.h"
 
 namespace splinegrid::server {
@@ -45,6 +46,47 @@ class OpsTest : public OpsFixture {
     return request;
   }
 };
+
+// A first layer to hold on a grid without walls is refused naming the request's field (the
+// kernel names GridFitOptions'): "spec." for FitGrid, the refaired revision's spec for FairGrid,
+// which cannot change that spec and says how to get past it. Such a revision can be in a store
+// from before the refusal existed (here added as an archive would add it).
+TEST_F(OpsTest, AFirstLayerWithoutWallsIsRefusedNamingTheRequestField) {
+  ops::ImportedSource source;
+  source.imported.grid.blocks.push_back(PlanarBlock(9, 9, [](int i, int j) {
+    return std::array<double, 2>{0.1 * i, 0.1 * j};
+  }));
+  source.imported.format = "plot3d";
+  ASSERT_TRUE(ops::StoreImported(ops_, {"square", "", ""}, std::move(source)).ok());
+  GridFitOptions options;
+  options.boundary_tolerances = BoundaryTolerances();
+  options.boundary_tolerances->first_layer = 0.05;
+  const auto refused = ops::Fit(ops_, "square", options, {});
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.status().message(),
+              HasSubstr("spec.boundary_tolerances.first_layer = 0.05 holds nothing"));
+  EXPECT_TRUE(store_.Get("square").value()->revisions.empty());
+
+  options.boundary_tolerances->first_layer = 0.0;
+  const auto fit = ops::Fit(ops_, "square", options, {});
+  ASSERT_TRUE(fit.ok()) << fit.status();
+  GridRevision archived;
+  archived.fit_options = (*fit)->fit_options;
+  archived.fit_options.boundary_tolerances->first_layer = 0.05;
+  archived.blocks = (*fit)->blocks;
+  archived.kinds = (*fit)->kinds;
+  archived.report = (*fit)->report;
+  const std::string incarnation = store_.Get("square").value()->incarnation;
+  ASSERT_TRUE(store_.AddRevision("square", std::move(archived), 0, incarnation).ok());
+  const auto refair =
+      ops::Fair(ops_, {"square", 2, FairingOptions{FairingMode::kToTolerance}, false}, {});
+  EXPECT_EQ(refair.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(
+      refair.status().message(),
+      HasSubstr("revision 2 fit_spec.boundary_tolerances.first_layer = 0.05 holds nothing"));
+  EXPECT_THAT(refair.status().message(), HasSubstr("fit the grid again"));
+  EXPECT_EQ(store_.Get("square").value()->revisions.size(), 2u);
+}
 
 TEST_F(OpsTest, FitFairAndDeformPublishRevisions) {
   GridFitOptions options;

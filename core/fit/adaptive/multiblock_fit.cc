@@ -366,7 +366,7 @@ absl::StatusOr<MultiBlockRun> FitMultiBlock(const MultiBlockGrid& grid,
   // by nothing, and the report would read as if it were held.
   if (tolerances.first_layer > 0.0 && !HasFirstLayerEdgesOffPoles(grid, kinds, result.poles)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "tolerances.first_layer = ", tolerances.first_layer,
+        "boundary_tolerances.first_layer = ", tolerances.first_layer,
         " holds nothing: no wall of the grid has a first layer off a pole (walls are the faces "
         "towards which the grid is clustered; name them by FitSpec.face_kinds, CLI --face "
         "0:jmin=wall)"));
