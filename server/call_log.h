@@ -1,6 +1,8 @@
 // One log line per RPC, written to stderr when the call finishes. Client-supplied strings (the
-// grid, the principal, the status message) are escaped and cut (core/util/quote.h), so every
-// call gives exactly one line of bounded length whatever the request holds.
+// grid, the principal, the status message) are escaped and cut, so every call gives exactly one
+// line of bounded length whatever the request holds: in text lines C-escaped
+// (core/util/quote.h), in JSON lines JSON-escaped once, so that a field's value is the string
+// itself (the message as the client received it; invalid UTF-8 as U+FFFD).
 //
 // LogFormat::kText:
 //   2026-11-21T10:00:00.123Z EvaluateGrid grids/wing OK 12.3 ms by alice

@@ -80,11 +80,31 @@ TEST(CallLogTest, JsonLineParsesWithEveryField) {
     EXPECT_TRUE(f.contains(key)) << key << " missing in " << line;
   }
   EXPECT_EQ(f.at("method").string_value(), "GetGrid");
-  EXPECT_EQ(f.at("grid").string_value(), "grids/\"q\"\\n\\\\x");
+  EXPECT_EQ(f.at("grid").string_value(), "grids/\"q\"\n\\x");
   EXPECT_EQ(f.at("principal").string_value(), "bob");
   EXPECT_EQ(f.at("status").string_value(), "NOT_FOUND");
   EXPECT_EQ(f.at("message").string_value(), "no grid \"x\"");
   EXPECT_GE(f.at("ms").number_value(), 0.0);
+}
+
+// A JSON field's value is the string the client got, escaped once: a status message that quotes
+// a name (with its C escapes) reads in the log as it read to the client, not with its
+// backslashes doubled; UTF-8 is kept, a byte of invalid UTF-8 is U+FFFD, a long message is cut
+// at a character.
+TEST(CallLogTest, JsonValuesAreTheStringsTheClientGot) {
+  server::ServerOptions options;
+  options.log_format = server::LogFormat::kJson;
+  server::CallLog log("GetGrid", "grids/caf\xc3\xa9\xff", options);
+  const std::string message = "grid_id " + QuoteClientString("a\nb") + " is not a valid id";
+  const google::protobuf::Struct json =
+      ParseJson(log.Line(absl::InvalidArgumentError(message), absl::Now()));
+  EXPECT_EQ(json.fields().at("message").string_value(), "grid_id 'a\\nb' is not a valid id");
+  EXPECT_EQ(json.fields().at("grid").string_value(), "grids/caf\xc3\xa9\xef\xbf\xbd");
+  const std::string long_message = std::string(999, 'x') + "\xc3\xa9" + std::string(100, 'y');
+  const google::protobuf::Struct long_json =
+      ParseJson(log.Line(absl::InternalError(long_message), absl::Now()));
+  EXPECT_EQ(long_json.fields().at("message").string_value(),
+            std::string(999, 'x') + "\xc3\xa9... (1101 bytes)");
 }
 
 class LogHygieneTest : public ServiceTest {
