@@ -78,7 +78,13 @@ absl::StatusOr<std::string> ParseGridName(const std::string& name, const std::st
 absl::StatusOr<Caller> AdmitCall(const ServiceState& state, grpc::CallbackServerContext* context,
                                  Role needed, CallLog* log) {
   if (state.draining.load()) return absl::UnavailableError("the server is shutting down");
-  SG_ASSIGN_OR_RETURN(Caller caller, state.authenticator.Authenticate(*context));
+  absl::StatusOr<Caller> authenticated = state.authenticator.Authenticate(*context);
+  if (!authenticated.ok()) {
+    // A refused token's line names where it came from (no principal is known).
+    log->set_principal(state.authenticator.Connection(*context));
+    return authenticated.status();
+  }
+  Caller caller = *std::move(authenticated);
   log->set_principal(caller.principal);
   if (caller.role < needed) {
     return absl::PermissionDeniedError(absl::StrCat("this call needs the role ", RoleName(needed),

@@ -73,11 +73,16 @@ absl::StatusOr<Caller> Authenticator::Authenticate(
   if (const auto it = metadata.find(kAuthorizationHeader); it != metadata.end()) {
     authorization = absl::string_view(it->second.data(), it->second.size());
   }
+  return Authenticate(authorization, Connection(context));
+}
+
+std::string Authenticator::Connection(const grpc::CallbackServerContext& context) const {
   std::optional<absl::string_view> client;
+  const auto& metadata = context.client_metadata();
   if (const auto it = metadata.find(kClientAddressHeader); it != metadata.end()) {
     client = absl::string_view(it->second.data(), it->second.size());
   }
-  return Authenticate(authorization, trusted_proxies_.CallerName(context.peer(), client));
+  return trusted_proxies_.CallerName(context.peer(), client);
 }
 
 absl::StatusOr<Caller> Authenticator::Authenticate(std::optional<absl::string_view> authorization,

@@ -58,8 +58,12 @@ class Authenticator {
   // (trusted_proxies.h). Set before serving; none by default.
   void SetTrustedProxies(TrustedProxies proxies) { trusted_proxies_ = std::move(proxies); }
 
-  // The caller of `context`, or UNAUTHENTICATED. Without tokens, the peer, or the client a
-  // trusted proxy names.
+  // The connection `context` came from: its peer, or the client a trusted proxy names
+  // (ipv4:192.0.2.7:51234). The caller's principal without tokens; what the log names for a
+  // call that failed to authenticate.
+  std::string Connection(const grpc::CallbackServerContext& context) const;
+
+  // The caller of `context`, or UNAUTHENTICATED. Without tokens, its Connection.
   absl::StatusOr<Caller> Authenticate(const grpc::CallbackServerContext& context) const;
 
   // The caller with the `authorization` metadata value `authorization` (nullopt: none sent)

@@ -8,6 +8,8 @@
 #include <map>
 
 #include "absl/strings/str_cat.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/security/credentials.h"
 #include "tests/server/service_fixture.h"
 
 namespace splinegrid::testing {
@@ -85,6 +87,28 @@ TEST_F(AuthTest, WithoutAKnownTokenEveryCallIsUnauthenticatedButHealthIsOpen) {
     EXPECT_EQ(client->Health("").value(), "SERVING");
     EXPECT_EQ(client->Health(server::kServiceName).value(), "SERVING");
   }
+}
+
+// A refused call's log line names the connection it came from (no principal is known), so
+// that an operator can tell where unknown tokens come from; the token is not in it.
+TEST_F(AuthTest, ARefusedTokensLogLineNamesItsConnection) {
+  server_.reset();
+  options_.log_calls = true;
+  options_.address = "127.0.0.1:0";
+  StartServer();
+  client::ClientOptions options;
+  options.retry.max_attempts = 1;
+  options.token = "not-a-known-token";
+  client::Client remote(grpc::CreateChannel(absl::StrCat("127.0.0.1:", server_->port()),
+                                            grpc::InsecureChannelCredentials()),
+                        options);
+  ::testing::internal::CaptureStderr();
+  ExpectCode(remote.List().status(), absl::StatusCode::kUnauthenticated);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(log, HasSubstr(" UNAUTHENTICATED "));
+  EXPECT_THAT(log, HasSubstr(" by ipv4:127.0.0.1:"));
+  EXPECT_THAT(log, HasSubstr(": the token is not known to this server"));
+  EXPECT_THAT(log, Not(HasSubstr("not-a-known-token")));
 }
 
 // Every role (and none) against one call of each class: read (GetGrid), write (ImportGrid),
