@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "core/io/planar_view.h"
 #include "core/util/status_macros.h"
 #include "io/cgns/cgns_file.h"
 #include "io/cgns/cgns_io.h"
@@ -73,6 +74,7 @@ class Reader {
     if (nzones < 1)
       return absl::InvalidArgumentError(absl::StrCat("base '", base_name, "' has no zone"));
     for (int z = 1; z <= nzones; ++z) SG_RETURN_IF_ERROR(ReadZone(z));
+    NoteTwoPlaneZones();
     for (int z = 1; z <= nzones; ++z) {
       SG_RETURN_IF_ERROR(ReadConditions(z));
       SG_RETURN_IF_ERROR(ReadConnections(z));
@@ -96,6 +98,27 @@ class Reader {
   void Note(std::string note) { out_.boundaries.notes.push_back(std::move(note)); }
 
   std::string ZoneName(int z) const { return out_.boundaries.block_names[z - 1]; }
+
+  // A 2D case stored as a 3D volume of two planes (as CFL3D writes them) is a volume to
+  // splinegrid: the planar view (planar_view.h) is a Plot3D reading, whose write-back restores
+  // the planes; a CGNS file's conditions and connections would need it too. Say so, and how to
+  // get the 2D grid, rather than let a 2D case pass as a volume one unit thick.
+  void NoteTwoPlaneZones() {
+    if (cell_dim_ != 3) return;
+    constexpr char kIndices[] = "ijk", kAxes[] = "xyz";
+    for (size_t b = 0; b < out_.grid.blocks.size(); ++b) {
+      const absl::StatusOr<TwoPlaneLayout> layout = DetectTwoPlaneBlock(out_.grid.blocks[b]);
+      if (!layout.ok()) continue;
+      Note(absl::StrCat(
+          "zone '", out_.boundaries.block_names[b], "' is two planes (",
+          std::string(1, kIndices[layout->plane_direction]), " = 1, 2) at ",
+          std::string(1, kAxes[layout->normal_coordinate]), " = ", layout->plane_values[0], " and ",
+          layout->plane_values[1],
+          ", a 2D case stored as a 3D volume: it is read as a volume (fitted across the planes "
+          "too, its reference length and evaluations 3D); for the 2D grid convert the file to "
+          "Plot3D (cgns_to_plot3d), whose two-plane blocks are read as their 2D view"));
+    }
+  }
 
   absl::Status ReadFamilies() {
     int nfamilies = 0;
@@ -246,8 +269,8 @@ class Reader {
         for (int d = 0; d < cell_dim_; ++d) {
           parts.push_back(absl::StrCat(begin[d], ":", end[d]));
           sizes.push_back(absl::StrCat(extents[d]));
-          outside = outside || std::min(begin[d], end[d]) < 1 ||
-                    std::max(begin[d], end[d]) > extents[d];
+          outside =
+              outside || std::min(begin[d], end[d]) < 1 || std::max(begin[d], end[d]) > extents[d];
         }
         Note(absl::StrCat(what, " (", absl::StrJoin(parts, ", "), ", 1-based) ",
                           outside ? absl::StrCat("lies outside the zone's ",

@@ -21,7 +21,10 @@ namespace splinegrid {
 namespace {
 
 using ::splinegrid::testing::TempDir;
+using ::testing::AllOf;
+using ::testing::Contains;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // Single precision keeps about 7 significant digits; the grids are O(1)..O(500) in size.
 constexpr double kSingleRelative = 1e-6;
@@ -202,6 +205,30 @@ TEST(CgnsReaderTest, FaceWithWallAndOuterConditionsIsAWallWithANote) {
   EXPECT_THAT(back->boundaries.notes[0], HasSubstr("fitted as wall"));
 }
 
+// A 2D case stored as two planes (the shared CFL3D RAE 2822 grid, 2 x 257 x 97, y = 0 and -1)
+// in a CGNS file is read as the volume it is, with a note saying so and how to get its 2D view;
+// a genuine volume gets no such note.
+TEST(CgnsReaderTest, ATwoPlaneZoneIsReadAsAVolumeWithANote) {
+  TempDir dir("cgns-io");
+  const MultiBlockGrid grid = ReadPlot3dFile(SharedDataPath("grids/rae2822_257x97.fmt")).value();
+  CgnsWriteOptions options;
+  options.source_extents = {grid.blocks[0].extents()};
+  ASSERT_TRUE(WriteCgnsFile(dir.File("planes.cgns"), grid, options, nullptr).ok());
+  absl::StatusOr<ImportedGrid> read = ReadCgnsFile(dir.File("planes.cgns"));
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(testing::MaxDifference(read->grid, grid), 0.0);
+  EXPECT_THAT(read->boundaries.notes,
+              Contains(AllOf(HasSubstr("zone 'block_0' is two planes (i = 1, 2) at y = 0 and -1"),
+                             HasSubstr("cgns_to_plot3d"))));
+
+  const MultiBlockGrid boxes = testing::TwoBoxes();
+  options.source_extents = {boxes.blocks[0].extents(), boxes.blocks[1].extents()};
+  ASSERT_TRUE(WriteCgnsFile(dir.File("boxes.cgns"), boxes, options, nullptr).ok());
+  read = ReadCgnsFile(dir.File("boxes.cgns"));
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_THAT(read->boundaries.notes, Not(Contains(HasSubstr("two planes"))));
+}
+
 TEST(CgnsWriterTest, RefusesBlocksThatAreNotALevelOfTheSource) {
   TempDir dir("cgns-io");
   const MultiBlockGrid grid = testing::TwoBoxes();
@@ -257,8 +284,8 @@ TEST(CgnsWriterTest, AWriteThroughALinkReplacesItsTargetAndKeepsTheMode) {
   std::filesystem::create_directories(dir.File("real"));
   const std::string target = dir.File("real/grid.cgns");
   ASSERT_TRUE(WriteCgnsFile(target, grid, options, nullptr).ok());
-  std::filesystem::permissions(target, std::filesystem::perms::owner_read |
-                                           std::filesystem::perms::owner_write);
+  std::filesystem::permissions(
+      target, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
   const std::string link = dir.File("link.cgns");
   std::filesystem::create_symlink(target, link);
   MultiBlockGrid one;
@@ -368,8 +395,8 @@ TEST(CgnsWriterTest, SurfacePatchesAsCellDimensionTwoInSingleOrDoublePrecision) 
     absl::StatusOr<ImportedGrid> back = ReadCgnsFile(path);
     ASSERT_TRUE(back.ok()) << back.status();
     // 3 coordinates on patches of 2 index directions: CellDimension 2, PhysicalDimension 3.
-    EXPECT_THAT(back->format, HasSubstr(single ? "surface, 9 zones, single"
-                                               : "surface, 9 zones, double"));
+    EXPECT_THAT(back->format,
+                HasSubstr(single ? "surface, 9 zones, single" : "surface, 9 zones, double"));
     const double difference = testing::MaxDifference(back->grid, *m6);
     if (single) {
       EXPECT_GT(difference, 0.0);
