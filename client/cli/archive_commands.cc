@@ -48,11 +48,9 @@ absl::Status Import(const Args& args) {
                               "`splinegrid export`); for a Plot3D grid use `splinegrid fit ", path,
                               "`"));
   }
-  const std::string name = absl::GetFlag(FLAGS_name);
+  SG_ASSIGN_OR_RETURN(const std::string id, NameFlagId());
   ProgressLine upload("import");
-  SG_ASSIGN_OR_RETURN(
-      const v1::Grid grid,
-      Connect()->ImportArchive(path, name.empty() ? "" : client::GridId(name), upload.callback()));
+  SG_ASSIGN_OR_RETURN(const v1::Grid grid, Connect()->ImportArchive(path, id, upload.callback()));
   upload.Done();
   Print(absl::StrCat("imported ", path, " as ", grid.name(), " (", grid.revisions_size(),
                      " revision(s))\n", FormatGrid(grid)),

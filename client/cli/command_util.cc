@@ -17,6 +17,7 @@
 #include "client/cli/commands.h"
 #include "client/cli/output.h"
 #include "core/util/status_macros.h"
+#include "server/grid_id.h"
 #include "server/memory_limit.h"
 
 namespace splinegrid::cli {
@@ -168,6 +169,14 @@ std::string IdFromPath(const std::string& path) {
   }
   if (id.empty() || !std::isalpha(static_cast<unsigned char>(id[0]))) id = "grid-" + id;
   return id.substr(0, 63);
+}
+
+absl::StatusOr<std::string> NameFlagId() {
+  const std::string name = absl::GetFlag(FLAGS_name);
+  if (name.empty()) return std::string();
+  const std::string id = client::GridId(name);
+  SG_RETURN_IF_ERROR(server::CheckRequestedGridId(id, "--name"));
+  return id;
 }
 
 // Three quarters of the memory this process may use: MemAvailable (/proc/meminfo), or what its

@@ -65,6 +65,10 @@ absl::Status RevisionOrStep(const SetRevision& set_revision, const SetStep& set_
 // A grid id from a file name: lower case, [a-z0-9-], starting with a letter.
 std::string IdFromPath(const std::string& path);
 
+// The grid id --name asks for ("grids/ID" or "ID"), "" when it is not given; INVALID_ARGUMENT
+// naming --name and its value when the id is not valid, before any file is read or sent.
+absl::StatusOr<std::string> NameFlagId();
+
 // --fair: "" (none), "tol" (to tolerance) or a weight.
 absl::StatusOr<std::optional<v1::Fairing>> ParseFairFlag();
 

@@ -69,6 +69,7 @@ absl::Status Fit(const Args& args) {
   }
   const std::string& path = args[0];
   SG_ASSIGN_OR_RETURN(const v1::FitSpec spec, SpecFromFlags());
+  SG_ASSIGN_OR_RETURN(const std::string named, NameFlagId());
   // Not a file but a grid's name: that stored grid is fitted again.
   std::error_code no_file;
   if (!std::filesystem::exists(path, no_file) && LooksLikeGridName(path)) {
@@ -84,8 +85,7 @@ absl::Status Fit(const Args& args) {
   if (bytes.empty()) {  // the server would name only its header field, total_bytes = 0
     return absl::InvalidArgumentError(absl::StrCat(path, " is empty: no grid to fit"));
   }
-  const std::string id =
-      absl::GetFlag(FLAGS_name).empty() ? IdFromPath(path) : absl::GetFlag(FLAGS_name);
+  const std::string id = named.empty() ? IdFromPath(path) : named;
   auto client = Connect();
   // A CGNS file (by extension or signature) is decoded by the server, BCs included; it is
   // stored as its zones are (--planar is about two-plane Plot3D files).

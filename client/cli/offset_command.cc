@@ -26,7 +26,7 @@ namespace {
 // with grids/), the stored surface grid;
 // the new grid's id (--name, else from the file or the surface's id) and display name.
 absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& request) {
-  const std::string& name = absl::GetFlag(FLAGS_name);
+  SG_ASSIGN_OR_RETURN(const std::string name, NameFlagId());
   // The surface flags: a profile request that sets them is refused by the server, by name.
   const std::string side = absl::AsciiStrToLower(absl::GetFlag(FLAGS_side));
   if (side == "along") {
@@ -44,7 +44,7 @@ absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& req
       !argument.starts_with("grids/") && (std::filesystem::is_regular_file(argument) ||
                                           argument.find_first_of("./") != std::string::npos);
   if (path) {
-    request.set_grid_id(name.empty() ? IdFromPath(argument) : client::GridName(name).substr(6));
+    request.set_grid_id(name.empty() ? IdFromPath(argument) : name);
     request.set_display_name(std::filesystem::path(argument).filename().string());
     SG_ASSIGN_OR_RETURN(*request.mutable_airfoil_file(), ReadFileToString(argument));
     // Parsed here too, so that a bad file is named by its path (the server knows only the
@@ -54,8 +54,7 @@ absl::Status SetSource(const std::string& argument, v1::GenerateGridRequest& req
   }
   const std::string surface = client::GridName(argument);
   request.mutable_stored_surface()->set_name(surface);
-  request.set_grid_id(name.empty() ? absl::StrCat(surface.substr(6), "-volume")
-                                   : client::GridName(name).substr(6));
+  request.set_grid_id(name.empty() ? absl::StrCat(surface.substr(6), "-volume") : name);
   return absl::OkStatus();
 }
 

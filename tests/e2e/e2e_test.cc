@@ -292,6 +292,11 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   EXPECT_EQ(nan_edge.exit_code, 2) << nan_edge.out;
   EXPECT_THAT(nan_edge.out, HasSubstr("edge = nan"));
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/nan-edge")));
+  // A bad --name is named as the flag (it was the request's header.grid_id), before the upload.
+  const Result bad_name =
+      Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --name=Bad_Name"));
+  EXPECT_EQ(bad_name.exit_code, 2) << bad_name.out;
+  EXPECT_THAT(bad_name.out, HasSubstr("--name = 'Bad_Name' is not valid"));
   // Files named by their path: an empty grid file, and a profile with a bad number (the server
   // knows only its request fields, total_bytes and airfoil_file).
   const std::string empty = (dir_ / "empty.fmt").string();
