@@ -246,7 +246,18 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
                          "; each earlier one ended UNAVAILABLE or was reset, and was made again]"));
       }
       // A TLS server closes a plaintext connection at once, and a server that asks for client
-      // certificates a TLS connection without one; say what that usually means.
+      // certificates a TLS connection without one; say what that usually means, and so for a
+      // TLS client of a plaintext server.
+      // A plaintext server answers a TLS handshake with bytes that are no TLS record (OpenSSL:
+      // "wrong version number").
+      if (options_.use_tls && absl::IsUnavailable(result) &&
+          absl::StrContains(result.message(), "wrong version number")) {
+        result = absl::Status(
+            result.code(),
+            absl::StrCat(result.message(),
+                         " (the server answered the TLS handshake in plaintext: it does not use "
+                         "TLS; connect without --tls_ca, ClientOptions.use_tls = false)"));
+      }
       if (absl::IsUnavailable(result) && absl::StrContains(result.message(), "Socket closed")) {
         const char* hint =
             !options_.use_tls

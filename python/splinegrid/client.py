@@ -256,6 +256,14 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                         translated = SplinegridError(
                             translated.code,
                             f"{translated.message} (the server closed the connection: {hint})")
+                    # A plaintext server answers a TLS handshake with bytes that are no TLS
+                    # record (OpenSSL: "wrong version number").
+                    if (self._tls and translated.code == "UNAVAILABLE"
+                            and "wrong version number" in translated.message):
+                        translated = SplinegridError(
+                            translated.code,
+                            f"{translated.message} (the server answered the TLS handshake in "
+                            "plaintext: it does not use TLS; connect without tls_ca=)")
                     raise translated from error
             self._pause_before_retry(wait)
 

@@ -249,6 +249,34 @@ TEST_F(TlsAuthTest, MutualTlsRefusesAClientWithoutACertificate) {
   EXPECT_EQ(server.Stop(), 0) << server.Log();
 }
 
+// A TLS client of a plaintext server is told that the server does not use TLS (a trial read
+// only OpenSSL's "wrong version number"): CLI, C++ and Python clients.
+TEST_F(TlsAuthTest, ATlsClientOfAPlaintextServerIsToldSo) {
+  Server server({"--address=" + Address()}, Log());
+  ASSERT_TRUE(server.WaitForPort(port_)) << server.Log();
+  const Result cli = Cli("list", "--timeout=5s --tls_ca=" + Cert("ca.pem"));
+  EXPECT_NE(cli.exit_code, 0);
+  EXPECT_THAT(cli.out, HasSubstr("it does not use TLS; connect without --tls_ca"));
+
+  client::ClientOptions options;
+  options.timeout = absl::Seconds(5);
+  options.retry.max_attempts = 1;
+  ASSERT_TRUE(client::LoadTlsFiles(Cert("ca.pem"), "", "", &options).ok());
+  const absl::Status refused = client::Client::Connect(Address(), options)->List().status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kUnavailable);
+  EXPECT_THAT(refused.message(), HasSubstr("it does not use TLS"));
+
+  const Result python = Python(
+      "try:\n"
+      "    client.Client(target, timeout=5, tls_ca=certs + '/ca.pem',\n"
+      "                  retry=client.RetryPolicy(max_attempts=1)).list()\n"
+      "except client.SplinegridError as e:\n"
+      "    print('tls', e.code, 'it does not use TLS' in e.message)\n");
+  EXPECT_EQ(python.exit_code, 0) << python.out;
+  EXPECT_THAT(python.out, HasSubstr("tls UNAVAILABLE True"));
+  EXPECT_EQ(server.Stop(), 0) << server.Log();
+}
+
 TEST_F(TlsAuthTest, PlaintextOnANonLoopbackAddressNeedsInsecure) {
   const std::string any = absl::StrCat("--address=0.0.0.0:", port_);
   {
