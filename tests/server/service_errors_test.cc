@@ -188,7 +188,10 @@ TEST_F(ServiceErrorsTest, BadEvaluationsAreRejected) {
               StatusIs(absl::StatusCode::kOutOfRange, "refinement_level = 21"));
   // Over the server's cap (default 2^30 points): 113 x 33 at level 12.
   request.set_refinement_level(12);
-  EXPECT_THAT(client_->Evaluate(request).status(), StatusIs(absl::StatusCode::kOutOfRange, "cap"));
+  EXPECT_THAT(client_->Evaluate(request).status(),
+              StatusIs(absl::StatusCode::kOutOfRange,
+                       "gives 60130131969 points in all blocks, more than the server's cap of "
+                       "1073741824"));
   request.set_refinement_level(0);
   request.add_blocks(3);
   EXPECT_THAT(client_->Evaluate(request).status(),
