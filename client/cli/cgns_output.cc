@@ -85,6 +85,9 @@ absl::StatusOr<int64_t> WriteCgnsOutput(const std::string& out, client::Evaluate
         const Connectivity connectivity,
         ParseStoredConnectivity(stored, options.source_extents, "source.connectivity"));
     options.block_names = boundaries.block_names;
+    options.base_name = boundaries.base_name;
+    options.data_class = boundaries.data_class;
+    options.units = boundaries.units;
     options.conditions = boundaries.conditions;
     options.matches = connectivity.matches;
   }

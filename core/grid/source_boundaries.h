@@ -6,8 +6,8 @@
 #define SPLINEGRID_CORE_GRID_SOURCE_BOUNDARIES_H_
 
 #include <array>
-#include <string>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -32,8 +32,17 @@ struct SourceBoundaries {
   std::vector<SourceBoundary> conditions;
   std::vector<FaceKindOverride> face_kinds;  // FaceKindsOf(conditions)
   std::vector<std::string> notes;            // choices made and content left out, one sentence each
+  // A CGNS file's base: its name, its DataClass and DimensionalUnits (mass, length, time,
+  // temperature, angle), by their SIDS names ("Dimensional", "Meter", ...); empty when the
+  // file states none. The CGNS writer writes them back.
+  std::string base_name;
+  std::string data_class;
+  std::vector<std::string> units;  // none or five
 
-  bool empty() const { return block_names.empty() && conditions.empty() && notes.empty(); }
+  bool empty() const {
+    return block_names.empty() && conditions.empty() && notes.empty() && base_name.empty() &&
+           data_class.empty() && units.empty();
+  }
 };
 
 // A 1-to-1 connection a file states (CGNS GridConnectivity1to1_t): `range` of its block

@@ -49,6 +49,12 @@ struct CgnsWriteOptions {
   std::vector<SourceBoundary> conditions;  // at source indices
   std::vector<BoundaryMatch> matches;      // at source indices, written as 1-to-1 both ways
   bool single_precision = false;           // RealSingle coordinates
+  // The base's name ("" : "Base"), DataClass and DimensionalUnits (SourceBoundaries: a CGNS
+  // source's, written back). No DataClass (a Plot3D source): NormalizedByUnknownDimensional,
+  // coordinates in an unstated unit.
+  std::string base_name;
+  std::string data_class;
+  std::vector<std::string> units;  // none or five: mass, length, time, temperature, angle
 };
 
 // Writes `grid` as one CGNS (HDF5) base: a structured zone per block, its coordinates, the

@@ -57,6 +57,8 @@ class Reader {
     char base_name[33] = {};
     SG_RETURN_IF_ERROR(file_.Check(
         cg_base_read(file_.fn(), kBase, base_name, &cell_dim_, &phys_dim_), "reading base 1"));
+    out_.boundaries.base_name = base_name;
+    SG_RETURN_IF_ERROR(ReadBaseUnits());
     if (nbases > 1) {
       Note(absl::StrCat("the file has ", nbases, " bases; only the first ('", base_name,
                         "') is read"));
@@ -98,6 +100,30 @@ class Reader {
   void Note(std::string note) { out_.boundaries.notes.push_back(std::move(note)); }
 
   std::string ZoneName(int z) const { return out_.boundaries.block_names[z - 1]; }
+
+  // The base's DataClass and DimensionalUnits, kept so that a written evaluation states what
+  // the file did (the coordinates are not converted); absent ones stay empty.
+  absl::Status ReadBaseUnits() {
+    SG_RETURN_IF_ERROR(file_.Check(cg_goto(file_.fn(), kBase, "end"), "opening base 1"));
+    CGNS_ENUMT(DataClass_t) data_class;
+    if (const int status = cg_dataclass_read(&data_class); status != CG_NODE_NOT_FOUND) {
+      SG_RETURN_IF_ERROR(file_.Check(status, "reading the base's DataClass"));
+      out_.boundaries.data_class = cg_DataClassName(data_class);
+    }
+    CGNS_ENUMT(MassUnits_t) mass;
+    CGNS_ENUMT(LengthUnits_t) length;
+    CGNS_ENUMT(TimeUnits_t) time;
+    CGNS_ENUMT(TemperatureUnits_t) temperature;
+    CGNS_ENUMT(AngleUnits_t) angle;
+    if (const int status = cg_units_read(&mass, &length, &time, &temperature, &angle);
+        status != CG_NODE_NOT_FOUND) {
+      SG_RETURN_IF_ERROR(file_.Check(status, "reading the base's DimensionalUnits"));
+      out_.boundaries.units = {cg_MassUnitsName(mass), cg_LengthUnitsName(length),
+                               cg_TimeUnitsName(time), cg_TemperatureUnitsName(temperature),
+                               cg_AngleUnitsName(angle)};
+    }
+    return absl::OkStatus();
+  }
 
   // A 2D case stored as a 3D volume of two planes (as CFL3D writes them) is a volume to
   // splinegrid: the planar view (planar_view.h) is a Plot3D reading, whose write-back restores

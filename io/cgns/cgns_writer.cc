@@ -1,8 +1,8 @@
 // WriteCgnsFile: one base, a structured zone per block, BCs with families, 1-to-1 connections.
 #include <cgnslib.h>
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -93,8 +93,11 @@ class Writer {
       return absl::InvalidArgumentError(
           "a planar grid (2 coordinates) with k > 1 has no CGNS form");
     }
-    SG_RETURN_IF_ERROR(file_.Check(cg_base_write(file_.fn(), "Base", cell_dim_, phys_dim_, &base_),
-                                   "writing the base"));
+    const std::string base_name = options_.base_name.empty() ? "Base" : options_.base_name;
+    SG_RETURN_IF_ERROR(
+        file_.Check(cg_base_write(file_.fn(), base_name.c_str(), cell_dim_, phys_dim_, &base_),
+                    "writing the base"));
+    SG_RETURN_IF_ERROR(WriteBaseUnits());
     for (size_t w = 0; w < grid_.blocks.size(); ++w) {
       const int source =
           options_.source_blocks.empty() ? static_cast<int>(w) : options_.source_blocks[w];
@@ -110,6 +113,51 @@ class Writer {
   }
 
  private:
+  // The enumerator of T named `name` among the first `count` (cg_*Name), or INVALID_ARGUMENT.
+  template <typename T>
+  static absl::StatusOr<T> Enumerator(const std::string& name, int count, const char* (*name_of)(T),
+                                      const char* what) {
+    for (int e = 0; e < count; ++e) {
+      if (name == name_of(static_cast<T>(e))) return static_cast<T>(e);
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("the source's ", what, " '", name, "' is not a CGNS name"));
+  }
+
+  // The source's DataClass and DimensionalUnits on the base (CgnsWriteOptions), or
+  // NormalizedByUnknownDimensional when it stated none.
+  absl::Status WriteBaseUnits() {
+    SG_RETURN_IF_ERROR(file_.Check(cg_goto(file_.fn(), base_, "end"), "opening the base"));
+    SG_ASSIGN_OR_RETURN(
+        const CGNS_ENUMT(DataClass_t) data_class,
+        Enumerator<CGNS_ENUMT(DataClass_t)>(
+            options_.data_class.empty() ? "NormalizedByUnknownDimensional" : options_.data_class,
+            NofValidDataClass, cg_DataClassName, "DataClass"));
+    SG_RETURN_IF_ERROR(file_.Check(cg_dataclass_write(data_class), "writing the DataClass"));
+    if (options_.units.empty()) return absl::OkStatus();
+    if (options_.units.size() != 5) {
+      return absl::InvalidArgumentError(absl::StrCat("the source's DimensionalUnits have ",
+                                                     options_.units.size(), " entries, not five"));
+    }
+    SG_ASSIGN_OR_RETURN(const auto mass,
+                        Enumerator<CGNS_ENUMT(MassUnits_t)>(options_.units[0], NofValidMassUnits,
+                                                            cg_MassUnitsName, "mass unit"));
+    SG_ASSIGN_OR_RETURN(const auto length, Enumerator<CGNS_ENUMT(LengthUnits_t)>(
+                                               options_.units[1], NofValidLengthUnits,
+                                               cg_LengthUnitsName, "length unit"));
+    SG_ASSIGN_OR_RETURN(const auto time,
+                        Enumerator<CGNS_ENUMT(TimeUnits_t)>(options_.units[2], NofValidTimeUnits,
+                                                            cg_TimeUnitsName, "time unit"));
+    SG_ASSIGN_OR_RETURN(const auto temperature, Enumerator<CGNS_ENUMT(TemperatureUnits_t)>(
+                                                    options_.units[3], NofValidTemperatureUnits,
+                                                    cg_TemperatureUnitsName, "temperature unit"));
+    SG_ASSIGN_OR_RETURN(const auto angle,
+                        Enumerator<CGNS_ENUMT(AngleUnits_t)>(options_.units[4], NofValidAngleUnits,
+                                                             cg_AngleUnitsName, "angle unit"));
+    return file_.Check(cg_units_write(mass, length, time, temperature, angle),
+                       "writing the DimensionalUnits");
+  }
+
   std::string ZoneName(int source) const {
     if (source < static_cast<int>(options_.block_names.size()) &&
         !options_.block_names[source].empty()) {
@@ -125,8 +173,8 @@ class Writer {
 
   // How many blocks the source grid has, as far as the options tell (at least the written ones).
   int SourceBlockCount() const {
-    size_t count = std::max({grid_.blocks.size(), options_.source_extents.size(),
-                             options_.block_names.size()});
+    size_t count = std::max(
+        {grid_.blocks.size(), options_.source_extents.size(), options_.block_names.size()});
     for (const int source : options_.source_blocks)
       count = std::max(count, static_cast<size_t>(source) + 1);
     return static_cast<int>(std::max<size_t>(count, 1));
@@ -160,6 +208,16 @@ class Writer {
       }
       SG_RETURN_IF_ERROR(
           file_.Check(result, absl::StrCat("writing ", kNames[c], " of '", name, "'")));
+      // A coordinate is a length: mass^0 length^1 time^0 temperature^0 angle^0 (SIDS 5.1.1;
+      // cgnscheck asks for the exponents of data that are not dimensionless).
+      const double exponents[5] = {0.0, 1.0, 0.0, 0.0, 0.0};
+      SG_RETURN_IF_ERROR(file_.Check(
+          cg_goto(file_.fn(), base_, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", index,
+                  "end"),
+          absl::StrCat("opening ", kNames[c], " of '", name, "'")));
+      SG_RETURN_IF_ERROR(
+          file_.Check(cg_exponents_write(CGNS_ENUMV(RealDouble), exponents),
+                      absl::StrCat("writing the DimensionalExponents of ", kNames[c])));
     }
     return absl::OkStatus();
   }

@@ -40,6 +40,9 @@ void EncodeSourceBoundaries(const SourceBoundaries& boundaries, v1::SourceBounda
     entry->set_kind(EncodeBoundaryKind(k.kind));
   }
   for (const std::string& note : boundaries.notes) out->add_notes(note);
+  out->set_base_name(boundaries.base_name);
+  out->set_data_class(boundaries.data_class);
+  for (const std::string& unit : boundaries.units) out->add_dimensional_units(unit);
 }
 
 absl::StatusOr<SourceBoundaries> ParseSourceBoundaries(const v1::SourceBoundaries& in,
@@ -49,6 +52,20 @@ absl::StatusOr<SourceBoundaries> ParseSourceBoundaries(const v1::SourceBoundarie
   for (int q = 0; q < in.block_names_size(); ++q) {
     SG_RETURN_IF_ERROR(CheckName(in.block_names(q), absl::StrCat(field, ".block_names[", q, "]")));
     out.block_names.push_back(in.block_names(q));
+  }
+  SG_RETURN_IF_ERROR(CheckName(in.base_name(), field + ".base_name"));
+  SG_RETURN_IF_ERROR(CheckName(in.data_class(), field + ".data_class"));
+  out.base_name = in.base_name();
+  out.data_class = in.data_class();
+  if (in.dimensional_units_size() != 0 && in.dimensional_units_size() != 5) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".dimensional_units has ", in.dimensional_units_size(),
+                     " entries; give none or five (mass, length, time, temperature, angle)"));
+  }
+  for (int q = 0; q < in.dimensional_units_size(); ++q) {
+    SG_RETURN_IF_ERROR(
+        CheckName(in.dimensional_units(q), absl::StrCat(field, ".dimensional_units[", q, "]")));
+    out.units.push_back(in.dimensional_units(q));
   }
   for (int q = 0; q < in.conditions_size(); ++q) {
     const v1::SourceBoundary& entry = in.conditions(q);

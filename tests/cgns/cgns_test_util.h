@@ -42,6 +42,19 @@ inline void Plot3dToCgns(const std::string& plot3d, const std::string& cgns,
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
 }
 
+// What Debian's checker of the standard (cgns-convert's cgnscheck) says of the file at `path`,
+// standard output and error together.
+inline std::string CgnsCheckReport(const std::string& path) {
+  const std::string command = absl::StrCat("cgnscheck '", path, "' 2>&1");
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return "cannot run " + command;
+  std::string report;
+  char line[512];
+  while (fgets(line, sizeof(line), pipe) != nullptr) report += line;
+  pclose(pipe);
+  return report;
+}
+
 // Largest coordinate difference of two grids of equal shapes (infinity when shapes differ).
 inline double MaxDifference(const MultiBlockGrid& a, const MultiBlockGrid& b) {
   if (a.blocks.size() != b.blocks.size()) return INFINITY;

@@ -91,6 +91,11 @@ v1::CgnsDecoded ValidDecoded() {
   c->set_kind(v1::BOUNDARY_KIND_WALL);
   c->set_name("wall");
   c->set_bc_type("BCWall");
+  d.mutable_boundaries()->set_base_name("Airfoil");
+  d.mutable_boundaries()->set_data_class("Dimensional");
+  for (const char* unit : {"Kilogram", "Meter", "Second", "Kelvin", "Radian"}) {
+    d.mutable_boundaries()->add_dimensional_units(unit);
+  }
   return d;
 }
 
@@ -99,6 +104,8 @@ TEST(CgnsDecodedTest, ValidOutputParsesAndEncodesBack) {
   ASSERT_TRUE(grid.ok()) << grid.status();
   EXPECT_EQ(grid->grid.blocks[0].Point(2, 1, 0)[0], 2.0);
   ASSERT_EQ(grid->boundaries.conditions.size(), 1u);
+  EXPECT_EQ(grid->boundaries.base_name, "Airfoil");
+  EXPECT_EQ(grid->boundaries.units[1], "Meter");
   v1::CgnsDecoded again;
   EncodeCgnsDecoded(*grid, &again);
   EXPECT_EQ(again.SerializeAsString(), ValidDecoded().SerializeAsString());
@@ -131,6 +138,12 @@ TEST(CgnsDecodedTest, HostileOutputIsInvalidArgumentNamingTheField) {
   d = ValidDecoded();
   d.mutable_boundaries()->mutable_conditions(0)->set_name(std::string(300, 'x'));
   expect_refused(d, "boundaries.conditions[0].name is longer than 256 bytes");
+  d = ValidDecoded();
+  d.mutable_boundaries()->mutable_dimensional_units()->RemoveLast();
+  expect_refused(d, "boundaries.dimensional_units has 4 entries; give none or five");
+  d = ValidDecoded();
+  d.mutable_boundaries()->set_base_name(std::string(300, 'b'));
+  expect_refused(d, "boundaries.base_name is longer than 256 bytes");
   d = ValidDecoded();
   v1::CgnsConnection* c = d.add_connections();
   c->mutable_range()->set_face(v1::BLOCK_FACE_I_MIN);
