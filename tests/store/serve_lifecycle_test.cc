@@ -148,7 +148,8 @@ TEST_F(DrainTest, SigtermTurnsNotServingWhileCallsSucceedThenExits) {
     }
     EXPECT_LT(line.size(), 2000u);
   }
-  EXPECT_THAT(log, HasSubstr("\"grid\":\"grids/naca\\\\n2026-01-01T00:00:00.000Z DeleteGrid"));
+  // The name's newline is escaped once (JSON's \u000a): the value is the name as sent.
+  EXPECT_THAT(log, HasSubstr("\"grid\":\"grids/naca\\u000a2026-01-01T00:00:00.000Z DeleteGrid"));
   EXPECT_THAT(log, ::testing::Not(HasSubstr("\n2026-01-01T00:00:00.000Z DeleteGrid")));
 }
 
