@@ -90,6 +90,12 @@ absl::Status Fit(const Args& args) {
   // A CGNS file (by extension or signature) is decoded by the server, BCs included; it is
   // stored as its zones are (--planar is about two-plane Plot3D files).
   const bool cgns = IsCgnsPath(path) || LooksLikeCgns(bytes);
+  if (cgns && !LooksLikeCgns(bytes)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        path,
+        " is named .cgns but is not a CGNS file: it starts with neither the HDF5 signature "
+        "nor an ADF header (a Plot3D file is recognised by its content under another name)"));
+  }
   // Plot3D read options given for a CGNS file would be ignored: refused instead (the defaults,
   // --planar=true included, are not "given").
   for (const char* flag : {"planar", "plot3d_layout"}) {

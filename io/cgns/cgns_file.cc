@@ -2,15 +2,34 @@
 
 #include <cgnslib.h>
 
+#include <algorithm>
+#include <fstream>
+
 #include "absl/strings/str_cat.h"
+#include "io/cgns/cgns_io.h"
 
 namespace splinegrid {
 
 absl::StatusOr<CgnsFile> CgnsFile::Open(const std::string& path, int mode) {
   int fn = -1;
   if (cg_open(path.c_str(), mode, &fn) != CG_OK) {
+    const std::string error = cg_get_error();
+    if (mode == CG_MODE_READ) {
+      // libcgns's own words for a file of another kind are about ADF internals ("Memory
+      // boundary tag bad"): say first whether the file is CGNS at all.
+      std::string start(8192, '\0');
+      std::ifstream file(path, std::ios::binary);
+      file.read(start.data(), static_cast<std::streamsize>(start.size()));
+      start.resize(static_cast<size_t>(std::max<std::streamsize>(file.gcount(), 0)));
+      if (file.is_open() && !LooksLikeCgns(start)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(path,
+                         ": not a CGNS file: it starts with neither the HDF5 signature nor an ADF "
+                         "header"));
+      }
+    }
     return absl::InvalidArgumentError(
-        absl::StrCat(path, ": not a readable CGNS file (", cg_get_error(), ")"));
+        absl::StrCat(path, ": not a readable CGNS file (", error, ")"));
   }
   return CgnsFile(fn, path);
 }

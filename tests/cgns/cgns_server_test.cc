@@ -310,6 +310,18 @@ TEST(CgnsServerTest, DamagedFilesAreInvalidArgumentAndTheServerKeepsServing) {
     EXPECT_EQ(server.Cli(absl::StrCat("fit ", dir.File(name)), &out), 2) << out;
     EXPECT_THAT(out, HasSubstr("INVALID_ARGUMENT: cgns: ")) << out;
   }
+  // A file that is no CGNS at all is named so (libcgns spoke of ADF internals): by the server
+  // for an upload, by the CLI for a file named .cgns, before any upload.
+  const std::string plot3d = *ReadFileToString(SharedDataPath("grids/n0012_113-33.p2dfmt"));
+  const absl::Status not_cgns = server.client().ImportCgns(plot3d, "", "n0012.cgns").status();
+  EXPECT_EQ(not_cgns.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(not_cgns.message(),
+              HasSubstr("not a CGNS file: it starts with neither the HDF5 signature nor an ADF "
+                        "header"));
+  std::ofstream(dir.File("plot3d.cgns"), std::ios::binary) << plot3d;
+  std::string misnamed;
+  EXPECT_EQ(server.Cli(absl::StrCat("fit ", dir.File("plot3d.cgns")), &misnamed), 2) << misnamed;
+  EXPECT_THAT(misnamed, HasSubstr("plot3d.cgns is named .cgns but is not a CGNS file"));
   // A zone whose coordinates are not finite: the decoder names the zone in quotes, and the
   // server passes that on once (a trial saw zone \'blk\' when it was quoted again).
   MultiBlockGrid nan_grid;
