@@ -24,6 +24,7 @@ absl::StatusOr<v1::DeformGridRequest> BaseRequest(const char* grid,
   request.set_time(o.time);
   request.set_step(o.step);
   request.set_check_level(o.check_level);
+  request.set_max_boundary_error(o.max_boundary_error);  // the server names a bad one
   if (o.boundary_kind != 0) {
     if (!v1::BoundaryKind_IsValid(o.boundary_kind)) {
       return absl::InvalidArgumentError(absl::StrCat("options.boundary_kind: ", o.boundary_kind,
@@ -40,8 +41,9 @@ absl::Status Deform(sg_client* c, const v1::DeformGridRequest& request, sg_defor
   SG_ASSIGN_OR_RETURN(const v1::DeformGridResponse moved, connected->Deform(request));
   if (result != nullptr) {
     const v1::DeformReport& r = moved.report();
-    *result = sg_deform_result{moved.revision(), r.min_jacobian_ratio(), r.max_jacobian_ratio(),
-                               r.seconds(),      r.moved_controls(),     0};
+    *result = sg_deform_result{moved.revision(),  r.min_jacobian_ratio(), r.max_jacobian_ratio(),
+                               r.seconds(),       r.moved_controls(),     0,
+                               r.boundary_error()};
   }
   return absl::OkStatus();
 }

@@ -103,6 +103,9 @@ typedef struct sg_deform_options {
   int64_t step;               /* solver time step stamped on the new revision */
   int32_t check_level;        /* refinement level of the server's fold check, 0 to 4 */
   int32_t boundary_kind;      /* SG_BOUNDARY_*: the moved boundary (rigid and point motions); 0: walls */
+  double max_boundary_error;  /* sg_deform_points: how far the deformed boundary may miss the
+                                 points (else SG_FAILED_PRECONDITION); 0: the fit's wall
+                                 tolerance */
 } sg_deform_options;
 
 /* What a deformation stored (DeformGridResponse and its DeformReport). */
@@ -113,6 +116,8 @@ typedef struct sg_deform_result {
   double seconds; /* the server's deformation and check time */
   int32_t moved_controls;
   int32_t reserved;
+  double boundary_error; /* sg_deform_points: how far the deformed boundary lies from the
+                            points given (rigid motions: 0, met exactly) */
 } sg_deform_result;
 
 /* A grid's shape (GetGrid, basic view). */

@@ -17,6 +17,7 @@ absl::StatusOr<ops::DeformRequest> ParseRequest(const v1::DeformGridRequest& req
   SG_ASSIGN_OR_RETURN(out.options, ParseDeformOptions(request));
   SG_ASSIGN_OR_RETURN(out.motion, ParseDeformMotion(request));
   out.check_level = request.check_level();
+  out.max_boundary_error = request.max_boundary_error();
   out.time = request.time();
   out.step = request.step();
   return out;

@@ -45,6 +45,7 @@ void EncodeDeformReport(const DeformSummary& deform, v1::DeformReport* out) {
   out->set_moved_controls(deform.moved_controls);
   out->set_decay_radius(std::isfinite(deform.decay_radius) ? deform.decay_radius : 0.0);
   out->set_seconds(deform.seconds);
+  out->set_boundary_error(deform.boundary_error);
 }
 
 absl::Status EncodeGrid(const StoredGrid& grid, int64_t revision, v1::GridView view,

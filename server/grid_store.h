@@ -47,6 +47,8 @@ struct DeformSummary {
   int moved_controls = 0;
   double decay_radius = 0.0;
   double seconds = 0.0;
+  // Boundary-point motions: how far the deformed boundary lies from the points given.
+  double boundary_error = 0.0;
 };
 
 // An immutable state of a grid's spline mapping.

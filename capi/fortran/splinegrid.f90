@@ -52,11 +52,13 @@ module splinegrid
     real(c_double) :: time = 0
     integer(c_int64_t) :: step = 0
     integer(c_int32_t) :: check_level = 0, boundary_kind = 0
+    real(c_double) :: max_boundary_error = 0
   end type sg_deform_options
   type, bind(c), public :: sg_deform_result
     integer(c_int64_t) :: revision = 0
     real(c_double) :: min_jacobian_ratio = 0, max_jacobian_ratio = 0, seconds = 0
     integer(c_int32_t) :: moved_controls = 0, reserved = 0
+    real(c_double) :: boundary_error = 0
   end type sg_deform_result
   type, bind(c), public :: sg_grid_info
     integer(c_int64_t) :: latest_revision = 0

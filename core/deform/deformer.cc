@@ -542,9 +542,9 @@ absl::StatusOr<std::shared_ptr<const Deformer::BoundaryFit>> Deformer::CheckedFi
     if (inside[b][p] && !selected_[b][p]) {
       const int64_t ni = extents[b][0], nj = extents[b][1], at = static_cast<int64_t>(p);
       return absl::InvalidArgumentError(absl::StrCat(
-          name, ": point (", at % ni, ", ", (at / ni) % nj, ", ", at / (ni * nj), ") of block ",
-          b, " is not on the moved boundary (DeformOptions.moved, a request's boundary: the "
-             "walls unless it names kinds or face ranges)"));
+          name, ": point (", at % ni, ", ", (at / ni) % nj, ", ", at / (ni * nj), ") of block ", b,
+          " is not on the moved boundary (DeformOptions.moved, a request's boundary: the "
+          "walls unless it names kinds or face ranges)"));
     }
   }
   if (given.level < 0 || given.level > kMaxRefinementLevel) {
@@ -629,6 +629,42 @@ void Deformer::AccumulateMoved(const BoundaryPoints& given, const BoundaryFit& f
       ++hits[it->second];
     }
   }
+}
+
+absl::StatusOr<BoundaryMiss> Deformer::Miss(const std::vector<FittedBlock>& moved,
+                                            std::span<const BoundaryPoints> points) const {
+  const int s = reference_.front().spline.spatial_dim();
+  const std::vector<Extents> extents = PointExtents(reference_);
+  BoundaryMiss miss;
+  for (size_t r = 0; r < points.size(); ++r) {
+    SG_ASSIGN_OR_RETURN(const std::shared_ptr<const BoundaryFit> fit,
+                        CheckedFit(points[r], r, extents));
+    const StructuredBlock now = EvaluateGrid(moved[fit->block].spline, fit->params);
+    // The positions asked: given, or the reference's plus the displacements given.
+    std::vector<double> asked = SampleDisplacements(points[r], *fit);
+    const StructuredBlock was = EvaluateGrid(reference_[fit->block].spline, fit->params);
+    for (size_t v = 0; v < asked.size(); ++v) asked[v] += was.coords()[v];
+    const int64_t count = now.num_points();
+    for (int64_t p = 0; p < count; ++p) {
+      double squared = 0.0;
+      for (int e = 0; e < s; ++e) {
+        const double d = now.coords()[p * s + e] - asked[p * s + e];
+        squared += d * d;
+      }
+      if (std::sqrt(squared) > miss.distance) {
+        miss.distance = std::sqrt(squared);
+        miss.range = static_cast<int>(r);
+        // The sample's point of the block at the range's level: the range's lower corner
+        // scaled, plus the sample's position along each tangential direction.
+        const int64_t n0 = now.extent(0), n1 = now.extent(1);
+        const Extents at = {static_cast<int>(p % n0), static_cast<int>((p / n0) % n1),
+                            static_cast<int>(p / (n0 * n1))};
+        const int scale = 1 << points[r].level;
+        for (int d = 0; d < 3; ++d) miss.point[d] = points[r].range.begin[d] * scale + at[d];
+      }
+    }
+  }
+  return miss;
 }
 
 absl::StatusOr<std::vector<FittedBlock>> Deformer::MoveBoundaryPoints(

@@ -85,6 +85,13 @@ struct BoundaryPoints {
   bool displacements = false;  // coordinates are displacements, not positions
 };
 
+// How far a deformed boundary lies from the points asked of it (Deformer::BoundaryMiss).
+struct BoundaryMiss {
+  double distance = 0.0;      // the largest distance
+  int range = 0;              // of the range given as points[range]
+  Extents point = {0, 0, 0};  // at this point of its block, at the range's level
+};
+
 class Deformer {
  public:
   // Prepares the deformation of `reference` (the blocks of a revision), whose boundary points
@@ -111,6 +118,14 @@ class Deformer {
   // control (too coarse a level).
   absl::StatusOr<std::vector<FittedBlock>> MoveBoundaryPoints(
       std::span<const BoundaryPoints> points) const;
+
+  // The largest distance of the boundary of `moved` (MoveBoundaryPoints(points)) from the
+  // positions `points` ask for: the least-squares fit of a range's controls meets displacements
+  // of the boundary's own basis exactly and others only approximately (a bump narrower than
+  // the boundary's knot spans is missed by up to half its height), so a caller can see it and
+  // refuse. O(samples) per range. Errors as MoveBoundaryPoints.
+  absl::StatusOr<BoundaryMiss> Miss(const std::vector<FittedBlock>& moved,
+                                    std::span<const BoundaryPoints> points) const;
 
   // (block, control index) of every moved control, block by block in control order.
   const std::vector<std::pair<int, int64_t>>& moved_controls() const { return moved_; }

@@ -24,7 +24,8 @@ def _deform_request(name: str, rotate_degrees: Optional[float],
                     check_level: int, control_displacements: Optional[ControlDisplacements],
                     boundary_points: Optional[Iterable[BoundaryPoints]], propagation: str,
                     decay_radius: float, rigid_radius: float,
-                    smoothing_iterations: int) -> service_pb2.DeformGridRequest:
+                    smoothing_iterations: int,
+                    max_boundary_error: float = 0.0) -> service_pb2.DeformGridRequest:
     """The DeformGridRequest of :meth:`Client.deform`'s arguments; ValueError naming the
     argument (and its value) that is wrong, or the motions when not exactly one is given."""
     request = service_pb2.DeformGridRequest(name=grid_name(name))
@@ -38,6 +39,7 @@ def _deform_request(name: str, rotate_degrees: Optional[float],
     if propagation not in _PROPAGATIONS:
         raise ValueError(f"propagation = {propagation!r}; give 'blend' or 'transfinite'")
     request.propagation = _PROPAGATIONS[propagation]
+    request.max_boundary_error = _non_negative(max_boundary_error, "max_boundary_error")
     request.decay_radius = _non_negative(decay_radius, "decay_radius")
     request.rigid_radius = _non_negative(rigid_radius, "rigid_radius")
     if request.decay_radius > 0.0 and request.rigid_radius > request.decay_radius:
@@ -83,12 +85,13 @@ class _DeformCalls(_Calls):
                boundary_points: Optional[Iterable[BoundaryPoints]] = None,
                propagation: str = "blend", decay_radius: float = 0.0,
                rigid_radius: float = 0.0,
-               smoothing_iterations: int = 0) -> service_pb2.DeformGridResponse:
+               smoothing_iterations: int = 0,
+               max_boundary_error: float = 0.0) -> service_pb2.DeformGridResponse:
         """Moves part of a revision's boundary, lets the grid follow, checks it for folded cells
         and stores it as a new revision (DeformGrid); returns the DeformGridResponse proto:
         ``revision`` and ``report`` (DeformReport: ``min_jacobian_ratio``,
         ``max_orthogonality_change_degrees``, ``moved_controls``, ``decay_radius``,
-        ``seconds``, ...).
+        ``boundary_error``, ``seconds``, ...).
 
         The motion is one of
           - a rigid motion: ``rotate_degrees`` about the axis ``axis`` (3 values; default z,
@@ -98,7 +101,10 @@ class _DeformCalls(_Calls):
             (i fastest) of moved controls and their displacements shaped ``(N, s)``; moved
             controls not listed stay;
           - ``boundary_points``: :class:`BoundaryPoints`, new positions (or displacements) of
-            the points of boundary ranges at a refinement level, fitted with the stored basis.
+            the points of boundary ranges at a refinement level, fitted with the stored basis
+            by least squares. A boundary that misses them by more than
+            ``max_boundary_error`` (0: the fitted revision's wall tolerance) is refused with
+            ``FAILED_PRECONDITION`` naming the point; ``report.boundary_error`` is the miss.
 
         ``boundary`` says what moves: ``"wall"`` (the default), ``"outer"``, ``"interface"``, a
         list of those, or face ranges (one or a list): ``(block, face, begin, end)`` tuples or
@@ -122,5 +128,6 @@ class _DeformCalls(_Calls):
         request = _deform_request(name, rotate_degrees, about, axis, translate, boundary,
                                   reference_revision, base_revision, time, step, check_level,
                                   control_displacements, boundary_points, propagation,
-                                  decay_radius, rigid_radius, smoothing_iterations)
+                                  decay_radius, rigid_radius, smoothing_iterations,
+                                  max_boundary_error)
         return self._unary(self.stub.DeformGrid, request, service_pb2.DeformGridResponse)

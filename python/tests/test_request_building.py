@@ -124,12 +124,13 @@ class TestGenerate:
 def deform(name="naca", rotate_degrees=None, about=None, axis=None, translate=None,
            boundary=None, reference_revision=0, base_revision=0, time=0.0, step=0,
            check_level=0, control_displacements=None, boundary_points=None,
-           propagation="blend", decay_radius=0.0, rigid_radius=0.0, smoothing_iterations=0):
+           propagation="blend", decay_radius=0.0, rigid_radius=0.0, smoothing_iterations=0,
+           max_boundary_error=0.0):
     """_deform_request with Client.deform's defaults."""
     return _deform_request(name, rotate_degrees, about, axis, translate, boundary,
                            reference_revision, base_revision, time, step, check_level,
                            control_displacements, boundary_points, propagation, decay_radius,
-                           rigid_radius, smoothing_iterations)
+                           rigid_radius, smoothing_iterations, max_boundary_error)
 
 
 class TestDeform:
@@ -158,7 +159,8 @@ class TestDeform:
     def test_boundary_points_over_a_face_range(self):
         points = BoundaryPoints((0, "jmin", (0, 0), (2, 0)), np.zeros((3, 2)), level=1,
                                 displacements=True)
-        request = deform(boundary_points=[points])
+        request = deform(boundary_points=[points], max_boundary_error=1e-3)
+        assert request.max_boundary_error == 1e-3
         (moved,) = request.boundary_points.ranges
         assert (moved.range.block, moved.range.face) == (0, grid_pb2.BLOCK_FACE_J_MIN)
         assert (moved.range.end.i, moved.refinement_level, moved.displacements) == (2, 1, True)
@@ -181,6 +183,8 @@ class TestDeform:
         (dict(control_displacements={0: ([1], [[0.0, 0.1], [0.0, 0.2]])}),
          r"control_displacements\[0\]: displacements have shape \(2, 2\); expected \(1, s\)"),
         (dict(boundary_points=[]), "boundary_points is empty"),
+        (dict(rotate_degrees=1.0, max_boundary_error=-1.0),
+         "max_boundary_error = -1.0; must not be negative"),
         (dict(rotate_degrees=1.0, smoothing_iterations=1.5),
          "smoothing_iterations = 1.5; must be an integer"),
     ])

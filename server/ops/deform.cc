@@ -56,7 +56,48 @@ absl::Status Validate(const DeformRequest& request) {
   if (!std::isfinite(request.time)) {
     return absl::InvalidArgumentError(absl::StrCat("time = ", request.time, " is not finite"));
   }
+  if (!(request.max_boundary_error >= 0.0) || !std::isfinite(request.max_boundary_error)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_boundary_error = ", request.max_boundary_error,
+                     " is not a finite distance >= 0 (0: default)"));
+  }
   return absl::OkStatus();
+}
+
+// How far a boundary-point deformation may miss the points given by default: as far as the
+// fitted revision the reference comes from was allowed to miss its walls (its wall tolerance),
+// or, fitted to control counts, did miss its points (its largest deviation); at least a
+// rounding-sized length. Deformed revisions carry no fit report: their fitted ancestor's.
+double DefaultMaxBoundaryError(const StoredGrid& grid, const GridRevision& reference) {
+  const GridRevision* fitted = &reference;
+  std::shared_ptr<const GridRevision> up;
+  for (int hops = 0; hops < 1000 && fitted->origin == RevisionOrigin::kDeform && fitted->parent > 0;
+       ++hops) {
+    absl::StatusOr<std::shared_ptr<const GridRevision>> parent =
+        grid.ResolveRevision(fitted->parent);
+    if (!parent.ok()) break;
+    up = *std::move(parent);
+    fitted = up.get();
+  }
+  const GridFitReport& report = fitted->report;
+  const double limit = report.tolerances ? report.tolerances->wall : report.max_deviation;
+  return std::max(limit, 1e-12 * std::max(report.reference.length, 1.0));
+}
+
+// The refusal of boundary points the deformed boundary misses by more than `limit`.
+absl::Status MissesBoundary(const BoundaryMiss& miss, double limit, bool given,
+                            const std::vector<BoundaryPoints>& points) {
+  const Extents& p = miss.point;
+  return absl::FailedPreconditionError(absl::StrCat(
+      "the deformed boundary misses boundary_points[", miss.range, "] by ", miss.distance,
+      " at point (", p[0], ", ", p[1], ", ", p[2], ") of block ",
+      points[miss.range].range.face.block, " at level ", points[miss.range].level,
+      ", more than max_boundary_error = ", limit,
+      given ? "" : " (the default: the fitted revision's wall tolerance)",
+      ": the boundary's controls, fitted to the points by least squares, cannot follow a "
+      "displacement that varies faster than its knot spans; nothing was stored (give smoother "
+      "displacements, fit the grid with a tighter wall tolerance for more wall controls, or "
+      "allow a larger max_boundary_error)"));
 }
 
 // The refusal of a deformation that folds cells, with what may avoid it. Motions are relative
@@ -78,11 +119,10 @@ absl::Status Folds(const DeformationCheck& check, const DeformMotion& motion) {
         "unwound, but a series passing 180 degrees then jumps a turn inside between steps (a "
         "rotor needs a block that rotates with it)");
   }
-  return absl::FailedPreconditionError(
-      absl::StrCat("the deformation folds ", check.folded, " cells at refinement level ",
-                   check.level, "; the worst in block ", check.worst_block, " at cell (", c[0],
-                   ", ", c[1], ", ", c[2], ") with Jacobian ratio ", check.min_jacobian_ratio,
-                   "; nothing was stored (", advice, ")"));
+  return absl::FailedPreconditionError(absl::StrCat(
+      "the deformation folds ", check.folded, " cells at refinement level ", check.level,
+      "; the worst in block ", check.worst_block, " at cell (", c[0], ", ", c[1], ", ", c[2],
+      ") with Jacobian ratio ", check.min_jacobian_ratio, "; nothing was stored (", advice, ")"));
 }
 
 // The deformed revision: the reference's blocks with the moved splines, stamped.
@@ -179,9 +219,19 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   // The fold gate of the reference at the check level is kept with the deformer.
   SG_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationGate> gate,
                       kept->Gate(request.check_level, context.budget, cancel));
+  double boundary_error = 0.0;
+  if (const auto* points = std::get_if<std::vector<BoundaryPoints>>(&request.motion)) {
+    SG_ASSIGN_OR_RETURN(const BoundaryMiss miss, deformer.Miss(moved, *points));
+    const bool given = request.max_boundary_error > 0.0;
+    const double limit =
+        given ? request.max_boundary_error : DefaultMaxBoundaryError(*grid, *reference);
+    if (miss.distance > limit) return MissesBoundary(miss, limit, given, *points);
+    boundary_error = miss.distance;
+  }
   SG_ASSIGN_OR_RETURN(const DeformationCheck check, gate->Check(moved, cancel));
   if (!check.ok()) return Folds(check, request.motion);
   GridRevision revision = DeformedRevision(*reference, deformer, std::move(moved), check, request);
+  revision.deform.boundary_error = boundary_error;
   revision.deform.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SG_ASSIGN_OR_RETURN(revision.memory,

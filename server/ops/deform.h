@@ -29,6 +29,9 @@ struct DeformRequest {
   DeformOptions options;  // what moves and how the grid follows
   DeformMotion motion;
   int check_level = 0;  // the fold check's refinement level, [0, kMaxDeformCheckLevel]
+  // Boundary-point motions: the largest distance the deformed boundary may keep from the points
+  // given; 0: the fitted revision's wall tolerance (its largest deviation for a count fit).
+  double max_boundary_error = 0.0;
   double time = 0.0;    // the solver's time and step, stamped on the revision
   int64_t step = 0;
 };

@@ -30,6 +30,7 @@ void EncodeDeformSummary(const DeformSummary& deform, v1::StoredDeformSummary* o
   out->set_moved_controls(deform.moved_controls);
   out->set_decay_radius(deform.decay_radius);
   out->set_seconds(deform.seconds);
+  out->set_boundary_error(deform.boundary_error);
 }
 
 absl::StatusOr<DeformSummary> ParseDeformSummary(const v1::StoredDeformSummary& stored) {
@@ -42,6 +43,11 @@ absl::StatusOr<DeformSummary> ParseDeformSummary(const v1::StoredDeformSummary& 
   }
   deform.decay_radius = stored.decay_radius();  // +infinity: no decay
   deform.seconds = stored.seconds();
+  deform.boundary_error = stored.boundary_error();
+  if (!(deform.boundary_error >= 0.0) || !std::isfinite(deform.boundary_error)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "revision.deform.boundary_error = ", deform.boundary_error, " is not a finite distance"));
+  }
   return deform;
 }
 

@@ -266,9 +266,25 @@ static void Airfoil(sg_client* client, const char* grid_file) {
               sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MIN, begin, end, 0, NULL,
                                22, 1, &moved),
               SG_INVALID_ARGUMENT, "points: NULL");
+  /* One point of them moved by 2e-3: the wall's basis cannot follow a spike, misses it by more
+   * than the wall tolerance (1.5e-4 chords), and that is refused. */
+  double spike[22];
+  for (int v = 0; v < 22; ++v) spike[v] = 0.0;
+  spike[11] = 2e-3;
+  CHECK_ERROR(client,
+              sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MIN, begin, end, 0, spike,
+                               22, 1, &moved),
+              SG_FAILED_PRECONDITION, "the deformed boundary misses boundary_points[0] by ");
+  options.max_boundary_error = -1.0;
+  CHECK_ERROR(client,
+              sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MIN, begin, end, 0, bump,
+                               22, 1, &moved),
+              SG_INVALID_ARGUMENT, "max_boundary_error = -1");
+  options.max_boundary_error = 0.0;
   CHECK_OK(client, sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MIN, begin, end, 0,
                                     bump, 22, 1, &moved));
   CHECK(moved.revision == 3 && moved.min_jacobian_ratio > 0.0);
+  CHECK(moved.boundary_error >= 0.0 && moved.boundary_error <= 1.5e-4);
 
   /* The watch sends the three stored revisions, then blocks until cancelled. */
   sg_watch* watch = NULL;
