@@ -232,6 +232,18 @@ SG_API sg_status sg_evaluate(sg_client* client, const char* grid, int64_t revisi
                              int32_t level, double* points, int64_t capacity, int32_t extents[3],
                              int64_t* revision_out);
 
+/* sg_evaluate into an array of `rank` (1 to 4) dimensions `shape` (`rank` values, column-major,
+ * as Fortran's shape()) that must fit the block: rank 1 any size from the needed one up; otherwise
+ * (spatial_dim, ni, nj, nk) with the directions after the last dimension merged into it, e.g.
+ * (spatial_dim, ni, nj) for nk = 1 or (spatial_dim, ni * nj * nk). Anything else is
+ * INVALID_ARGUMENT naming both shapes, and nothing is written. The Fortran module's sg_evaluate
+ * calls it, so that an array of another level's shape is refused rather than filled with this
+ * level's points in the wrong layout. */
+SG_API sg_status sg_evaluate_shaped(sg_client* client, const char* grid, int64_t revision,
+                                    int32_t block, int32_t level, double* points, int32_t rank,
+                                    const int64_t* shape, int32_t extents[3],
+                                    int64_t* revision_out);
+
 /* ---- Watching ---- */
 
 /* Opens a watch of the grid's revisions: those after `after_revision` (0: every stored one

@@ -4,8 +4,9 @@
 ! as SG_INVALID_ARGUMENT or SG_NOT_FOUND); sg_last_error(client) is the message of the calling
 ! thread's last call on that client ("" after a success). Strings are passed as ordinary
 ! character values (trailing blanks are trimmed); ids come back in character variables.
-! Points are real(c_double) arrays laid out as points(spatial_dim, ni, nj, nk) (any contiguous
-! array of rank 1 to 4 whose size is the capacity); the caller owns every array.
+! Points are real(c_double) arrays laid out as points(spatial_dim, ni, nj, nk); sg_evaluate
+! checks an array of rank 2 to 4 against that shape (sg_evaluate_shaped) and takes a rank-1
+! array of any size from the needed one up. The caller owns every array.
 !
 !   use splinegrid
 !   type(sg_client) :: client
@@ -211,19 +212,20 @@ module splinegrid
       type(sg_deform_result), intent(out) :: result
       integer(c_int) :: status
     end function c_sg_deform_points
-    function c_sg_evaluate(client, grid, revision, block, level, points, capacity, extents, &
-        revision_out) bind(c, name="sg_evaluate") result(status)
+    function c_sg_evaluate_shaped(client, grid, revision, block, level, points, rank, shape, &
+        extents, revision_out) bind(c, name="sg_evaluate_shaped") result(status)
       import :: c_ptr, c_char, c_int64_t, c_int32_t, c_int
       type(c_ptr), value :: client
       character(kind=c_char), dimension(*), intent(in) :: grid
       integer(c_int64_t), value :: revision
       integer(c_int32_t), value :: block, level
       type(c_ptr), value :: points
-      integer(c_int64_t), value :: capacity
+      integer(c_int32_t), value :: rank
+      integer(c_int64_t), dimension(4), intent(in) :: shape
       integer(c_int32_t), dimension(3), intent(out) :: extents
       integer(c_int64_t), intent(out) :: revision_out
       integer(c_int) :: status
-    end function c_sg_evaluate
+    end function c_sg_evaluate_shaped
     function c_sg_watch_open(client, grid, after_revision, watch) bind(c, name="sg_watch_open") &
         result(status)
       import :: c_ptr, c_char, c_int64_t, c_int
@@ -547,26 +549,31 @@ contains
 
   ! ---- Evaluation ----
 
-  integer(c_int) function evaluate(client, grid, revision, block, level, points, capacity, &
+  integer(c_int) function evaluate(client, grid, revision, block, level, points, array_shape, &
       extents, revision_out) result(status)
     type(sg_client), intent(in) :: client
     character(*), intent(in) :: grid
     integer(c_int64_t), intent(in) :: revision
     integer, intent(in) :: block, level
     type(c_ptr), intent(in) :: points
-    integer(c_int64_t), intent(in) :: capacity
+    integer, intent(in) :: array_shape(:)
     integer, intent(out), optional :: extents(3)
     integer(c_int64_t), intent(out), optional :: revision_out
     integer(c_int32_t) :: e(3)
-    integer(c_int64_t) :: r
-    status = c_sg_evaluate(client%handle, c_string(grid), revision, int(block, c_int32_t), &
-        int(level, c_int32_t), points, capacity, e, r)
+    integer(c_int64_t) :: r, dims(4)
+    dims = 1
+    dims(1:size(array_shape)) = int(array_shape, c_int64_t)
+    status = c_sg_evaluate_shaped(client%handle, c_string(grid), revision, int(block, c_int32_t), &
+        int(level, c_int32_t), points, int(size(array_shape), c_int32_t), dims, e, r)
     if (present(extents)) extents = int(e)
     if (present(revision_out)) revision_out = r
   end function evaluate
 
   ! Evaluates `block` (0-based) of `revision` (0: the latest) at refinement `level` into
-  ! points(spatial_dim, ni, nj, nk), or any contiguous array of that size or larger.
+  ! points(spatial_dim, ni, nj, nk), the directions after its last dimension merged into it
+  ! (points(spatial_dim, ni, nj) for nk = 1, points(spatial_dim, ni * nj * nk)), or a rank-1
+  ! array of that size or larger. An array of another shape (another level's) is
+  ! SG_INVALID_ARGUMENT naming both shapes, and nothing is written.
   integer(c_int) function sg_evaluate_1(client, grid, revision, block, level, points, extents, &
       revision_out) result(status)
     type(sg_client), intent(in) :: client
@@ -576,8 +583,8 @@ contains
     real(c_double), intent(inout), contiguous, target :: points(:)
     integer, intent(out), optional :: extents(3)
     integer(c_int64_t), intent(out), optional :: revision_out
-    status = evaluate(client, grid, revision, block, level, c_loc(points), &
-        int(size(points), c_int64_t), extents, revision_out)
+    status = evaluate(client, grid, revision, block, level, c_loc(points), shape(points), &
+        extents, revision_out)
   end function sg_evaluate_1
   integer(c_int) function sg_evaluate_2(client, grid, revision, block, level, points, extents, &
       revision_out) result(status)
@@ -588,8 +595,8 @@ contains
     real(c_double), intent(inout), contiguous, target :: points(:, :)
     integer, intent(out), optional :: extents(3)
     integer(c_int64_t), intent(out), optional :: revision_out
-    status = evaluate(client, grid, revision, block, level, c_loc(points), &
-        int(size(points), c_int64_t), extents, revision_out)
+    status = evaluate(client, grid, revision, block, level, c_loc(points), shape(points), &
+        extents, revision_out)
   end function sg_evaluate_2
   integer(c_int) function sg_evaluate_3(client, grid, revision, block, level, points, extents, &
       revision_out) result(status)
@@ -600,8 +607,8 @@ contains
     real(c_double), intent(inout), contiguous, target :: points(:, :, :)
     integer, intent(out), optional :: extents(3)
     integer(c_int64_t), intent(out), optional :: revision_out
-    status = evaluate(client, grid, revision, block, level, c_loc(points), &
-        int(size(points), c_int64_t), extents, revision_out)
+    status = evaluate(client, grid, revision, block, level, c_loc(points), shape(points), &
+        extents, revision_out)
   end function sg_evaluate_3
   integer(c_int) function sg_evaluate_4(client, grid, revision, block, level, points, extents, &
       revision_out) result(status)
@@ -612,8 +619,8 @@ contains
     real(c_double), intent(inout), contiguous, target :: points(:, :, :, :)
     integer, intent(out), optional :: extents(3)
     integer(c_int64_t), intent(out), optional :: revision_out
-    status = evaluate(client, grid, revision, block, level, c_loc(points), &
-        int(size(points), c_int64_t), extents, revision_out)
+    status = evaluate(client, grid, revision, block, level, c_loc(points), shape(points), &
+        extents, revision_out)
   end function sg_evaluate_4
 
   ! ---- Watching ----

@@ -202,6 +202,20 @@ static void Points(sg_client* client) {
               SG_INVALID_ARGUMENT, "3");
   CHECK_ERROR(client, sg_evaluate(client, "nothing", 0, 0, 0, evaluated, 4, NULL, NULL),
               SG_NOT_FOUND, "nothing");
+  /* Shaped arrays (the Fortran module's): (2, ni, nj), (2, ni * nj) and (2, ni, nj, 1) fit;
+   * another level's shape, even large enough, does not, and nothing is written. */
+  const int64_t fits[3][4] = {{2, kNi, kNj, 1}, {2, kNi * kNj, 1, 1}, {2, kNi, kNj, 1}};
+  const int32_t ranks[3] = {3, 2, 4};
+  for (int q = 0; q < 3; ++q) {
+    CHECK_OK(client, sg_evaluate_shaped(client, "c-points", 0, 0, 0, evaluated, ranks[q], fits[q],
+                                        got, NULL));
+  }
+  const int64_t level1[3] = {2, 2 * kNi - 1, 2 * kNj - 1};
+  static double larger[2 * (2 * kNi - 1) * (2 * kNj - 1)];
+  larger[0] = -7.0;
+  CHECK_ERROR(client, sg_evaluate_shaped(client, "c-points", 0, 0, 0, larger, 3, level1, got, NULL),
+              SG_INVALID_ARGUMENT, "points: shape (2, 41, 21) does not fit block 0 at level 0");
+  CHECK(larger[0] == -7.0); /* nothing written */
   CHECK_OK(client, sg_delete(client, "c-points"));
   CHECK_ERROR(client, sg_delete(client, "c-points"), SG_NOT_FOUND, "c-points");
 }
@@ -320,8 +334,8 @@ static void Airfoil(sg_client* client, const char* grid_file) {
   options.step = 4;
   options.boundary_kind = 0; /* the walls */
   CHECK_ERROR(client,
-              sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MAX, far_begin, far_end,
-                               0, still, 22, 1, &moved),
+              sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MAX, far_begin, far_end, 0,
+                               still, 22, 1, &moved),
               SG_INVALID_ARGUMENT, "point (50, 32, 0) of block 0 is not on the moved boundary");
   options.boundary_kind = SG_BOUNDARY_OUTER;
   CHECK_OK(client, sg_deform_points(client, "c-naca", &options, 0, SG_FACE_J_MAX, far_begin,
@@ -338,8 +352,8 @@ static void Cgns(sg_client* client, const char* cgns_file, const char* plot3d_fi
               "path: NULL");
   CHECK_ERROR(client, sg_import_cgns(client, "/nonexistent/grid.cgns", "c-cgns", NULL, 0),
               SG_NOT_FOUND, "/nonexistent/grid.cgns");
-  CHECK_ERROR(client, sg_import_cgns(client, plot3d_file, "c-cgns", NULL, 0),
-              SG_INVALID_ARGUMENT, "cgns");
+  CHECK_ERROR(client, sg_import_cgns(client, plot3d_file, "c-cgns", NULL, 0), SG_INVALID_ARGUMENT,
+              "cgns");
   char id[64];
   CHECK_OK(client, sg_import_cgns(client, cgns_file, "c-cgns", id, sizeof id));
   CHECK(strcmp(id, "c-cgns") == 0);
