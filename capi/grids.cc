@@ -1,4 +1,5 @@
 // splinegrid.h: importing, fitting, describing and deleting grids.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -43,10 +44,9 @@ namespace {
 
 // The body of the file imports: reads `path` and uploads it with `upload` (the client, the
 // file's bytes, the wanted id), then copies the new grid's id out.
-sg_status ImportFile(
-    sg_client* c, const char* path, const char* grid_id, char* id, size_t id_size,
-    const std::function<absl::StatusOr<v1::Grid>(client::Client&, const std::string&,
-                                                 const std::string&)>& upload) {
+sg_status ImportFile(sg_client* c, const char* path, const char* grid_id, char* id, size_t id_size,
+                     const std::function<absl::StatusOr<v1::Grid>(
+                         client::Client&, const std::string&, const std::string&)>& upload) {
   if (c == nullptr) return SG_INVALID_ARGUMENT;
   return Guard(StateOf(c), [&]() -> absl::Status {
     SG_RETURN_IF_ERROR(RequireString(path, "path"));
@@ -64,21 +64,20 @@ extern "C" {
 
 sg_status sg_import_plot3d(sg_client* c, const char* path, const char* grid_id, int32_t planar_view,
                            char* id, size_t id_size) {
-  return ImportFile(c, path, grid_id, id, id_size,
-                    [&](client::Client& connected, const std::string& bytes,
-                        const std::string& wanted) {
-                      return connected.ImportPlot3d(bytes, wanted, BaseName(path),
-                                                    planar_view != 0);
-                    });
+  return ImportFile(
+      c, path, grid_id, id, id_size,
+      [&](client::Client& connected, const std::string& bytes, const std::string& wanted) {
+        return connected.ImportPlot3d(bytes, wanted, BaseName(path), planar_view != 0);
+      });
 }
 
 sg_status sg_import_cgns(sg_client* c, const char* path, const char* grid_id, char* id,
                          size_t id_size) {
-  return ImportFile(c, path, grid_id, id, id_size,
-                    [&](client::Client& connected, const std::string& bytes,
-                        const std::string& wanted) {
-                      return connected.ImportCgns(bytes, wanted, BaseName(path));
-                    });
+  return ImportFile(
+      c, path, grid_id, id, id_size,
+      [&](client::Client& connected, const std::string& bytes, const std::string& wanted) {
+        return connected.ImportCgns(bytes, wanted, BaseName(path));
+      });
 }
 
 sg_status sg_import_points(sg_client* c, const char* grid_id, int32_t spatial_dim,
@@ -111,24 +110,47 @@ sg_status sg_import_points(sg_client* c, const char* grid_id, int32_t spatial_di
 }
 
 sg_status sg_fit(sg_client* c, const char* grid, double tolerance, sg_fit_result* result) {
+  const sg_fit_options options{tolerance, 0.0};
+  return sg_fit_with(c, grid, &options, result);
+}
+
+sg_status sg_fit_with(sg_client* c, const char* grid, const sg_fit_options* options,
+                      sg_fit_result* result) {
   if (c == nullptr) return SG_INVALID_ARGUMENT;
   return Guard(StateOf(c), [&]() -> absl::Status {
     SG_RETURN_IF_ERROR(RequireString(grid, "grid"));
+    const sg_fit_options o = options == nullptr ? sg_fit_options{0.0, 0.0} : *options;
     v1::FitSpec spec;
-    if (tolerance > 0.0 && std::isfinite(tolerance)) {
-      spec.set_tolerance(tolerance);
-    } else if (tolerance == 0.0) {
+    if (o.tolerance > 0.0 && std::isfinite(o.tolerance)) {
+      spec.set_tolerance(o.tolerance);
+    } else if (o.tolerance == 0.0) {
       spec.mutable_boundary_tolerances();  // the defaults by kind
     } else {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "tolerance: ", tolerance, " (give a length > 0, or 0 for tolerances by boundary kind)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("tolerance: ", o.tolerance,
+                       " (give a length > 0, or 0 for tolerances by boundary kind)"));
+    }
+    if (o.first_layer != 0.0) {
+      if (o.tolerance != 0.0) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "first_layer: ", o.first_layer, " holds with tolerances by kind only (tolerance 0)"));
+      }
+      // The server names a value outside [0, 1] and a grid without walls.
+      spec.mutable_boundary_tolerances()->set_first_layer(o.first_layer);
     }
     SG_ASSIGN_OR_RETURN(client::Client * connected, c->state->Connected());
     SG_ASSIGN_OR_RETURN(const v1::FitGridResponse fit,
                         connected->Fit(client::GridName(grid), spec));
     if (result != nullptr) {
-      *result = sg_fit_result{fit.revision(), fit.num_points(), fit.num_control_points(),
-                              fit.max_deviation(), fit.seconds()};
+      double first_layer_change = -1.0;
+      for (const v1::BlockFitSummary& block : fit.blocks()) {
+        if (block.deviation_by_kind().has_first_layer()) {
+          first_layer_change =
+              std::max(first_layer_change, block.deviation_by_kind().first_layer());
+        }
+      }
+      *result = sg_fit_result{fit.revision(),      fit.num_points(), fit.num_control_points(),
+                              fit.max_deviation(), fit.seconds(),    first_layer_change};
     }
     return absl::OkStatus();
   });

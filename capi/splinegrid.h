@@ -89,7 +89,16 @@ typedef struct sg_fit_result {
   int64_t num_control_points; /* control points of every block together */
   double max_deviation;       /* largest distance of a point from the spline, grid units */
   double seconds;             /* the server's fit time */
+  double first_layer_change;  /* largest relative change of a wall's first-layer height (what a
+                                 solver's y+ follows), e.g. 0.05 for 5%; -1: no wall measured */
 } sg_fit_result;
+
+/* How sg_fit_with fits; all zero is sg_fit(client, grid, 0, result): tolerances by kind. */
+typedef struct sg_fit_options {
+  double tolerance;   /* > 0: the largest deviation of any point; 0: tolerances by boundary kind */
+  double first_layer; /* by kind only: hold the first-layer heights at walls to this relative
+                         change (e.g. 0.05); 0: not held (they may change by tens of percent) */
+} sg_fit_options;
 
 /* How a deformation is stamped and checked (DeformGridRequest); all zero is a valid default:
  * deform the latest revision, no staleness check, time 0, step 0, fold check at level 0, the
@@ -189,6 +198,10 @@ SG_API sg_status sg_import_points(sg_client* client, const char* grid_id, int32_
  * NULL. */
 SG_API sg_status sg_fit(sg_client* client, const char* grid, double tolerance,
                         sg_fit_result* result);
+/* sg_fit with `options` (NULL: all zero). A first_layer with a tolerance > 0, outside [0, 1],
+ * or on a grid without walls is INVALID_ARGUMENT naming it. */
+SG_API sg_status sg_fit_with(sg_client* client, const char* grid, const sg_fit_options* options,
+                             sg_fit_result* result);
 /* The grid's shape. */
 SG_API sg_status sg_grid_info_get(sg_client* client, const char* grid, sg_grid_info* info);
 /* Point counts of block `block` evaluated at refinement `level`: (n - 1) 2^level + 1 in every

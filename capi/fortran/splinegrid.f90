@@ -46,8 +46,11 @@ module splinegrid
   ! The C structs, field for field.
   type, bind(c), public :: sg_fit_result
     integer(c_int64_t) :: revision = 0, num_points = 0, num_control_points = 0
-    real(c_double) :: max_deviation = 0, seconds = 0
+    real(c_double) :: max_deviation = 0, seconds = 0, first_layer_change = 0
   end type sg_fit_result
+  type, bind(c), public :: sg_fit_options
+    real(c_double) :: tolerance = 0, first_layer = 0
+  end type sg_fit_options
   type, bind(c), public :: sg_deform_options
     integer(c_int64_t) :: reference_revision = 0, base_revision = 0
     real(c_double) :: time = 0
@@ -72,7 +75,8 @@ module splinegrid
   end type sg_revision_info
 
   public :: sg_connect, sg_close, sg_last_error, sg_status_name, sg_version
-  public :: sg_import_plot3d, sg_import_cgns, sg_import_points, sg_fit, sg_grid_info_get, sg_block_extents
+  public :: sg_import_plot3d, sg_import_cgns, sg_import_points, sg_fit, sg_fit_with
+  public :: sg_grid_info_get, sg_block_extents
   public :: sg_delete, sg_deform_rigid, sg_deform_points, sg_evaluate
   public :: sg_watch_open, sg_watch_next, sg_watch_cancel, sg_watch_close
 
@@ -155,6 +159,15 @@ module splinegrid
       integer(c_size_t), value :: id_size
       integer(c_int) :: status
     end function c_sg_import_points
+    function c_sg_fit_with(client, grid, options, result) bind(c, name="sg_fit_with") &
+        result(status)
+      import :: c_ptr, c_char, sg_fit_options, sg_fit_result, c_int
+      type(c_ptr), value :: client
+      character(kind=c_char), dimension(*), intent(in) :: grid
+      type(sg_fit_options), intent(in) :: options
+      type(sg_fit_result), intent(out) :: result
+      integer(c_int) :: status
+    end function c_sg_fit_with
     function c_sg_fit(client, grid, tolerance, result) bind(c, name="sg_fit") result(status)
       import :: c_ptr, c_char, c_double, sg_fit_result, c_int
       type(c_ptr), value :: client
@@ -453,6 +466,15 @@ contains
     type(sg_fit_result), intent(out) :: result
     status = c_sg_fit(client%handle, c_string(grid), tolerance, result)
   end function sg_fit
+
+  ! sg_fit with `options` (sg_fit_options: tolerance, first_layer).
+  integer(c_int) function sg_fit_with(client, grid, options, result) result(status)
+    type(sg_client), intent(in) :: client
+    character(*), intent(in) :: grid
+    type(sg_fit_options), intent(in) :: options
+    type(sg_fit_result), intent(out) :: result
+    status = c_sg_fit_with(client%handle, c_string(grid), options, result)
+  end function sg_fit_with
 
   integer(c_int) function sg_grid_info_get(client, grid, info) result(status)
     type(sg_client), intent(in) :: client

@@ -233,6 +233,20 @@ static void Airfoil(sg_client* client, const char* grid_file) {
   sg_fit_result fit;
   CHECK_OK(client, sg_fit(client, "c-naca", 0.0, &fit));
   CHECK(fit.revision == 1);
+  /* The first-layer heights a solver's y+ follows: reported, and held when asked. */
+  CHECK(fit.first_layer_change > 0.05);
+  CHECK_OK(client, sg_import_plot3d(client, grid_file, "c-layer", 0, NULL, 0));
+  sg_fit_options held = {0.0, 0.05};
+  CHECK_OK(client, sg_fit_with(client, "c-layer", &held, &fit));
+  CHECK(fit.revision == 1 && fit.first_layer_change >= 0.0 && fit.first_layer_change <= 0.05);
+  held.tolerance = 1e-3;
+  CHECK_ERROR(client, sg_fit_with(client, "c-layer", &held, &fit), SG_INVALID_ARGUMENT,
+              "first_layer: 0.05 holds with tolerances by kind only");
+  held.tolerance = 0.0;
+  held.first_layer = 2.0;
+  CHECK_ERROR(client, sg_fit_with(client, "c-layer", &held, &fit), SG_INVALID_ARGUMENT,
+              "spec.boundary_tolerances.first_layer = 2 is outside [0, 1]");
+  CHECK_OK(client, sg_delete(client, "c-layer"));
 
   sg_deform_options options;
   memset(&options, 0, sizeof options);
