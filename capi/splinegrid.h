@@ -163,7 +163,10 @@ SG_API const char* sg_version(void);
 
 /* Connects to `target` ("host:port") and checks that the server answers its health check
  * within `timeout_seconds` (also the deadline of every later call, retries included; <= 0: 120
- * s). `token` (bearer token) and `tls_ca_file` (PEM of the CA to trust: TLS instead of
+ * s). A call that breaks off (UNAVAILABLE: the server restarting, a replica gone) is made again
+ * with backoff (50 ms doubling to 2 s) until that deadline; a retried call that stores
+ * something can meet its own earlier attempt (a deform with base_revision then answers
+ * SG_ABORTED, a fit may store a second revision). `token` (bearer token) and `tls_ca_file` (PEM of the CA to trust: TLS instead of
  * plaintext) may be NULL or "". On SG_OK `*client` is a connected client. On an error other
  * than INVALID_ARGUMENT for a NULL `client`, `*client` is still set, to a client whose
  * sg_last_error says what went wrong (as sqlite3_open does): close it with sg_close. */
