@@ -57,17 +57,22 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
       return absl::InvalidArgumentError(
           absl::StrCat(field, " = ", number, " and step = ", *step, " are both given; give one"));
     }
-    std::optional<int64_t> newest_step;  // of the deformed revisions kept
+    std::optional<int64_t> newest_step, oldest_step;  // of the deformed revisions kept
     for (auto it = revisions.rbegin(); it != revisions.rend(); ++it) {
       if ((*it)->origin != RevisionOrigin::kDeform) continue;
       if ((*it)->step == *step) return *it;
       newest_step = std::max(newest_step.value_or((*it)->step), (*it)->step);
+      oldest_step = std::min(oldest_step.value_or((*it)->step), (*it)->step);
     }
     // Say why only as far as it is known: a step beyond every kept one was never stored (as far
-    // as this grid knows); one below may have been dropped by retention.
+    // as this grid knows); one between kept ones was not stored either (retention drops the
+    // oldest); one below them may have been dropped by retention.
     std::string why;
     if (newest_step && *step > *newest_step) {
       why = absl::StrCat(" (the newest step stored is ", *newest_step, ")");
+    } else if (oldest_step && *step > *oldest_step) {
+      why = absl::StrCat(" (none was stored for it; the deformed revisions kept range from step ",
+                         *oldest_step, " to ", *newest_step, ")");
     } else if (DroppedSome(*this)) {
       why = " (older deformed revisions were dropped by retention)";
     } else if (!newest_step) {

@@ -191,9 +191,13 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   SG_RETURN_IF_ERROR(Validate(request));
   const int64_t latest = grid->revisions.empty() ? 0 : grid->revisions.back()->number;
   if (request.base_revision != 0 && request.base_revision != latest) {
-    return absl::AbortedError(absl::StrCat("grids/", request.grid_id, ": base_revision ",
-                                           request.base_revision,
-                                           " is stale; the latest revision is ", latest));
+    // Ahead of the latest: not stale, but of another creation of this id or a wrong number.
+    return absl::AbortedError(absl::StrCat(
+        "grids/", request.grid_id, ": base_revision ", request.base_revision,
+        request.base_revision < latest
+            ? " is stale"
+            : " is ahead of the grid (deleted and created again since, or not a revision of it)",
+        "; the latest revision is ", latest));
   }
   SG_ASSIGN_OR_RETURN(
       const std::shared_ptr<const GridRevision> reference,

@@ -236,8 +236,8 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   const v1::EvaluatePointsResponse at = client_->EvaluatePoints(wall).value();
   double largest = 0.0;
   for (size_t s = 0; s < want.size(); ++s) {
-    largest = std::max(largest, std::hypot(at.points(2 * s) - want[s][0],
-                                           at.points(2 * s + 1) - want[s][1]));
+    largest = std::max(
+        largest, std::hypot(at.points(2 * s) - want[s][0], at.points(2 * s + 1) - want[s][1]));
   }
   EXPECT_GT(largest, 2e-4);  // the miss is real: a tenth of the bump or more
   EXPECT_NEAR(stored.report().boundary_error(), largest, 1e-12);
@@ -314,7 +314,11 @@ TEST_F(DeformErrorsTest, MalformedRequestsAreInvalidArguments) {
 TEST_F(DeformErrorsTest, StaleBaseIsAbortedAndAFoldIsRefused) {
   v1::DeformGridRequest stale = Pitch("naca", 1.0, 1);
   stale.set_base_revision(5);
-  EXPECT_THAT(Deform(stale), StatusIs(absl::StatusCode::kAborted, "stale"));
+  // Ahead of the latest revision (1) is not "stale" (a trial read that): it is said as it is.
+  EXPECT_THAT(Deform(stale),
+              StatusIs(absl::StatusCode::kAborted,
+                       "base_revision 5 is ahead of the grid (deleted and created again since, or "
+                       "not a revision of it); the latest revision is 1"));
   // Everything a third of a chord away stays while the nose turns by 60 degrees: it tears.
   v1::DeformGridRequest fold = Pitch("naca", 60.0, 1);
   fold.set_decay_radius(0.3);
@@ -467,6 +471,14 @@ TEST_F(DeformTest, RetentionKeepsTheFitAndTheNewestDeformedRevisions) {
       client_->Fair("naca", 8, &fairing).status(),
       StatusIs(absl::StatusCode::kFailedPrecondition, "revision 8 is faired already, as asked"));
   EXPECT_THAT(numbers(), ::testing::ElementsAre(1, 6, 7, 8, 9));  // nothing stored
+  // Steps 5, 6 and 7 are kept: a step between them that was never stored (a trial's step whose
+  // deform failed) is not blamed on retention either.
+  EXPECT_EQ(client_->Deform(Pitch("naca", 9.0, 9)).value().revision(), 10);
+  dropped_step.set_step(8);
+  EXPECT_THAT(client_->Evaluate(dropped_step).status(),
+              StatusIs(absl::StatusCode::kNotFound,
+                       "has no revision of step 8 (none was stored for it; the deformed "
+                       "revisions kept range from step 6 to 9)"));
 }
 
 }  // namespace
