@@ -116,7 +116,8 @@ class _DeformCalls(_Calls):
         ``base_revision`` is the latest revision the caller has seen: if the grid has a newer
         one the call fails with ABORTED (0: no check). ``time`` and ``step`` stamp the new
         revision (see ``get``/``evaluate(step=...)``). ``check_level`` (0 to 4) is the
-        refinement level of the fold check. ``propagation``: ``"blend"`` (free controls by
+        refinement level of the fold check: set it to the level you evaluate at (level 0 does
+        not see the folds of finer levels). ``propagation``: ``"blend"`` (free controls by
         their distance to the moved boundary) or ``"transfinite"`` (block interiors by Coons
         interpolation); ``decay_radius`` (0: the distance to the nearest fixed boundary),
         ``rigid_radius`` and ``smoothing_iterations`` shape it.
