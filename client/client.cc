@@ -248,6 +248,16 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
       // A TLS server closes a plaintext connection at once, and a server that asks for client
       // certificates a TLS connection without one; say what that usually means, and so for a
       // TLS client of a plaintext server.
+      // gRPC's own words when the client's deadline fires first; the server's say more.
+      if (result.code() == absl::StatusCode::kDeadlineExceeded &&
+          result.message() == "Deadline Exceeded") {
+        result = absl::Status(
+            result.code(),
+            absl::StrCat(
+                "the call's deadline passed before its answer came (the client's timeout, ",
+                absl::FormatDuration(options_.timeout),
+                ": ClientOptions.timeout, CLI --timeout, C timeout_seconds)"));
+      }
       // A plaintext server answers a TLS handshake with bytes that are no TLS record (OpenSSL:
       // "wrong version number").
       if (options_.use_tls && absl::IsUnavailable(result) &&

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
 #include "core/util/status_macros.h"
 
 namespace splinegrid {
@@ -233,7 +234,9 @@ absl::StatusOr<RigidMotion> ParseRigidMotion(const v1::RigidMotion& motion) {
         absl::StrCat("rigid.angle_degrees = ", motion.angle_degrees(), " is not finite"));
   }
   if (absl::Status s = out.Validate(); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("rigid ", s.message()));
+    // The kernel's "motion: center[0] = nan ..." as the request's field, rigid.center[0].
+    return absl::InvalidArgumentError(
+        absl::StrCat("rigid.", absl::StripPrefix(s.message(), "motion: ")));
   }
   return out;
 }

@@ -256,6 +256,12 @@ class Client(_UploadCalls, _ArchiveCalls, _GridCalls, _FitCalls, _GenerateCalls,
                         translated = SplinegridError(
                             translated.code,
                             f"{translated.message} (the server closed the connection: {hint})")
+                    # gRPC's own words when the client's deadline fires first.
+                    if (translated.code == "DEADLINE_EXCEEDED"
+                            and translated.message == "Deadline Exceeded"):
+                        translated = SplinegridError(
+                            translated.code, "the call's deadline passed before its answer "
+                            f"came (the client's timeout, {self.timeout} s: timeout=)")
                     # A plaintext server answers a TLS handshake with bytes that are no TLS
                     # record (OpenSSL: "wrong version number").
                     if (self._tls and translated.code == "UNAVAILABLE"

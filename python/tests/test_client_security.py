@@ -117,3 +117,19 @@ def test_a_tls_channel_trusts_the_given_ca_and_plaintext_fails(tmp_path):
         assert servicer.authorization == ["Bearer tls-token-1", None]
     finally:
         server.stop(None)
+
+
+def test_a_deadline_the_client_sees_first_says_which_timeout():
+    """A server that accepts the connection and never answers: the client's own deadline fires,
+    and its error names the timeout instead of gRPC's bare "Deadline Exceeded"."""
+    import socket
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(1)
+        port = silent.getsockname()[1]
+        with Client(f"127.0.0.1:{port}", retry=ONCE, timeout=1.5) as c, \
+                pytest.raises(SplinegridError) as error:
+            c.list()
+    assert error.value.code == "DEADLINE_EXCEEDED"
+    assert "the call's deadline passed before its answer came (the client's timeout, 1.5 s" \
+        in error.value.message

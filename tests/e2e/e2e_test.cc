@@ -292,6 +292,23 @@ TEST_F(EndToEndTest, CliReportsErrorsWithNonZeroExit) {
   EXPECT_EQ(nan_edge.exit_code, 2) << nan_edge.out;
   EXPECT_THAT(nan_edge.out, HasSubstr("edge = nan"));
   EXPECT_THAT(Cli("list").out, ::testing::Not(HasSubstr("grids/nan-edge")));
+  // A server that accepts the connection and never answers: the CLI's own deadline fires, and
+  // the error names the timeout (gRPC's words were only "Deadline Exceeded").
+  const int silent = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  ASSERT_EQ(bind(silent, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  ASSERT_EQ(listen(silent, 1), 0);
+  ASSERT_EQ(getsockname(silent, reinterpret_cast<sockaddr*>(&address), &length), 0);
+  const Result late = RunCommand(
+      absl::StrCat(kBinary, " list --timeout=1s --server=127.0.0.1:", ntohs(address.sin_port)));
+  close(silent);
+  EXPECT_EQ(late.exit_code, 1) << late.out;
+  EXPECT_THAT(late.out, HasSubstr("DEADLINE_EXCEEDED: the call's deadline passed before its "
+                                  "answer came (the client's timeout, 1s: ClientOptions.timeout, "
+                                  "CLI --timeout"));
   // A bad --name is named as the flag (it was the request's header.grid_id), before the upload.
   const Result bad_name =
       Cli(absl::StrCat("fit ", SharedDataPath("grids/n0012_113-33.p2dfmt"), " --name=Bad_Name"));
@@ -366,11 +383,12 @@ TEST_F(EndToEndTest, CliFitsByKindFairsAndWritesWallCurvature) {
   // The deviation of each kind against the tolerance it was held to, relative to the chord
   // found (issue 13); the interior has none.
   EXPECT_THAT(fit.out, HasSubstr("reference length 1 (the largest extent of 1 wall"));
-  EXPECT_THAT(fit.out, ::testing::MatchesRegex("(.|\n)*deviation: wall [0-9.e-]+ <= 0.00015 met, "
-                                               "interface [0-9.e-]+ <= 0.002 met, outer [0-9.e-]+ "
-                                               "<= 0.008 met, interior [0-9.e-]+ \\(no tolerance\\); "
-                                               "first-layer heights at walls changed by up to "
-                                               "[0-9.e-]+%\n(.|\n)*"));
+  EXPECT_THAT(fit.out,
+              ::testing::MatchesRegex("(.|\n)*deviation: wall [0-9.e-]+ <= 0.00015 met, "
+                                      "interface [0-9.e-]+ <= 0.002 met, outer [0-9.e-]+ "
+                                      "<= 0.008 met, interior [0-9.e-]+ \\(no tolerance\\); "
+                                      "first-layer heights at walls changed by up to "
+                                      "[0-9.e-]+%\n(.|\n)*"));
   EXPECT_THAT(fit.out, HasSubstr("connectivity: 1 matches"));
   // Block by block in the table too (a percentage).
   EXPECT_THAT(fit.out, HasSubstr("interior 1st layer  min jac"));

@@ -274,6 +274,10 @@ TEST_F(DeformErrorsTest, MalformedRequestsAreInvalidArguments) {
   EXPECT_THAT(Deform(unknown), StatusIs(absl::StatusCode::kInvalidArgument, "block 3"));
   EXPECT_THAT(Deform(Pitch("naca", std::nan(""), 1)),
               StatusIs(absl::StatusCode::kInvalidArgument, "angle_degrees = nan"));
+  v1::DeformGridRequest centre = Pitch("naca", 1.0, 1);
+  centre.mutable_rigid()->set_center(1, std::nan(""));
+  EXPECT_THAT(Deform(centre),
+              StatusIs(absl::StatusCode::kInvalidArgument, "rigid.center[1] = nan is not finite"));
   v1::DeformGridRequest counts = Pitch("naca", 0.0, 1);
   v1::ControlDisplacements* given = counts.mutable_controls()->add_blocks();
   given->add_controls(20);
