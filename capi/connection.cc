@@ -31,6 +31,9 @@ absl::Status Connect(const char* target, const char* token, const char* tls_ca_f
   // coupled solver rides out a restart of the server (a trial's C solver gave up 0.76 s into
   // one with a 30 s timeout, after the C++ client's default five attempts).
   options.retry.max_attempts = std::numeric_limits<int>::max();
+  // A watch has no deadline: its resumptions keep the bounded default, so that sg_watch_next
+  // reports a server that is gone for good.
+  options.watch_retry = client::RetryPolicy();
   if (token != nullptr) options.token = token;
   if (tls_ca_file != nullptr && *tls_ca_file != '\0') {
     SG_RETURN_IF_ERROR(client::LoadTlsFiles(tls_ca_file, "", "", &options), "tls_ca_file: ");

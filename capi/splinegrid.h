@@ -113,8 +113,8 @@ typedef struct sg_deform_options {
   int32_t check_level;        /* refinement level of the server's fold check, 0 to 4 */
   int32_t boundary_kind;      /* SG_BOUNDARY_*: the moved boundary (rigid and point motions); 0: walls */
   double max_boundary_error;  /* sg_deform_points: how far the deformed boundary may miss the
-                                 points (else SG_FAILED_PRECONDITION); 0: the fit's wall
-                                 tolerance */
+                                 points (else SG_FAILED_PRECONDITION); 0: twice the fit's
+                                 tolerance of the moved boundary's kind */
 } sg_deform_options;
 
 /* What a deformation stored (DeformGridResponse and its DeformReport). */
@@ -156,7 +156,7 @@ SG_API const char* sg_last_error(const sg_client* client);
 SG_API size_t sg_last_error_copy(const sg_client* client, char* buffer, size_t size);
 /* The code's name ("INVALID_ARGUMENT"); "UNKNOWN_CODE" for a number that is none. Static. */
 SG_API const char* sg_status_name(sg_status status);
-/* The library's version, "0.1.0". Static. */
+/* The library's version, "0.2.0". Static. */
 SG_API const char* sg_version(void);
 
 /* ---- Connection ---- */

@@ -245,9 +245,6 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
             absl::StrCat(result.message(), " [attempt ", attempts,
                          "; each earlier one ended UNAVAILABLE or was reset, and was made again]"));
       }
-      // A TLS server closes a plaintext connection at once, and a server that asks for client
-      // certificates a TLS connection without one; say what that usually means, and so for a
-      // TLS client of a plaintext server.
       // gRPC's own words when the client's deadline fires first; the server's say more.
       if (result.code() == absl::StatusCode::kDeadlineExceeded &&
           result.message() == "Deadline Exceeded") {
@@ -258,8 +255,10 @@ absl::Status Client::Call(const std::string& grid, const Attempt& attempt) const
                 absl::FormatDuration(options_.timeout),
                 ": ClientOptions.timeout, CLI --timeout, C timeout_seconds)"));
       }
-      // A plaintext server answers a TLS handshake with bytes that are no TLS record (OpenSSL:
-      // "wrong version number").
+      // A TLS server closes a plaintext connection at once, and a server that asks for client
+      // certificates a TLS connection without one; a plaintext server answers a TLS handshake
+      // with bytes that are no TLS record (OpenSSL: "wrong version number"). Say what that
+      // usually means.
       if (options_.use_tls && absl::IsUnavailable(result) &&
           absl::StrContains(result.message(), "wrong version number")) {
         result = absl::Status(
@@ -628,7 +627,8 @@ std::unique_ptr<RevisionStream> Client::Watch(const std::string& name, int64_t a
     call.reader = stub->WatchGrid(call.context.get(), resumed);
     return call;
   };
-  return std::make_unique<RevisionStream>(open, after_revision, options_.retry, channel_,
+  return std::make_unique<RevisionStream>(open, after_revision,
+                                          options_.watch_retry.value_or(options_.retry), channel_,
                                           std::move(cancel));
 }
 

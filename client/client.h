@@ -45,6 +45,8 @@ struct ClientOptions {
   // and FairGrid may store a second revision; imports and GenerateGrid with an id answer
   // ALREADY_EXISTS, DeleteGrid NOT_FOUND. Set retry.max_attempts = 1 to see every UNAVAILABLE.
   RetryPolicy retry;
+  // The resumptions of a watch (WatchGrid has no deadline to bound them): unset, `retry`.
+  std::optional<RetryPolicy> watch_retry;
 
   // The most bytes of values an Evaluate may assemble in this process (0: no limit). A larger
   // evaluation is refused with RESOURCE_EXHAUSTED as soon as its header arrives, before

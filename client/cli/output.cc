@@ -43,10 +43,14 @@ std::string FormatDeformReport(const v1::DeformReport& r) {
   return absl::StrFormat(
       "  fold check at level %d: %d cells, Jacobian ratio min %.4g (block %d, cell %d,%d,%d) "
       "max %.4g\n"
-      "  wall orthogonality change %.3g degrees; %d moved controls, decay radius %.4g; %.2f ms\n",
+      "  wall orthogonality change %.3g degrees; %d moved controls, decay radius %.4g; %.2f ms\n"
+      "%s",
       r.check_level(), r.cells_checked(), r.min_jacobian_ratio(), r.worst_block(), c.i(), c.j(),
       c.k(), r.max_jacobian_ratio(), r.max_orthogonality_change_degrees(), r.moved_controls(),
-      r.decay_radius(), 1e3 * r.seconds());
+      r.decay_radius(), 1e3 * r.seconds(),
+      r.boundary_error() > 0.0
+          ? absl::StrFormat("  boundary points missed by up to %.4g\n", r.boundary_error())
+          : std::string());
 }
 
 std::string FormatDeform(const std::string& name, const v1::DeformGridRequest& request,
@@ -238,9 +242,9 @@ std::string FormatFit(const std::string& name, const v1::FitGridResponse& fit) {
   absl::StrAppend(
       &out, FormatReport(fit.report(), fit.num_control_points() == fit.num_points(), cells > 0));
   absl::StrAppend(
-      &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %9s %8s %8s %6s\n",
-                            "block", "points", "controls", "ratio", "max dev", "wall", "interface",
-                            "outer", "interior", "1st layer", "min jac", "max size", "bad"));
+      &out, absl::StrFormat("%6s %10s %9s %7s %10s %10s %10s %10s %10s %9s %8s %8s %6s\n", "block",
+                            "points", "controls", "ratio", "max dev", "wall", "interface", "outer",
+                            "interior", "1st layer", "min jac", "max size", "bad"));
   for (int b = 0; b < fit.blocks_size(); ++b) {
     const v1::BlockFitSummary& s = fit.blocks(b);
     const v1::DeviationByKind& k = s.deviation_by_kind();

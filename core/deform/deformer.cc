@@ -659,8 +659,18 @@ absl::StatusOr<BoundaryMiss> Deformer::Miss(const std::vector<FittedBlock>& move
         const int64_t n0 = now.extent(0), n1 = now.extent(1);
         const Extents at = {static_cast<int>(p % n0), static_cast<int>((p / n0) % n1),
                             static_cast<int>(p / (n0 * n1))};
-        const int scale = 1 << points[r].level;
-        for (int d = 0; d < 3; ++d) miss.point[d] = points[r].range.begin[d] * scale + at[d];
+        // The face's own index in its normal direction (a range's begin there is not read:
+        // SelectedPoints), the range's lower corner scaled plus the sample's position along
+        // the others, at the range's level.
+        const FaceRange& range = points[r].range;
+        const int64_t scale = int64_t{1} << points[r].level;
+        for (int d = 0; d < 3; ++d) {
+          const int64_t index =
+              d == range.face.normal
+                  ? (range.face.upper ? (extents[fit->block][d] - int64_t{1}) * scale : 0)
+                  : range.begin[d] * scale + at[d];
+          miss.point[d] = index;
+        }
       }
     }
   }

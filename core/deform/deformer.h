@@ -40,6 +40,7 @@
 #ifndef SPLINEGRID_CORE_DEFORM_DEFORMER_H_
 #define SPLINEGRID_CORE_DEFORM_DEFORMER_H_
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -87,9 +88,9 @@ struct BoundaryPoints {
 
 // How far a deformed boundary lies from the points asked of it (Deformer::BoundaryMiss).
 struct BoundaryMiss {
-  double distance = 0.0;      // the largest distance
-  int range = 0;              // of the range given as points[range]
-  Extents point = {0, 0, 0};  // at this point of its block, at the range's level
+  double distance = 0.0;                     // the largest distance
+  int range = 0;                             // of the range given as points[range]
+  std::array<int64_t, 3> point = {0, 0, 0};  // at this point of its block, at the range's level
 };
 
 class Deformer {

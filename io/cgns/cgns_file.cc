@@ -17,7 +17,7 @@ absl::StatusOr<CgnsFile> CgnsFile::Open(const std::string& path, int mode) {
     if (mode == CG_MODE_READ) {
       // libcgns's own words for a file of another kind are about ADF internals ("Memory
       // boundary tag bad"): say first whether the file is CGNS at all.
-      std::string start(8192, '\0');
+      std::string start(8192 + 8, '\0');  // LooksLikeCgns tries offsets up to 8192
       std::ifstream file(path, std::ios::binary);
       file.read(start.data(), static_cast<std::streamsize>(start.size()));
       start.resize(static_cast<size_t>(std::max<std::streamsize>(file.gcount(), 0)));

@@ -109,8 +109,8 @@ absl::StatusOr<GridFitReport> ParseFitReport(const v1::StoredFitReport& stored,
       return Invalid(field, ".reference_length_source = ",
                      static_cast<int>(stored.reference_length_source()), " is not a known value");
     }
-    report.reference = ReferenceLength{stored.reference_length(), *source,
-                                       stored.reference_length_description()};
+    report.reference =
+        ReferenceLength{stored.reference_length(), *source, stored.reference_length_description()};
   }
   if (stored.has_tolerances()) {
     const v1::StoredBoundaryTolerances& t = stored.tolerances();
@@ -248,7 +248,8 @@ absl::StatusOr<GridFitOptions> ParseGridFitOptions(const v1::StoredFitOptions& s
     const BoundaryTolerances tolerances{t.wall(),     t.interface(), t.outer(),
                                         t.interior(), t.edge(),      t.first_layer()};
     if (absl::Status s = tolerances.Validate(); !s.ok()) {
-      return Annotate(s, field + ".boundary_tolerances");
+      // The message names boundary_tolerances.<kind>: under this field, as a request field is.
+      return absl::InvalidArgumentError(absl::StrCat(field, ".", s.message()));
     }
     options.boundary_tolerances = tolerances;
   }

@@ -54,6 +54,10 @@ absl::StatusOr<SourceBoundaries> ParseSourceBoundaries(const v1::SourceBoundarie
     out.block_names.push_back(in.block_names(q));
   }
   SG_RETURN_IF_ERROR(CheckName(in.base_name(), field + ".base_name"));
+  if (in.base_name().size() > 32) {  // a CGNS name: the writer could not write it back
+    return absl::InvalidArgumentError(absl::StrCat(field, ".base_name is ", in.base_name().size(),
+                                                   " bytes; a CGNS name has at most 32"));
+  }
   SG_RETURN_IF_ERROR(CheckName(in.data_class(), field + ".data_class"));
   out.base_name = in.base_name();
   out.data_class = in.data_class();

@@ -103,7 +103,7 @@ class _DeformCalls(_Calls):
           - ``boundary_points``: :class:`BoundaryPoints`, new positions (or displacements) of
             the points of boundary ranges at a refinement level, fitted with the stored basis
             by least squares. A boundary that misses them by more than
-            ``max_boundary_error`` (0: the fitted revision's wall tolerance) is refused with
+            ``max_boundary_error`` (0: twice the fit's tolerance of the moved boundary's kind) is refused with
             ``FAILED_PRECONDITION`` naming the point; ``report.boundary_error`` is the miss.
 
         ``boundary`` says what moves: ``"wall"`` (the default), ``"outer"``, ``"interface"``, a

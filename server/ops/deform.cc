@@ -64,14 +64,19 @@ absl::Status Validate(const DeformRequest& request) {
   return absl::OkStatus();
 }
 
-// How far a boundary-point deformation may miss the points given by default: as far as the
-// fitted revision the reference comes from was allowed to miss its walls (its wall tolerance),
-// or, fitted to control counts, did miss its points (its largest deviation); at least a
-// rounding-sized length. Deformed revisions carry no fit report: their fitted ancestor's.
-double DefaultMaxBoundaryError(const StoredGrid& grid, const GridRevision& reference) {
+// How far a boundary-point deformation may miss the points given by default: twice the
+// tolerance the fit of the reference held the moved boundary's kind to (the fit's own
+// allowance, and as much again for the motion, so that a solver sending its original wall nodes
+// is not refused for the fit's deviation), the tightest kind of a selection, walls for face
+// ranges; a fit without tolerances (control counts, interpolation) gets the default
+// tolerances by kind in its reference length. Deformed revisions carry their fit's report
+// (DeformedRevision); ones stored before that are walked back to their fit.
+double DefaultMaxBoundaryError(const StoredGrid& grid, const GridRevision& reference,
+                               const BoundarySelection& moved) {
   const GridRevision* fitted = &reference;
   std::shared_ptr<const GridRevision> up;
-  for (int hops = 0; hops < 1000 && fitted->origin == RevisionOrigin::kDeform && fitted->parent > 0;
+  for (int hops = 0; hops < 1000 && fitted->report.reference.length <= 0.0 &&
+                     fitted->origin == RevisionOrigin::kDeform && fitted->parent > 0;
        ++hops) {
     absl::StatusOr<std::shared_ptr<const GridRevision>> parent =
         grid.ResolveRevision(fitted->parent);
@@ -80,20 +85,25 @@ double DefaultMaxBoundaryError(const StoredGrid& grid, const GridRevision& refer
     fitted = up.get();
   }
   const GridFitReport& report = fitted->report;
-  const double limit = report.tolerances ? report.tolerances->wall : report.max_deviation;
-  return std::max(limit, 1e-12 * std::max(report.reference.length, 1.0));
+  const uint8_t kinds = moved.ranges.empty() && moved.kinds != 0
+                            ? moved.kinds
+                            : static_cast<uint8_t>(BoundaryKind::kWall);
+  const double length = report.reference.length > 0.0 ? report.reference.length : 1.0;
+  const double tolerance =
+      report.tolerances ? report.tolerances->For(kinds) : BoundaryTolerances().For(kinds) * length;
+  return 2.0 * std::max(tolerance, 1e-12 * length);
 }
 
 // The refusal of boundary points the deformed boundary misses by more than `limit`.
 absl::Status MissesBoundary(const BoundaryMiss& miss, double limit, bool given,
                             const std::vector<BoundaryPoints>& points) {
-  const Extents& p = miss.point;
+  const std::array<int64_t, 3>& p = miss.point;
   return absl::FailedPreconditionError(absl::StrCat(
       "the deformed boundary misses boundary_points[", miss.range, "] by ", miss.distance,
       " at point (", p[0], ", ", p[1], ", ", p[2], ") of block ",
       points[miss.range].range.face.block, " at level ", points[miss.range].level,
       ", more than max_boundary_error = ", limit,
-      given ? "" : " (the default: the fitted revision's wall tolerance)",
+      given ? "" : " (the default: twice the fit's tolerance of the moved boundary's kind)",
       ": the boundary's controls, fitted to the points by least squares, cannot follow a "
       "displacement that varies faster than its knot spans; nothing was stored (give smoother "
       "displacements, fit the grid with a tighter wall tolerance for more wall controls, or "
@@ -136,6 +146,9 @@ GridRevision DeformedRevision(const GridRevision& reference, const Deformer& def
   revision.time = request.time;
   revision.step = request.step;
   revision.fit_options = reference.fit_options;
+  // The fit's report, as its blocks' summaries below: what the deformation started from, and
+  // the tolerances its boundary points are held to (DefaultMaxBoundaryError).
+  revision.report = reference.report;
   revision.kinds = reference.kinds;
   revision.blocks = reference.blocks;
   for (size_t b = 0; b < moved.size(); ++b) {
@@ -227,8 +240,8 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> Deform(const OpsContext& con
   if (const auto* points = std::get_if<std::vector<BoundaryPoints>>(&request.motion)) {
     SG_ASSIGN_OR_RETURN(const BoundaryMiss miss, deformer.Miss(moved, *points));
     const bool given = request.max_boundary_error > 0.0;
-    const double limit =
-        given ? request.max_boundary_error : DefaultMaxBoundaryError(*grid, *reference);
+    const double limit = given ? request.max_boundary_error
+                               : DefaultMaxBoundaryError(*grid, *reference, request.options.moved);
     if (miss.distance > limit) return MissesBoundary(miss, limit, given, *points);
     boundary_error = miss.distance;
   }

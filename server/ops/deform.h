@@ -30,7 +30,7 @@ struct DeformRequest {
   DeformMotion motion;
   int check_level = 0;  // the fold check's refinement level, [0, kMaxDeformCheckLevel]
   // Boundary-point motions: the largest distance the deformed boundary may keep from the points
-  // given; 0: the fitted revision's wall tolerance (its largest deviation for a count fit).
+  // given; 0: twice the fit's tolerance of the moved boundary's kind (DefaultMaxBoundaryError).
   double max_boundary_error = 0.0;
   double time = 0.0;    // the solver's time and step, stamped on the revision
   int64_t step = 0;

@@ -48,12 +48,13 @@ absl::StatusOr<std::unique_ptr<GridEvaluation>> GridEvaluation::Plan(
     total += NumPoints(extents);  // each at most 2^40 (SampleExtents): no overflow
     if (total > request.max_points) {
       // `total` counts the blocks up to this one: the rest would add to it.
-      return absl::OutOfRangeError(absl::StrCat(
-          "the requested resolution gives ", total, " points in ",
-          q + 1 == blocks.size() ? std::string("all")
-                                 : absl::StrCat("its first ", q + 1, " of ", blocks.size()),
-          " blocks, more than the server's cap of ", request.max_points,
-          " (flag --max_output_points)"));
+      return absl::OutOfRangeError(
+          absl::StrCat("the requested resolution gives ", total, " points in ",
+                       q + 1 == blocks.size()
+                           ? absl::StrCat("all ", blocks.size(), " requested")
+                           : absl::StrCat("the first ", q + 1, " of ", blocks.size(), " requested"),
+                       " blocks, more than the server's cap of ", request.max_points,
+                       " (flag --max_output_points)"));
     }
     // The evaluator's intermediate nets: n_u' x n_v x n_w, and planes of n_u' x n_v.
     // Measured blocks are evaluated point by point, without them.

@@ -3,6 +3,7 @@
 #include <optional>
 #include <string>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "core/util/status_macros.h"
 
@@ -14,6 +15,17 @@ namespace {
 std::string SpecField(RevisionOrigin origin, int64_t parent) {
   return origin == RevisionOrigin::kFair ? absl::StrCat("revision ", parent, " fit_spec.")
                                          : std::string("spec.");
+}
+
+// Whether a kernel message starts with a GridFitOptions field ("boundary_tolerances.wall = ..."),
+// which the request names under its spec; other refusals are about the data.
+bool NamesAnOption(absl::string_view message) {
+  for (const char* field :
+       {"boundary_tolerances.", "tolerance ", "features.", "order ", "max_controls_per_direction ",
+        "block_control_counts", "reference_length ", "face_kinds"}) {
+    if (absl::StartsWith(message, field)) return true;
+  }
+  return false;
 }
 
 // Fits grid `grid` and publishes the revision.
@@ -97,7 +109,8 @@ absl::StatusOr<GridRevision> FitRevision(const OpsContext& context, const Source
     return absl::FailedPreconditionError(
         absl::StrCat(fitted.status().message(), "; nothing was stored"));
   }
-  if (fitted.status().code() == absl::StatusCode::kInvalidArgument) {
+  if (fitted.status().code() == absl::StatusCode::kInvalidArgument &&
+      NamesAnOption(fitted.status().message())) {
     // Options that only the grid's walls and points refuse (a first layer to hold where no
     // wall is, a tolerance below double precision); the kernel names GridFitOptions' field.
     // A refaired revision's spec cannot be changed by FairGrid: say how to get past it.

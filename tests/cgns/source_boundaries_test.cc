@@ -142,8 +142,8 @@ TEST(CgnsDecodedTest, HostileOutputIsInvalidArgumentNamingTheField) {
   d.mutable_boundaries()->mutable_dimensional_units()->RemoveLast();
   expect_refused(d, "boundaries.dimensional_units has 4 entries; give none or five");
   d = ValidDecoded();
-  d.mutable_boundaries()->set_base_name(std::string(300, 'b'));
-  expect_refused(d, "boundaries.base_name is longer than 256 bytes");
+  d.mutable_boundaries()->set_base_name(std::string(33, 'b'));
+  expect_refused(d, "boundaries.base_name is 33 bytes; a CGNS name has at most 32");
   d = ValidDecoded();
   v1::CgnsConnection* c = d.add_connections();
   c->mutable_range()->set_face(v1::BLOCK_FACE_I_MIN);

@@ -454,7 +454,7 @@ TEST_F(ArchiveCodecTest, HostileRevisionsAreRefusedNamingTheField) {
       {[](v1::StoredRevision& r) {
          r.mutable_fit_options()->mutable_boundary_tolerances()->set_wall(-1);
        },
-       "revision.fit_options.boundary_tolerances: "},
+       "revision.fit_options.boundary_tolerances.wall = -1"},
       {[](v1::StoredRevision& r) { r.mutable_fit_options()->set_tolerance(1e-3); },
        "tolerance and boundary_tolerances are both set"},
       {[](v1::StoredRevision& r) { r.mutable_fit_options()->set_order(11); },

@@ -227,7 +227,8 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   const absl::Status refused = client_->Deform(bump).status();
   EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition) << refused;
   EXPECT_THAT(refused.message(), HasSubstr("the deformed boundary misses boundary_points[0] by "));
-  EXPECT_THAT(refused.message(), HasSubstr("(the default: the fitted revision's wall tolerance)"));
+  EXPECT_THAT(refused.message(),
+              HasSubstr("(the default: twice the fit's tolerance of the moved boundary's kind)"));
   EXPECT_EQ(client_->Get("pitch").value().latest_revision(), 1);
 
   bump.set_max_boundary_error(0.01);
@@ -235,12 +236,17 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   EXPECT_EQ(stored.revision(), 2);
   const v1::EvaluatePointsResponse at = client_->EvaluatePoints(wall).value();
   double largest = 0.0;
+  size_t worst = 0;
   for (size_t s = 0; s < want.size(); ++s) {
-    largest = std::max(
-        largest, std::hypot(at.points(2 * s) - want[s][0], at.points(2 * s + 1) - want[s][1]));
+    const double d = std::hypot(at.points(2 * s) - want[s][0], at.points(2 * s + 1) - want[s][1]);
+    if (d > largest) largest = d, worst = s;
   }
   EXPECT_GT(largest, 2e-4);  // the miss is real: a tenth of the bump or more
   EXPECT_NEAR(stored.report().boundary_error(), largest, 1e-12);
+  // The refusal named that point: its grid index on the wall (j = 0) at level 0.
+  EXPECT_THAT(refused.message(),
+              HasSubstr(absl::StrCat("at point (", breaks[0] + static_cast<int>(worst),
+                                     ", 0, 0) of block 0 at level 0")));
   bump.set_max_boundary_error(-1.0);
   EXPECT_THAT(client_->Deform(bump).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, "max_boundary_error = -1"));

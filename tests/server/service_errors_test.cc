@@ -190,7 +190,7 @@ TEST_F(ServiceErrorsTest, BadEvaluationsAreRejected) {
   request.set_refinement_level(12);
   EXPECT_THAT(client_->Evaluate(request).status(),
               StatusIs(absl::StatusCode::kOutOfRange,
-                       "gives 60130131969 points in all blocks, more than the server's cap of "
+                       "gives 60130131969 points in all 1 requested blocks, more than the server's cap of "
                        "1073741824"));
   request.set_refinement_level(0);
   request.add_blocks(3);
