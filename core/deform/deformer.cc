@@ -654,8 +654,6 @@ absl::StatusOr<BoundaryMiss> Deformer::Miss(const std::vector<FittedBlock>& move
       if (std::sqrt(squared) > miss.distance) {
         miss.distance = std::sqrt(squared);
         miss.range = static_cast<int>(r);
-        // The sample's point of the block at the range's level: the range's lower corner
-        // scaled, plus the sample's position along each tangential direction.
         const int64_t n0 = now.extent(0), n1 = now.extent(1);
         const Extents at = {static_cast<int>(p % n0), static_cast<int>((p / n0) % n1),
                             static_cast<int>(p / (n0 * n1))};
