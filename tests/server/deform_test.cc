@@ -10,6 +10,8 @@
 
 #include "absl/synchronization/notification.h"
 #include "core/bspline/evaluation.h"
+#include "core/io/planar_view.h"
+#include "core/io/plot3d.h"
 #include "gmock/gmock.h"
 #include "proto/convert/convert.h"
 #include "tests/server/service_fixture.h"
@@ -250,6 +252,25 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   bump.set_max_boundary_error(-1.0);
   EXPECT_THAT(client_->Deform(bump).status(),
               StatusIs(absl::StatusCode::kInvalidArgument, "max_boundary_error = -1"));
+
+  // A solver sending its original wall nodes as positions is not refused for the fit's own
+  // deviation from them: the default allows twice the wall tolerance.
+  const MultiBlockGrid source =
+      PlanarView(ReadPlot3dFile(SharedDataPath("grids/n0012_pitch_257x129.fmt")).value()).value();
+  v1::DeformGridRequest nodes = Pitch("pitch", 0.0, 3);
+  nodes.clear_rigid();
+  v1::BoundaryPointMotion* same = nodes.mutable_boundary_points()->add_ranges();
+  *same->mutable_range() = range->range();
+  for (int i = breaks[0]; i <= breaks[1]; ++i) {
+    same->add_coordinates(source.blocks[0].Point(i, 0, 0)[0]);
+    same->add_coordinates(source.blocks[0].Point(i, 0, 0)[1]);
+  }
+  const absl::StatusOr<v1::DeformGridResponse> unchanged = client_->Deform(nodes);
+  ASSERT_TRUE(unchanged.ok()) << unchanged.status();
+  EXPECT_GT(unchanged->report().boundary_error(), 0.0);  // the fit's deviation from its points
+  const v1::Grid fitted = client_->Get("pitch", 1).value();
+  EXPECT_LE(unchanged->report().boundary_error(),
+            2.0 * fitted.revision().report().tolerances().wall());
 }
 
 // Every rejected deformation leaves the grid byte-identical, with no revision added.
