@@ -44,6 +44,20 @@ bool DroppedSome(const StoredGrid& grid) {
 
 }  // namespace
 
+std::shared_ptr<const GridRevision> StoredGrid::DeformationBase(
+    const GridRevision& revision) const {
+  if (revision.origin != RevisionOrigin::kDeform) return nullptr;
+  // Parents have smaller numbers: at most as many hops as revisions.
+  int64_t next = revision.parent;
+  for (size_t hops = 0; hops <= revisions.size() && next > 0; ++hops) {
+    absl::StatusOr<std::shared_ptr<const GridRevision>> up = ResolveRevision(next);
+    if (!up.ok()) return nullptr;
+    if ((*up)->origin != RevisionOrigin::kDeform) return *std::move(up);
+    next = (*up)->parent;
+  }
+  return nullptr;
+}
+
 absl::StatusOr<std::shared_ptr<const GridRevision>> StoredGrid::ResolveRevision(
     int64_t number, std::optional<int64_t> step, const char* field) const {
   if (number < 0) {

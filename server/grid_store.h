@@ -127,6 +127,10 @@ struct StoredGrid {
   absl::StatusOr<std::shared_ptr<const GridRevision>> ResolveRevision(
       int64_t number, std::optional<int64_t> step = std::nullopt,
       const char* field = "revision") const;
+
+  // The fitted or faired revision that deformed `revision`'s chain of deformations starts from
+  // (following parents); nullptr when `revision` is not deformed or retention dropped a link.
+  std::shared_ptr<const GridRevision> DeformationBase(const GridRevision& revision) const;
 };
 
 // The receiving end of a GridSubscription (implemented by the WatchGrid reactor).

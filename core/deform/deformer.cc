@@ -641,9 +641,11 @@ absl::StatusOr<BoundaryMiss> Deformer::Miss(const std::vector<FittedBlock>& move
                         CheckedFit(points[r], r, extents));
     const StructuredBlock now = EvaluateGrid(moved[fit->block].spline, fit->params);
     // The positions asked: given, or the reference's plus the displacements given.
-    std::vector<double> asked = SampleDisplacements(points[r], *fit);
-    const StructuredBlock was = EvaluateGrid(reference_[fit->block].spline, fit->params);
-    for (size_t v = 0; v < asked.size(); ++v) asked[v] += was.coords()[v];
+    std::vector<double> asked = points[r].coordinates;
+    if (points[r].displacements) {
+      const StructuredBlock was = EvaluateGrid(reference_[fit->block].spline, fit->params);
+      for (size_t v = 0; v < asked.size(); ++v) asked[v] += was.coords()[v];
+    }
     const int64_t count = now.num_points();
     for (int64_t p = 0; p < count; ++p) {
       double squared = 0.0;

@@ -73,18 +73,9 @@ absl::Status Validate(const DeformRequest& request) {
 // (DeformedRevision); ones stored before that are walked back to their fit.
 double DefaultMaxBoundaryError(const StoredGrid& grid, const GridRevision& reference,
                                const BoundarySelection& moved) {
-  const GridRevision* fitted = &reference;
-  std::shared_ptr<const GridRevision> up;
-  for (int hops = 0; hops < 1000 && fitted->report.reference.length <= 0.0 &&
-                     fitted->origin == RevisionOrigin::kDeform && fitted->parent > 0;
-       ++hops) {
-    absl::StatusOr<std::shared_ptr<const GridRevision>> parent =
-        grid.ResolveRevision(fitted->parent);
-    if (!parent.ok()) break;
-    up = *std::move(parent);
-    fitted = up.get();
-  }
-  const GridFitReport& report = fitted->report;
+  std::shared_ptr<const GridRevision> base;
+  if (reference.report.reference.length <= 0.0) base = grid.DeformationBase(reference);
+  const GridFitReport& report = base != nullptr ? base->report : reference.report;
   const uint8_t kinds = moved.ranges.empty() && moved.kinds != 0
                             ? moved.kinds
                             : static_cast<uint8_t>(BoundaryKind::kWall);

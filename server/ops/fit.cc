@@ -45,15 +45,10 @@ absl::StatusOr<std::shared_ptr<const GridRevision>> FitAndPublish(
 // revision the deformations start from.
 absl::Status CheckFairable(const StoredGrid& grid, const GridRevision& revision) {
   if (revision.origin != RevisionOrigin::kDeform) return absl::OkStatus();
-  // Walk the deformations back to their fit; retention may have dropped a link.
-  std::optional<int64_t> fitted;
-  int64_t next = revision.parent;
-  for (int hops = 0; hops < 1000 && !fitted; ++hops) {
-    const absl::StatusOr<std::shared_ptr<const GridRevision>> up = grid.ResolveRevision(next);
-    if (!up.ok()) break;
-    if ((*up)->origin != RevisionOrigin::kDeform) fitted = (*up)->number;
-    next = (*up)->parent;
-  }
+  // Retention may have dropped a link of the chain back to the fit.
+  const std::shared_ptr<const GridRevision> base = grid.DeformationBase(revision);
+  const std::optional<int64_t> fitted =
+      base == nullptr ? std::nullopt : std::optional<int64_t>(base->number);
   return absl::FailedPreconditionError(absl::StrCat(
       "grids/", grid.id, " revision ", revision.number,
       " is deformed: FairGrid refits the grid's imported points, which do not carry the "

@@ -38,6 +38,19 @@ v1::DeformGridRequest Pitch(const std::string& id, double degrees, int64_t step)
   return r;
 }
 
+// `request` (a Pitch) turned into a boundary-points motion of block 0's wall between the grid
+// indices breaks[0] and breaks[1] at `level`: the range added, its coordinates to be given.
+v1::BoundaryPointMotion* WallPoints(v1::DeformGridRequest& request, const std::vector<int>& breaks,
+                                    int level) {
+  request.clear_rigid();
+  v1::BoundaryPointMotion* range = request.mutable_boundary_points()->add_ranges();
+  range->mutable_range()->set_face(v1::BLOCK_FACE_J_MIN);
+  range->mutable_range()->mutable_begin()->set_i(breaks[0]);
+  range->mutable_range()->mutable_end()->set_i(breaks[1]);
+  range->set_refinement_level(level);
+  return range;
+}
+
 std::array<double, 2> Rotate(const double* x, double degrees) {
   const double a = degrees * kPi / 180.0, dx = x[0] - 0.25, dy = x[1];
   return {0.25 + std::cos(a) * dx - std::sin(a) * dy, std::sin(a) * dx + std::cos(a) * dy};
@@ -166,12 +179,7 @@ TEST_F(DeformTest, ControlDisplacementsAndBoundaryPointsMoveTheWall) {
   const std::vector<int>& breaks = reference.distribution.breaks(0);
   const std::vector<double> u = reference.distribution.Refined(0, breaks[0], breaks[1], 1);
   v1::DeformGridRequest points = Pitch("pitch", 0.0, 2);
-  points.clear_rigid();
-  v1::BoundaryPointMotion* range = points.mutable_boundary_points()->add_ranges();
-  range->mutable_range()->set_face(v1::BLOCK_FACE_J_MIN);
-  range->mutable_range()->mutable_begin()->set_i(breaks[0]);
-  range->mutable_range()->mutable_end()->set_i(breaks[1]);
-  range->set_refinement_level(1);
+  v1::BoundaryPointMotion* range = WallPoints(points, breaks, 1);
   v1::EvaluatePointsRequest wall;
   wall.set_name("grids/pitch");
   wall.set_revision(3);
@@ -207,11 +215,7 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   const std::vector<int>& breaks = reference.distribution.breaks(0);
   const std::vector<double> u = reference.distribution.Refined(0, breaks[0], breaks[1], 0);
   v1::DeformGridRequest bump = Pitch("pitch", 0.0, 1);
-  bump.clear_rigid();
-  v1::BoundaryPointMotion* range = bump.mutable_boundary_points()->add_ranges();
-  range->mutable_range()->set_face(v1::BLOCK_FACE_J_MIN);
-  range->mutable_range()->mutable_begin()->set_i(breaks[0]);
-  range->mutable_range()->mutable_end()->set_i(breaks[1]);
+  v1::BoundaryPointMotion* range = WallPoints(bump, breaks, 0);
   range->set_displacements(true);
   std::vector<std::array<double, 2>> want;
   v1::EvaluatePointsRequest wall;
@@ -258,9 +262,7 @@ TEST_F(DeformTest, ABoundaryThatCannotFollowThePointsIsRefusedOrReported) {
   const MultiBlockGrid source =
       PlanarView(ReadPlot3dFile(SharedDataPath("grids/n0012_pitch_257x129.fmt")).value()).value();
   v1::DeformGridRequest nodes = Pitch("pitch", 0.0, 3);
-  nodes.clear_rigid();
-  v1::BoundaryPointMotion* same = nodes.mutable_boundary_points()->add_ranges();
-  *same->mutable_range() = range->range();
+  v1::BoundaryPointMotion* same = WallPoints(nodes, breaks, 0);
   for (int i = breaks[0]; i <= breaks[1]; ++i) {
     same->add_coordinates(source.blocks[0].Point(i, 0, 0)[0]);
     same->add_coordinates(source.blocks[0].Point(i, 0, 0)[1]);
